@@ -1,0 +1,20 @@
+# All dependencies come from Debian 12 packages (scripts/install-deps.sh).
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(box2d 2.4 REQUIRED)
+
+# OpenCV: Debian's split packages (libopencv-{core,imgproc,imgcodecs}-dev) ship no CMake config,
+# so locate headers and the three libraries directly.
+find_path(OPENCV_INCLUDE_DIR opencv2/core.hpp PATH_SUFFIXES opencv4 REQUIRED)
+foreach(m core imgproc imgcodecs)
+  find_library(OPENCV_${m}_LIB NAMES opencv_${m} REQUIRED)
+endforeach()
+add_library(omniloc::opencv INTERFACE IMPORTED)
+target_include_directories(omniloc::opencv SYSTEM INTERFACE ${OPENCV_INCLUDE_DIR})
+target_link_libraries(omniloc::opencv INTERFACE ${OPENCV_imgcodecs_LIB} ${OPENCV_imgproc_LIB} ${OPENCV_core_LIB})
+
+# OSMesa and EGL are loaded at run time with dlopen (sim/gl_backend_*.cpp): each back-end resolves its
+# own GL entry points, so neither glvnd's libGL nor libOSMesa is linked and their gl* symbols never clash.
+find_path(OSMESA_INCLUDE_DIR GL/osmesa.h REQUIRED)
+find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)

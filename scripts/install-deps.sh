@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs every Debian package omniloc needs, only when something is missing.
+# OpenCV: we take the split -dev packages (core, imgproc, imgcodecs); they are ~10x smaller than
+# libopencv-dev but ship no CMake config, so CMakeLists.txt finds headers and libraries itself.
+set -euo pipefail
+PKGS=(
+  build-essential cmake pkg-config git
+  libbox2d-dev libeigen3-dev nlohmann-json3-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
+  libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
+  libbenchmark-dev libgtest-dev libgmock-dev
+  python3 python3-matplotlib
+)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PKGS[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"
