@@ -1,0 +1,30 @@
+#pragma once
+// Experiments that are not a simulated match (solver accuracy maps, the paper-001 cooperative
+// simulation, benchmarks of filters): `omniloc experiment NAME [--seed N] [-o DIR] [--quick]`.
+// Each writes its tables (JSON/CSV) and a printed summary into DIR, atomically.
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace omniloc::harness {
+
+struct ExperimentArgs {
+  std::uint64_t seed = 1;
+  std::string out_dir;   ///< results/experiments/<name> by default
+  bool quick = false;    ///< a smaller version for tests and the default job
+};
+
+struct ExperimentInfo {
+  std::string name;
+  std::string description;
+  /// Runs the experiment, writes files under args.out_dir, prints a paper-format table to `out`.
+  /// Returns 0 on success.
+  std::function<int(const ExperimentArgs& args, std::ostream& out)> run;
+};
+
+/// All experiments (harness/experiment_registry.cpp holds the list).
+const std::vector<ExperimentInfo>& experiments();
+
+}  // namespace omniloc::harness
