@@ -36,12 +36,21 @@ struct Lighting {
   std::vector<SunPatch> sun;     ///< bright sharp patches on the carpet
 };
 
+/// A flat coloured rectangle lying on the carpet (calibration patches, markers).
+struct FloorPatch {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();  ///< world frame, metres
+  Eigen::Vector2d half_size = {0.5, 0.5};            ///< metres, along the patch's own x / y
+  double angle = 0.0;                                ///< patch x axis in the world, radians
+  Eigen::Vector3d reflectance = {1, 1, 1};           ///< linear RGB albedo in [0, 1]
+};
+
 struct WorldState {
   double t = 0.0;  ///< seconds
   std::vector<RobotState> robots;
   BallState ball;
   bool has_ball = true;
   Lighting lighting;
+  std::vector<FloorPatch> floor_patches;
   const RobotState* robot(int id) const {
     for (const auto& r : robots)
       if (r.id == id) return &r;
