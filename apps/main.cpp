@@ -1,2 +1,162 @@
+// omniloc command line: validate, run, list, experiment (and more as capabilities land).
+// Exit codes: 0 success, 1 runtime failure, 2 bad input (scenario, arguments) — nothing written.
+#include <cstdlib>
 #include <iostream>
-int main() { std::cout << "omniloc\n"; return 0; }
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/field.hpp"
+#include "harness/experiment.hpp"
+#include "harness/localizer_registry.hpp"
+#include "harness/runner.hpp"
+#include "harness/scenario.hpp"
+#include "sim/motion.hpp"
+
+using namespace omniloc;
+
+namespace {
+
+const char* kUsage = R"(usage: omniloc <command> [options]
+
+commands:
+  run FILE [--seed N] [-o DIR] [--frames DIR] [--frames-every N] [--quiet]
+                         run a scenario; results in results/runs/<scenario>/<seed>/
+  validate FILE          check a scenario file (exit 2 with the JSON path of the first problem)
+  list                   field presets, motion scripts, localizers, noise profiles, experiments
+  experiment NAME [--seed N] [-o DIR] [--quick]
+                         run a named experiment (solver maps, cooperative simulation, ...)
+)";
+
+struct Args {
+  std::vector<std::string> positional;
+  std::vector<std::pair<std::string, std::string>> options;
+  std::vector<std::string> flags;
+};
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+Args parse(int argc, char** argv, int first, const std::vector<std::string>& with_value, const std::vector<std::string>& flags) {
+  Args a;
+  for (int i = first; i < argc; ++i) {
+    const std::string s = argv[i];
+    bool known = false;
+    for (const auto& o : with_value)
+      if (s == o) {
+        if (i + 1 >= argc) throw UsageError("option " + s + " needs a value");
+        a.options.emplace_back(s, argv[++i]);
+        known = true;
+      }
+    for (const auto& f : flags)
+      if (s == f) {
+        a.flags.push_back(s);
+        known = true;
+      }
+    if (!known) {
+      if (!s.empty() && s[0] == '-') throw UsageError("unknown option " + s);
+      a.positional.push_back(s);
+    }
+  }
+  return a;
+}
+
+std::string opt(const Args& a, const std::string& name, const std::string& def = "") {
+  for (const auto& [k, v] : a.options)
+    if (k == name) return v;
+  return def;
+}
+bool flag(const Args& a, const std::string& name) {
+  for (const auto& f : a.flags)
+    if (f == name) return true;
+  return false;
+}
+std::uint64_t parse_seed(const std::string& s) {
+  try {
+    std::size_t pos = 0;
+    const unsigned long long v = std::stoull(s, &pos);
+    if (pos != s.size()) throw std::invalid_argument(s);
+    return v;
+  } catch (const std::exception&) {
+    throw UsageError("--seed needs a non-negative integer, got \"" + s + "\"");
+  }
+}
+
+int cmd_validate(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("validate takes one scenario file");
+  const auto s = harness::load_scenario(a.positional[0]);
+  std::cout << a.positional[0] << ": ok (scenario \"" << s.name << "\", " << s.robots.size() << " robot(s), "
+            << s.duration << " s, localizer " << s.localizer.value("type", "?") << ")\n";
+  return 0;
+}
+
+int cmd_run(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("run takes one scenario file");
+  const auto s = harness::load_scenario(a.positional[0]);
+  harness::RunOptions o;
+  if (!opt(a, "--seed").empty()) o.seed = parse_seed(opt(a, "--seed"));
+  o.out_dir = opt(a, "-o");
+  o.frames_dir = opt(a, "--frames");
+  if (!opt(a, "--frames-every").empty()) o.frames_every = std::max(1, std::atoi(opt(a, "--frames-every").c_str()));
+  if (!flag(a, "--quiet")) o.log = &std::cerr;
+  const auto r = harness::run_scenario(s, o);
+  std::cout << "scenario " << s.name << ", seed " << r.seed << ", localizer " << r.summary["localizer"].get<std::string>()
+            << ", noise " << s.noise.name << "\n"
+            << r.table << "results: " << r.out_dir << "\n";
+  return 0;
+}
+
+int cmd_list() {
+  std::cout << "field presets:";
+  for (const auto& n : Field::preset_names()) std::cout << " " << n;
+  std::cout << "\nmotion scripts:";
+  for (const auto& n : sim::MotionScript::types()) std::cout << " " << n;
+  std::cout << "\nnoise profiles:";
+  for (const auto& n : harness::NoiseProfile::names()) std::cout << " " << n;
+  std::cout << "\nlocalizers:\n";
+  for (const auto& l : harness::localizers()) std::cout << "  " << l.type << " - " << l.description << "\n";
+  std::cout << "experiments:\n";
+  for (const auto& e : harness::experiments()) std::cout << "  " << e.name << " - " << e.description << "\n";
+  return 0;
+}
+
+int cmd_experiment(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("experiment takes one name (see omniloc list)");
+  for (const auto& e : harness::experiments()) {
+    if (e.name != a.positional[0]) continue;
+    harness::ExperimentArgs ea;
+    if (!opt(a, "--seed").empty()) ea.seed = parse_seed(opt(a, "--seed"));
+    ea.out_dir = opt(a, "-o", "results/experiments/" + e.name);
+    ea.quick = flag(a, "--quick");
+    return e.run(ea, std::cout);
+  }
+  throw UsageError("unknown experiment \"" + a.positional[0] + "\" (see omniloc list)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  try {
+    if (cmd == "validate") return cmd_validate(parse(argc, argv, 2, {}, {}));
+    if (cmd == "run") return cmd_run(parse(argc, argv, 2, {"--seed", "-o", "--frames", "--frames-every"}, {"--quiet"}));
+    if (cmd == "list") return cmd_list();
+    if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o"}, {"--quick"}));
+    throw UsageError("unknown command \"" + cmd + "\"");
+  } catch (const ConfigError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const UsageError& e) {
+    std::cerr << "error: " << e.what() << "\n" << kUsage;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "failed: " << e.what() << "\n";
+    return 1;
+  }
+}

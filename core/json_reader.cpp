@@ -45,8 +45,10 @@ std::string json_child(const std::string& path, const std::string& key) {
 
 std::string json_child(const std::string& path, std::size_t index) { return path + "/" + std::to_string(index); }
 
-JsonReader::JsonReader(const Json& j, std::string path) : j_(j), path_(std::move(path)) {
+JsonReader::JsonReader(const Json& j, std::string path, Json* effective)
+    : j_(j), effective_(effective), path_(std::move(path)) {
   if (!j_.is_object()) throw ConfigError(path_, json_brief(j_), "an object");
+  if (effective_ && !effective_->is_object()) *effective_ = Json::object();
 }
 
 bool JsonReader::has(const std::string& key) const { return j_.contains(key); }
@@ -62,29 +64,44 @@ const Json* JsonReader::fetch(const std::string& key, bool required) {
   return &*it;
 }
 
-const Json* JsonReader::raw(const std::string& key, bool required) { return fetch(key, required); }
+const Json* JsonReader::raw(const std::string& key, bool required) {
+  const Json* v = fetch(key, required);
+  if (v) record(key, *v);
+  return v;
+}
 
 double JsonReader::number(const std::string& key, std::optional<double> def, double lo, double hi) {
   const Json* v = fetch(key, !def.has_value());
-  if (!v) return *def;
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
   if (!v->is_number()) throw ConfigError(child_path(key), json_brief(*v), range_text(lo, hi));
   const double d = v->get<double>();
   if (!std::isfinite(d) || d < lo || d > hi) throw ConfigError(child_path(key), json_brief(*v), range_text(lo, hi));
+  record(key, d);
   return d;
 }
 
 double JsonReader::positive(const std::string& key, std::optional<double> def, double hi) {
   const Json* v = fetch(key, !def.has_value());
-  if (!v) return *def;
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
   if (!v->is_number()) throw ConfigError(child_path(key), json_brief(*v), range_text(0, hi, true));
   const double d = v->get<double>();
   if (!std::isfinite(d) || d <= 0.0 || d > hi) throw ConfigError(child_path(key), json_brief(*v), range_text(0, hi, true));
+  record(key, d);
   return d;
 }
 
 long long JsonReader::integer(const std::string& key, std::optional<long long> def, long long lo, long long hi) {
   const Json* v = fetch(key, !def.has_value());
-  if (!v) return *def;
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
   auto expected = [&] {
     std::string e = "an integer";
     if (lo != std::numeric_limits<long long>::min() && hi != std::numeric_limits<long long>::max())
@@ -104,13 +121,18 @@ long long JsonReader::integer(const std::string& key, std::optional<long long> d
     throw ConfigError(child_path(key), json_brief(*v), expected());
   }
   if (x < lo || x > hi) throw ConfigError(child_path(key), json_brief(*v), expected());
+  record(key, x);
   return x;
 }
 
 bool JsonReader::boolean(const std::string& key, std::optional<bool> def) {
   const Json* v = fetch(key, !def.has_value());
-  if (!v) return *def;
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
   if (!v->is_boolean()) throw ConfigError(child_path(key), json_brief(*v), "true or false");
+  record(key, v->get<bool>());
   return v->get<bool>();
 }
 
@@ -123,7 +145,10 @@ std::string JsonReader::string(const std::string& key, std::optional<std::string
     for (std::size_t i = 0; i < allowed.size(); ++i) e += (i ? ", \"" : "\"") + allowed[i] + "\"";
     return e;
   };
-  if (!v) return *def;
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
   if (!v->is_string()) throw ConfigError(child_path(key), json_brief(*v), expected());
   std::string s = v->get<std::string>();
   if (!allowed.empty()) {
@@ -131,13 +156,17 @@ std::string JsonReader::string(const std::string& key, std::optional<std::string
     for (const auto& a : allowed) ok = ok || a == s;
     if (!ok) throw ConfigError(child_path(key), json_brief(*v), expected());
   }
+  record(key, s);
   return s;
 }
 
 std::vector<double> JsonReader::numbers(const std::string& key, std::optional<std::vector<double>> def,
                                         std::size_t length) {
   const Json* v = fetch(key, !def.has_value());
-  if (!v) return *def;
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
   const std::string expected = "an array of " + std::to_string(length) + " numbers";
   if (!v->is_array() || v->size() != length) throw ConfigError(child_path(key), json_brief(*v), expected);
   std::vector<double> out;
@@ -147,13 +176,14 @@ std::vector<double> JsonReader::numbers(const std::string& key, std::optional<st
       throw ConfigError(json_child(child_path(key), i), json_brief(e), "a finite number");
     out.push_back(e.get<double>());
   }
+  record(key, out);
   return out;
 }
 
 std::optional<JsonReader> JsonReader::object(const std::string& key, bool required) {
   const Json* v = fetch(key, required);
   if (!v) return std::nullopt;
-  return JsonReader(*v, child_path(key));
+  return JsonReader(*v, child_path(key), effective_ ? &(*effective_)[key] : nullptr);
 }
 
 void JsonReader::finish() const {

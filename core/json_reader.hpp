@@ -24,8 +24,9 @@ std::string json_child(const std::string& path, std::size_t index);
 
 class JsonReader {
  public:
-  /// Throws ConfigError unless `j` is an object.
-  JsonReader(const Json& j, std::string path);
+  /// Throws ConfigError unless `j` is an object. When `effective` is given, every value read
+  /// (defaults included) is recorded there, so a run can save its effective configuration.
+  JsonReader(const Json& j, std::string path, Json* effective = nullptr);
 
   const std::string& path() const { return path_; }
   std::string child_path(const std::string& key) const { return json_child(path_, key); }
@@ -58,7 +59,12 @@ class JsonReader {
 
  private:
   const Json* fetch(const std::string& key, bool required);
+  template <class T>
+  void record(const std::string& key, const T& v) {
+    if (effective_) (*effective_)[key] = v;
+  }
   const Json& j_;
+  Json* effective_ = nullptr;
   std::string path_;
   std::set<std::string> seen_;
 };

@@ -1,0 +1,35 @@
+#include "harness/localizer_registry.hpp"
+
+#include "localization/odometry_only.hpp"
+
+namespace omniloc::harness {
+
+const std::vector<LocalizerInfo>& localizers() {
+  static const std::vector<LocalizerInfo> list = {
+      {"odometry_only", "dead reckoning from the true start pose (odometry drift baseline)", true, false,
+       [](JsonReader&, const LocalizerContext&) { return std::make_unique<OdometryOnlyLocalizer>(); }},
+  };
+  return list;
+}
+
+const LocalizerInfo& localizer_info(const std::string& type, const std::string& path) {
+  std::string known;
+  for (const auto& l : localizers()) {
+    if (l.type == type) return l;
+    known += (known.empty() ? "\"" : ", \"") + l.type + "\"";
+  }
+  throw ConfigError(path, "\"" + type + "\"", "a localizer type: one of " + known);
+}
+
+std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx,
+                                          Json* effective) {
+  JsonReader r(j, path, effective);
+  r.allow("comment");
+  const std::string type = r.string("type", std::nullopt);
+  const LocalizerInfo& info = localizer_info(type, r.child_path("type"));
+  auto loc = info.make(r, ctx);
+  r.finish();
+  return loc;
+}
+
+}  // namespace omniloc::harness

@@ -1,0 +1,42 @@
+#pragma once
+// Localizers by name. Adding a localizer: one new file pair in localization/ and one entry in
+// localizer_registry.cpp.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/field.hpp"
+#include "core/json_reader.hpp"
+#include "localization/localizer.hpp"
+
+namespace omniloc::harness {
+
+/// What a localizer may know when it is built: the field (the map every team has) and a seed for
+/// its own random stream. Never the simulator.
+struct LocalizerContext {
+  const Field* field = nullptr;
+  std::uint64_t seed = 0;
+  std::string cache_dir;  ///< where distance maps etc. may be cached
+};
+
+struct LocalizerInfo {
+  std::string type;
+  std::string description;
+  bool needs_start_pose = false;  ///< tracking-only localizers get the true start pose (papers' set-up)
+  bool needs_vision = true;       ///< false: no images need to be rendered
+  /// Reads parameters strictly (params reader at the localizer's JSON object; "type" already read)
+  /// and builds the localizer.
+  std::function<std::unique_ptr<Localizer>(JsonReader& params, const LocalizerContext& ctx)> make;
+};
+
+const std::vector<LocalizerInfo>& localizers();
+/// Throws ConfigError naming `path` when the type is unknown.
+const LocalizerInfo& localizer_info(const std::string& type, const std::string& path);
+
+/// Reads {"type": ..., params...} strictly and builds the localizer.
+std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx,
+                                          Json* effective = nullptr);
+
+}  // namespace omniloc::harness

@@ -1,0 +1,47 @@
+#pragma once
+// Scoring: the only place where ground truth meets estimates. Errors per frame, and the papers'
+// table layout (mean, std and max of |x|, |y| errors in cm and |theta| error in rad) plus position
+// RMSE and percentiles.
+#include <string>
+#include <vector>
+
+#include "core/json_reader.hpp"
+#include "core/pose2.hpp"
+
+namespace omniloc::harness {
+
+struct FrameError {
+  double t = 0.0;
+  double ex = 0.0, ey = 0.0;  ///< estimate - truth, world frame, metres
+  double eth = 0.0;           ///< wrapped, radians
+};
+
+struct AxisStats {
+  double mean = 0.0, std = 0.0, max = 0.0;  ///< of absolute errors
+};
+
+struct ErrorSummary {
+  std::size_t frames = 0;        ///< frames scored
+  AxisStats x_cm, y_cm;          ///< |x|, |y| errors, centimetres (papers' unit)
+  AxisStats theta_rad;           ///< |theta| error, radians
+  double pos_rmse_m = 0.0;       ///< sqrt(mean(ex^2 + ey^2)), metres
+  double pos_p50_m = 0.0, pos_p90_m = 0.0, pos_p95_m = 0.0, pos_max_m = 0.0;
+  double theta_rmse_rad = 0.0;
+};
+
+ErrorSummary summarize(const std::vector<FrameError>& errors);
+Json to_json(const ErrorSummary& s);
+
+/// One row of a paper-format table.
+struct TableRow {
+  std::string label;
+  ErrorSummary s;
+};
+/// The papers' layout: | case | mean x | mean y | mean th | std x | std y | std th | max x | max y | max th |
+/// followed by frames and position RMSE / p95. Plain text, fixed width.
+std::string paper_table(const std::vector<TableRow>& rows);
+
+/// Percentile (0..100) of a sample by linear interpolation between order statistics.
+double percentile(std::vector<double> v, double p);
+
+}  // namespace omniloc::harness

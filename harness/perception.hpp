@@ -1,0 +1,45 @@
+#pragma once
+// Perception: the robot-side path from the simulated world to Observations. The camera renders the
+// panorama (sim), the vision front end extracts line points from the pixels (localization); the
+// localizer only ever gets the Observations. Scenarios whose localizer needs no vision skip it.
+#include <memory>
+#include <optional>
+
+#include "core/messages.hpp"
+#include "core/rng.hpp"
+#include "harness/scenario.hpp"
+#include "localization/localizer.hpp"
+#include "sim/world_state.hpp"
+
+namespace omniloc::harness {
+
+struct PerceptionOutput {
+  Observations obs;
+  std::shared_ptr<const Image> image;  ///< the rendered frame (null when nothing was rendered)
+  CameraSettings settings;             ///< settings the image was taken with
+  double render_ms = 0.0;              ///< wall time, for timing.csv only (never in summaries)
+  double vision_ms = 0.0;
+};
+
+class Perception {
+ public:
+  virtual ~Perception() = default;
+  /// One camera frame of robot `robot_id`. `covered`: the lens is covered (kidnapping): black image.
+  virtual PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, bool covered) = 0;
+};
+
+/// No camera: empty observations (for localizers that need no vision, e.g. odometry_only).
+class NoPerception : public Perception {
+ public:
+  PerceptionOutput observe(const sim::WorldState&, int, double t, bool covered) override {
+    PerceptionOutput o;
+    o.obs.t = t;
+    o.obs.camera_ok = !covered;
+    return o;
+  }
+};
+
+/// Builds the perception a scenario needs (camera + vision when its localizer needs vision).
+std::unique_ptr<Perception> make_perception(const Scenario& s, bool needs_vision);
+
+}  // namespace omniloc::harness

@@ -1,0 +1,220 @@
+#include "harness/scenario.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "harness/localizer_registry.hpp"
+#include "sim/motion.hpp"
+
+namespace omniloc::harness {
+
+namespace {
+
+Pose2 read_pose(JsonReader& r, const std::string& key, std::optional<Pose2> def = std::nullopt) {
+  std::optional<std::vector<double>> d;
+  if (def) d = std::vector<double>{def->x, def->y, def->theta};
+  const auto v = r.numbers(key, d, 3);
+  return Pose2(v[0], v[1], v[2]);
+}
+
+void check_on_floor(const Field& f, const Eigen::Vector2d& p, double clearance, const std::string& path,
+                    const std::string& what) {
+  if (!f.inside_floor(p, clearance))
+    throw ConfigError(path, "[" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + "]",
+                      what + " inside the walls (|x| <= " + std::to_string(f.half_floor_x() - clearance) +
+                          ", |y| <= " + std::to_string(f.half_floor_y() - clearance) + " m)");
+}
+
+}  // namespace
+
+std::vector<std::string> NoiseProfile::names() { return {"ideal", "robot"}; }
+
+NoiseProfile NoiseProfile::named(const std::string& name, const std::string& path) {
+  NoiseProfile p;
+  p.name = name;
+  if (name == "ideal") {
+    p.camera = Json{{"vibration_std", 0.0}, {"read_noise", 0.0}, {"shot_noise", 0.0}};
+    return p;
+  }
+  if (name == "robot") {
+    // Physically plausible values for an MSL robot on carpet (not tuned to the papers' table):
+    // odometry random walk 1.5 cm/sqrt(m) with 1 % wheel-scale error and 2 deg/sqrt(rad) turn noise;
+    // an MTi-class heading: 1 deg white noise, bias random walk 0.1 deg/sqrt(s).
+    p.odometry = {0.015, 0.035, 0.01, 0.01};
+    p.heading = {deg2rad(1.0), deg2rad(0.1), 0.0, 0.0, 0.0};
+    p.camera = Json::object();  // the camera's own defaults are the robot profile
+    return p;
+  }
+  throw ConfigError(path, "\"" + name + "\"", "a noise profile: \"ideal\" or \"robot\"");
+}
+
+const RobotConfig* Scenario::robot(int id) const {
+  for (const auto& r : robots)
+    if (r.spec.id == id) return &r;
+  return nullptr;
+}
+
+std::vector<int> Scenario::localized_robots() const {
+  std::vector<int> ids;
+  for (const auto& r : robots)
+    if (r.localize) ids.push_back(r.spec.id);
+  return ids;
+}
+
+Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source) {
+  Scenario s;
+  s.source = source;
+  JsonReader r(j, "", &s.effective);
+  r.allow("comment");
+  s.name = r.string("name", name);
+  s.description = r.string("description", std::string());
+  s.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, (1LL << 53)));
+  s.duration = r.positive("duration", 30.0, 3600.0);
+  s.physics_rate = r.number("physics_rate", 200.0, 20.0, 2000.0);
+  s.camera_rate = r.number("camera_rate", 30.0, 1.0, 200.0);
+  if (s.camera_rate > s.physics_rate)
+    throw ConfigError("/camera_rate", std::to_string(s.camera_rate), "a camera rate <= physics_rate (" + std::to_string(s.physics_rate) + " Hz)");
+
+  // Field: a preset name or an inline object.
+  const Json* field = r.raw("field");
+  if (!field || field->is_string()) {
+    s.field = Field::preset(field ? field->get<std::string>() : std::string("msl2012"), "/field");
+    s.effective["field"] = s.field.name;
+  } else {
+    s.field = Field::from_json(*field, "/field");
+  }
+
+  s.noise = NoiseProfile::named(r.string("noise_profile", std::string("robot")), "/noise_profile");
+
+  // Robots.
+  const Json* robots = r.raw("robots", true);
+  if (!robots->is_array() || robots->empty())
+    throw ConfigError("/robots", json_brief(*robots), "a non-empty array of robot objects");
+  std::set<int> ids;
+  Json eff_robots = Json::array();
+  for (std::size_t i = 0; i < robots->size(); ++i) {
+    const std::string rp = json_child("/robots", i);
+    Json eff;
+    JsonReader rr((*robots)[i], rp, &eff);
+    rr.allow("comment");
+    RobotConfig rc;
+    rc.spec.id = static_cast<int>(rr.integer("id", static_cast<long long>(i), 0, 99));
+    if (!ids.insert(rc.spec.id).second) throw ConfigError(rp + "/id", std::to_string(rc.spec.id), "a robot id not used by another robot");
+    rc.spec.team = static_cast<int>(rr.integer("team", 0, 0, 1));
+    rc.spec.start = read_pose(rr, "start");
+    rc.spec.radius = rr.number("radius", 0.26, 0.1, 0.4);
+    rc.spec.height = rr.number("height", 0.8, 0.2, 1.5);
+    rc.spec.max_speed = rr.positive("max_speed", 4.0, 10.0);
+    rc.spec.max_accel = rr.positive("max_accel", 3.0, 20.0);
+    rc.localize = rr.boolean("localize", i == 0);
+    rc.has_heading_sensor = rr.boolean("heading_sensor", true);
+    check_on_floor(s.field, rc.spec.start.translation(), rc.spec.radius, rp + "/start", "a start position with the whole robot");
+    rc.motion = rr.raw("motion") ? *rr.raw("motion") : Json{{"type", "still"}};
+    rc.motion_path = rp + "/motion";
+    sim::MotionScript::from_json(rc.motion, rc.motion_path, 0);  // validate now
+    rc.odometry = s.noise.odometry;
+    rc.heading = s.noise.heading;
+    if (auto o = rr.object("odometry")) {
+      rc.odometry = sim::OdometryNoise::from_json(*o, s.noise.odometry);
+      o->finish();
+    } else {
+      eff["odometry"] = {{"trans_sigma", rc.odometry.trans_sigma}, {"rot_sigma", rc.odometry.rot_sigma},
+                         {"rot_per_trans", rc.odometry.rot_per_trans}, {"scale_sigma", rc.odometry.scale_sigma}};
+    }
+    if (auto h = rr.object("heading")) {
+      rc.heading = sim::HeadingNoise::from_json(*h, s.noise.heading);
+      h->finish();
+    } else {
+      eff["heading"] = {{"noise_sigma", rc.heading.noise_sigma}, {"bias_walk", rc.heading.bias_walk},
+                        {"drift_rate", rc.heading.drift_rate}, {"initial_bias", rc.heading.initial_bias},
+                        {"offset", rc.heading.offset}};
+    }
+    rr.finish();
+    eff_robots.push_back(eff);
+    s.robots.push_back(rc);
+  }
+  s.effective["robots"] = eff_robots;
+  // Robots must not start inside one another.
+  for (std::size_t a = 0; a < s.robots.size(); ++a)
+    for (std::size_t b = a + 1; b < s.robots.size(); ++b) {
+      const auto& A = s.robots[a].spec;
+      const auto& B = s.robots[b].spec;
+      if ((A.start.translation() - B.start.translation()).norm() < A.radius + B.radius)
+        throw ConfigError(json_child("/robots", b) + "/start", "robot " + std::to_string(B.id) + " overlapping robot " + std::to_string(A.id),
+                          "start positions at least the sum of the radii apart");
+    }
+  if (s.localized_robots().empty())
+    throw ConfigError("/robots", "no robot with \"localize\": true", "at least one localized robot");
+
+  if (auto b = r.object("ball")) {
+    s.has_ball = true;
+    const auto p = b->numbers("position", std::nullopt, 2);
+    const auto v = b->numbers("velocity", std::vector<double>{0, 0}, 2);
+    s.ball_position = {p[0], p[1]};
+    s.ball_velocity = {v[0], v[1]};
+    check_on_floor(s.field, s.ball_position, 0.11, "/ball/position", "a ball position");
+    b->finish();
+  }
+
+  // Events.
+  if (const Json* ev = r.raw("events")) {
+    if (!ev->is_array()) throw ConfigError("/events", json_brief(*ev), "an array of event objects");
+    for (std::size_t i = 0; i < ev->size(); ++i) {
+      const std::string ep = json_child("/events", i);
+      JsonReader er((*ev)[i], ep);
+      er.allow("comment");
+      EventConfig e;
+      e.path = ep;
+      e.type = er.string("type", std::nullopt, {"teleport", "cover", "kidnap"});
+      e.t = er.number("t", std::nullopt, 0.0, s.duration);
+      e.robot = static_cast<int>(er.integer("robot", s.localized_robots().front(), 0, 99));
+      if (!s.robot(e.robot)) throw ConfigError(ep + "/robot", std::to_string(e.robot), "the id of a robot in /robots");
+      if (e.type == "teleport" || e.type == "kidnap") {
+        e.pose = read_pose(er, "pose");
+        check_on_floor(s.field, e.pose.translation(), s.robot(e.robot)->spec.radius, ep + "/pose", "a target with the whole robot");
+      }
+      if (e.type == "cover" || e.type == "kidnap") e.duration = er.positive("duration", e.type == "kidnap" ? 2.0 : 1.0, 600.0);
+      er.finish();
+      s.events.push_back(e);
+    }
+    std::stable_sort(s.events.begin(), s.events.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  }
+
+  const Json* loc = r.raw("localizer");
+  s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};
+  if (!s.localizer.is_object()) throw ConfigError("/localizer", json_brief(s.localizer), "an object {\"type\": ...}");
+
+  // Camera: the profile's defaults under the scenario's explicit values.
+  s.camera = s.noise.camera;
+  if (const Json* cam = r.raw("camera")) {
+    if (!cam->is_object()) throw ConfigError("/camera", json_brief(*cam), "an object");
+    for (auto it = cam->begin(); it != cam->end(); ++it) s.camera[it.key()] = it.value();
+  }
+  r.finish();
+  validate_deep(s);
+  return s;
+}
+
+void validate_deep(const Scenario& s) {
+  LocalizerContext ctx;
+  ctx.field = &s.field;
+  ctx.seed = s.seed;
+  Json eff;
+  make_localizer(s.localizer, "/localizer", ctx, &eff);
+}
+
+Scenario load_scenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "no readable file", "an existing scenario JSON file");
+  Json j;
+  try {
+    j = Json::parse(in);
+  } catch (const Json::parse_error& e) {
+    throw ConfigError(path, "invalid JSON", std::string("valid JSON (") + e.what() + ")");
+  }
+  return parse_scenario(j, std::filesystem::path(path).stem().string(), path);
+}
+
+}  // namespace omniloc::harness

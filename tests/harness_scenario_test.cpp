@@ -1,0 +1,130 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <functional>
+
+#include "core/atomic_file.hpp"
+#include "harness/runner.hpp"
+#include "harness/scenario.hpp"
+
+using namespace omniloc;
+using namespace omniloc::harness;
+
+namespace {
+Json base() {
+  return Json::parse(R"({
+    "duration": 2.0,
+    "robots": [
+      {"id": 0, "start": [0, -2, 0], "motion": {"type": "waypoints", "speed": 1.0, "points": [[1, -2]]}},
+      {"id": 1, "team": 1, "start": [3, 0, 0], "localize": false}
+    ],
+    "ball": {"position": [1, 1]},
+    "events": [{"type": "kidnap", "t": 1.0, "pose": [2, 2, 0]}],
+    "localizer": {"type": "odometry_only"}
+  })");
+}
+
+std::string error_path(const Json& j) {
+  try {
+    parse_scenario(j, "t");
+  } catch (const ConfigError& e) {
+    return e.path();
+  }
+  return "(accepted)";
+}
+}  // namespace
+
+TEST(ScenarioValidation, BaseIsValid) { EXPECT_EQ(error_path(base()), "(accepted)"); }
+
+struct BadCase {
+  const char* name;
+  std::function<void(Json&)> mutate;
+  const char* path;
+};
+
+TEST(ScenarioValidation, EveryErrorNamesItsJsonPath) {
+  const std::vector<BadCase> cases = {
+      {"misspelt top-level key", [](Json& j) { j["duraton"] = 3; }, "/duraton"},
+      {"negative duration", [](Json& j) { j["duration"] = -1; }, "/duration"},
+      {"string duration", [](Json& j) { j["duration"] = "long"; }, "/duration"},
+      {"camera faster than physics", [](Json& j) { j["camera_rate"] = 150; j["physics_rate"] = 100; }, "/camera_rate"},
+      {"unknown preset", [](Json& j) { j["field"] = "nofield"; }, "/field"},
+      {"field too large", [](Json& j) { j["field"] = Json{{"length", 40}}; }, "/field/length"},
+      {"unknown noise profile", [](Json& j) { j["noise_profile"] = "noisy"; }, "/noise_profile"},
+      {"no robots", [](Json& j) { j["robots"] = Json::array(); }, "/robots"},
+      {"robot key typo", [](Json& j) { j["robots"][0]["strat"] = {0, 0, 0}; }, "/robots/0/strat"},
+      {"start outside walls", [](Json& j) { j["robots"][0]["start"] = {12, 0, 0}; }, "/robots/0/start"},
+      {"start with two numbers", [](Json& j) { j["robots"][0]["start"] = {1, 0}; }, "/robots/0/start"},
+      {"duplicate id", [](Json& j) { j["robots"][1]["id"] = 0; }, "/robots/1/id"},
+      {"overlapping robots", [](Json& j) { j["robots"][1]["start"] = {0.2, -2, 0}; }, "/robots/1/start"},
+      {"unknown motion", [](Json& j) { j["robots"][0]["motion"]["type"] = "fly"; }, "/robots/0/motion/type"},
+      {"negative speed", [](Json& j) { j["robots"][0]["motion"]["speed"] = -1; }, "/robots/0/motion/speed"},
+      {"bad waypoint", [](Json& j) { j["robots"][0]["motion"]["points"][0] = "x"; }, "/robots/0/motion/points/0"},
+      {"odometry noise typo", [](Json& j) { j["robots"][0]["odometry"] = {{"trans_sgma", 0.1}}; }, "/robots/0/odometry/trans_sgma"},
+      {"negative heading noise", [](Json& j) { j["robots"][0]["heading"] = {{"noise_sigma", -0.1}}; }, "/robots/0/heading/noise_sigma"},
+      {"nobody localized", [](Json& j) { j["robots"][0]["localize"] = false; }, "/robots"},
+      {"ball outside", [](Json& j) { j["ball"]["position"] = {0, 9}; }, "/ball/position"},
+      {"event type", [](Json& j) { j["events"][0]["type"] = "explode"; }, "/events/0/type"},
+      {"event after the end", [](Json& j) { j["events"][0]["t"] = 5.0; }, "/events/0/t"},
+      {"event unknown robot", [](Json& j) { j["events"][0]["robot"] = 7; }, "/events/0/robot"},
+      {"kidnap into a wall", [](Json& j) { j["events"][0]["pose"] = {9.9, 0, 0}; }, "/events/0/pose"},
+      {"localizer unknown", [](Json& j) { j["localizer"]["type"] = "magic"; }, "/localizer/type"},
+      {"localizer param typo", [](Json& j) { j["localizer"]["particels"] = 5; }, "/localizer/particels"},
+      {"camera not an object", [](Json& j) { j["camera"] = 3; }, "/camera"},
+  };
+  for (const auto& c : cases) {
+    Json j = base();
+    c.mutate(j);
+    EXPECT_EQ(error_path(j), c.path) << c.name;
+  }
+}
+
+TEST(ScenarioValidation, SyntaxErrorNamesTheFile) {
+  const std::string p = (std::filesystem::temp_directory_path() / "omniloc_bad_syntax.json").string();
+  write_file_atomic(p, "{\"duration\": 3,,}");
+  try {
+    load_scenario(p);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), p);
+    EXPECT_NE(std::string(e.what()).find("parse error"), std::string::npos);
+  }
+}
+
+TEST(ScenarioValidation, EffectiveConfigHasDefaults) {
+  const Scenario s = parse_scenario(base(), "t");
+  EXPECT_EQ(s.effective["physics_rate"], 200.0);
+  EXPECT_EQ(s.effective["noise_profile"], "robot");
+  EXPECT_EQ(s.effective["robots"][0]["max_speed"], 4.0);
+  EXPECT_EQ(s.effective["robots"][0]["odometry"]["trans_sigma"], 0.015);
+}
+
+TEST(Determinism, SameSeedGivesByteIdenticalResults) {
+  const Scenario s = parse_scenario(base(), "det");
+  const auto tmp = std::filesystem::temp_directory_path() / "omniloc_det";
+  std::filesystem::remove_all(tmp);
+  RunOptions a, b, c;
+  a.out_dir = (tmp / "a").string();
+  b.out_dir = (tmp / "b").string();
+  c.out_dir = (tmp / "c").string();
+  c.seed = 99;
+  run_scenario(s, a);
+  run_scenario(s, b);
+  run_scenario(s, c);
+  for (const char* f : {"gt.tum", "est.tum", "summary.json", "frames.csv", "events.jsonl", "config.json"})
+    EXPECT_EQ(read_file(a.out_dir + "/" + f), read_file(b.out_dir + "/" + f)) << f;
+  EXPECT_NE(read_file(a.out_dir + "/est.tum"), read_file(c.out_dir + "/est.tum"));
+  // Nothing half-written is left beside the results.
+  for (const auto& e : std::filesystem::directory_iterator(tmp)) EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos);
+}
+
+TEST(Runner, KidnapTeleportsWithoutOdometryAndIsLogged) {
+  const Scenario s = parse_scenario(base(), "kid");
+  RunOptions o;
+  o.out_dir = (std::filesystem::temp_directory_path() / "omniloc_kid").string();
+  const RunResult r = run_scenario(s, o);
+  const std::string ev = read_file(o.out_dir + "/events.jsonl");
+  EXPECT_NE(ev.find("\"kidnap\""), std::string::npos);
+  // Dead reckoning cannot know about the teleport: the final error is about the jump (~4.3 m).
+  EXPECT_GT(r.robots[0].all.pos_max_m, 3.5);
+}
