@@ -11,6 +11,7 @@
 #include "harness/localizer_registry.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "harness/sweep.hpp"
 #include "sim/motion.hpp"
 
 using namespace omniloc;
@@ -24,6 +25,9 @@ commands:
                          run a scenario; results in results/runs/<scenario>/<seed>/
   validate FILE          check a scenario file (exit 2 with the JSON path of the first problem)
   list                   field presets, motion scripts, localizers, noise profiles, experiments
+  sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
+                         scenarios x localizers x parameters x seeds, in parallel; aggregate
+                         with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
   experiment NAME [--seed N] [-o DIR] [--quick]
                          run a named experiment (solver maps, cooperative simulation, ...)
 )";
@@ -108,6 +112,35 @@ int cmd_run(const Args& a) {
   return 0;
 }
 
+int cmd_sweep(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("sweep takes one sweep file");
+  const auto spec = harness::load_sweep(a.positional[0]);
+  harness::SweepOptions o;
+  const std::string j = opt(a, "-j", "1");
+  o.jobs = std::atoi(j.c_str());
+  if (o.jobs < 1 || o.jobs > 256) throw UsageError("-j needs a worker count in [1, 256], got \"" + j + "\"");
+  const std::string shard = opt(a, "--shard");
+  if (!shard.empty()) {
+    const auto slash = shard.find('/');
+    if (slash == std::string::npos) throw UsageError("--shard needs I/N, got \"" + shard + "\"");
+    o.shard_index = std::atoi(shard.substr(0, slash).c_str());
+    o.shard_count = std::atoi(shard.substr(slash + 1).c_str());
+    if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+      throw UsageError("--shard I/N needs 0 <= I < N, got \"" + shard + "\"");
+  }
+  o.resume = flag(a, "--resume");
+  o.aggregate_only = flag(a, "--aggregate-only");
+  if (!opt(a, "--stop-after").empty()) o.stop_after = std::stoul(opt(a, "--stop-after"));
+  o.out_dir = opt(a, "-o");
+  o.progress = &std::cerr;
+  std::cerr << "sweep " << spec.name << ": " << spec.runs.size() << " runs, " << o.jobs << " worker(s)"
+            << (o.shard_count > 1 ? ", shard " + shard : std::string()) << "\n";
+  const auto r = harness::run_sweep(spec, o);
+  std::cout << r.table << "ran " << r.ran << ", skipped " << r.skipped << ", failed " << r.failed << ", missing " << r.missing
+            << "\nresults: " << r.out_dir << "\n";
+  return r.failed > 0 ? 1 : 0;
+}
+
 int cmd_list() {
   std::cout << "field presets:";
   for (const auto& n : Field::preset_names()) std::cout << " " << n;
@@ -147,6 +180,8 @@ int main(int argc, char** argv) {
     if (cmd == "validate") return cmd_validate(parse(argc, argv, 2, {}, {}));
     if (cmd == "run") return cmd_run(parse(argc, argv, 2, {"--seed", "-o", "--frames", "--frames-every"}, {"--quiet"}));
     if (cmd == "list") return cmd_list();
+    if (cmd == "sweep")
+      return cmd_sweep(parse(argc, argv, 2, {"-j", "--shard", "-o", "--stop-after"}, {"--resume", "--aggregate-only"}));
     if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o"}, {"--quick"}));
     throw UsageError("unknown command \"" + cmd + "\"");
   } catch (const ConfigError& e) {

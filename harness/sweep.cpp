@@ -1,0 +1,405 @@
+#include "harness/sweep.hpp"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <ostream>
+#include <set>
+#include <thread>
+
+#include "core/atomic_file.hpp"
+#include "harness/scenario.hpp"
+
+namespace omniloc::harness {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string sanitize(const std::string& s) {
+  std::string o;
+  for (char c : s) o += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '=' || c == '+') ? c : '_';
+  return o.empty() ? "_" : o;
+}
+
+Json read_json_file(const std::string& path, const std::string& what_path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(what_path, "\"" + path + "\" (no such file)", "an existing JSON file");
+  try {
+    return Json::parse(in);
+  } catch (const Json::parse_error& e) {
+    throw ConfigError(path, "invalid JSON", std::string("valid JSON (") + e.what() + ")");
+  }
+}
+
+// Student t 0.975 quantiles for 1..30 degrees of freedom, then the normal value.
+double t975(std::size_t df) {
+  static const double t[] = {0,     12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
+                             2.201, 2.179,  2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080,
+                             2.074, 2.069,  2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
+  return df <= 30 ? t[df] : 1.96;
+}
+
+void flatten(const Json& j, const std::string& prefix, std::map<std::string, double>& out) {
+  if (j.is_number()) {
+    out[prefix] = j.get<double>();
+  } else if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) flatten(it.value(), prefix.empty() ? it.key() : prefix + "/" + it.key(), out);
+  }
+}
+
+std::map<std::string, double> run_metrics(const Json& summary) {
+  std::map<std::string, double> m;
+  if (summary.contains("robots"))
+    for (const auto& r : summary["robots"]) {
+      Json copy = r;
+      const int id = copy.value("robot", 0);
+      copy.erase("robot");
+      flatten(copy, "r" + std::to_string(id), m);
+    }
+  if (summary.contains("metrics")) flatten(summary["metrics"], "", m);
+  return m;
+}
+
+std::string fmt(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string fmt_duration(double s) {
+  char b[32];
+  if (s >= 3600) std::snprintf(b, sizeof b, "%dh%02dm", static_cast<int>(s / 3600), static_cast<int>(std::fmod(s, 3600) / 60));
+  else if (s >= 60) std::snprintf(b, sizeof b, "%dm%02ds", static_cast<int>(s / 60), static_cast<int>(std::fmod(s, 60)));
+  else std::snprintf(b, sizeof b, "%.0fs", s);
+  return b;
+}
+
+// Runs one child `omniloc run`; returns its wait status.
+int spawn_run(const std::string& exe, const std::string& spec, const std::string& out, const std::string& log) {
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      ::close(fd);
+    }
+    ::execl(exe.c_str(), exe.c_str(), "run", spec.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return status;
+}
+
+std::string tail_of(const std::string& path, std::size_t max_chars) {
+  std::string s;
+  try {
+    s = read_file(path);
+  } catch (...) {
+    return "";
+  }
+  return s.size() > max_chars ? s.substr(s.size() - max_chars) : s;
+}
+
+}  // namespace
+
+Interval mean_ci95(const std::vector<double>& v) {
+  Interval iv;
+  iv.n = v.size();
+  if (v.empty()) return iv;
+  double s = 0;
+  for (double x : v) s += x;
+  iv.mean = s / v.size();
+  if (v.size() < 2) {
+    iv.low = iv.high = iv.mean;
+    return iv;
+  }
+  double s2 = 0;
+  for (double x : v) s2 += (x - iv.mean) * (x - iv.mean);
+  const double half = t975(v.size() - 1) * std::sqrt(s2 / (v.size() - 1)) / std::sqrt(static_cast<double>(v.size()));
+  iv.low = iv.mean - half;
+  iv.high = iv.mean + half;
+  return iv;
+}
+
+SweepSpec load_sweep(const std::string& path) {
+  SweepSpec spec;
+  spec.source = path;
+  const Json j = read_json_file(path, "sweep file");
+  JsonReader r(j, "");
+  r.allow("comment");
+  spec.name = r.string("name", fs::path(path).stem().string());
+  spec.name = sanitize(spec.name);
+  const fs::path base = fs::path(path).parent_path();
+
+  const Json* scen = r.raw("scenarios", true);
+  if (!scen->is_array() || scen->empty()) throw ConfigError("/scenarios", json_brief(*scen), "a non-empty array of scenario file paths");
+  struct Scen {
+    std::string name;
+    Json json;
+  };
+  std::vector<Scen> scenarios;
+  for (std::size_t i = 0; i < scen->size(); ++i) {
+    const std::string sp = json_child("/scenarios", i);
+    if (!(*scen)[i].is_string()) throw ConfigError(sp, json_brief((*scen)[i]), "a scenario file path (relative to the sweep file)");
+    fs::path p = (*scen)[i].get<std::string>();
+    if (p.is_relative()) p = base / p;
+    if (!fs::exists(p)) throw ConfigError(sp, json_brief((*scen)[i]), "an existing scenario file (looked for " + p.string() + ")");
+    Json sj = read_json_file(p.string(), sp);
+    scenarios.push_back({sj.is_object() && sj.contains("name") && sj["name"].is_string() ? sj["name"].get<std::string>() : p.stem().string(), sj});
+  }
+
+  std::vector<std::pair<std::string, Json>> locs;  // label, localizer JSON (empty = scenario's own)
+  if (const Json* l = r.raw("localizers")) {
+    if (!l->is_array() || l->empty()) throw ConfigError("/localizers", json_brief(*l), "a non-empty array of {\"type\": ...} objects");
+    for (std::size_t i = 0; i < l->size(); ++i) {
+      Json lj = (*l)[i];
+      if (!lj.is_object() || !lj.contains("type")) throw ConfigError(json_child("/localizers", i), json_brief(lj), "an object {\"type\": ...}");
+      std::string label = lj.value("label", lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
+      lj.erase("label");
+      locs.emplace_back(sanitize(label), lj);
+    }
+  } else {
+    locs.emplace_back("", Json());
+  }
+
+  // Parameter overrides: JSON pointer -> list of values; the cross product of all of them.
+  std::vector<std::vector<std::pair<std::string, Json>>> combos = {{}};
+  if (auto p = r.object("parameters")) {
+    const Json* pj = r.raw("parameters");
+    for (auto it = pj->begin(); it != pj->end(); ++it) {
+      p->allow(it.key());
+      const std::string pp = json_child("/parameters", it.key());
+      if (it.key().empty() || it.key()[0] != '/') throw ConfigError(pp, "\"" + it.key() + "\"", "a JSON pointer such as /robots/0/motion/speed");
+      if (!it.value().is_array() || it.value().empty()) throw ConfigError(pp, json_brief(it.value()), "a non-empty array of values");
+      std::vector<std::vector<std::pair<std::string, Json>>> next;
+      for (const auto& c : combos)
+        for (const auto& v : it.value()) {
+          auto c2 = c;
+          c2.emplace_back(it.key(), v);
+          next.push_back(c2);
+        }
+      combos = next;
+    }
+    p->finish();
+  }
+
+  std::vector<std::uint64_t> seeds;
+  const Json* sj = r.raw("seeds");
+  if (!sj) {
+    seeds = {1};
+  } else if (sj->is_array()) {
+    for (std::size_t i = 0; i < sj->size(); ++i) {
+      if (!(*sj)[i].is_number_unsigned()) throw ConfigError(json_child("/seeds", i), json_brief((*sj)[i]), "a non-negative integer seed");
+      seeds.push_back((*sj)[i].get<std::uint64_t>());
+    }
+  } else {
+    JsonReader s(*sj, "/seeds");
+    const auto first = s.integer("first", 1, 0);
+    const auto count = s.integer("count", std::nullopt, 1, 100000);
+    s.finish();
+    for (long long k = 0; k < count; ++k) seeds.push_back(static_cast<std::uint64_t>(first + k));
+  }
+  if (seeds.empty()) throw ConfigError("/seeds", "[]", "at least one seed");
+  r.finish();
+
+  std::set<std::string> ids;
+  for (const auto& sc : scenarios)
+    for (const auto& [llabel, lj] : locs)
+      for (const auto& combo : combos) {
+        Json patched = sc.json;
+        std::string plabel;
+        for (const auto& [ptr, v] : combo) {
+          try {
+            patched[Json::json_pointer(ptr)] = v;
+          } catch (const std::exception& e) {
+            throw ConfigError("/parameters" + ptr, json_brief(v), std::string("a pointer into the scenario (") + e.what() + ")");
+          }
+          const std::string leaf = ptr.substr(ptr.find_last_of('/') + 1);
+          plabel += (plabel.empty() ? "" : ",") + leaf + "=" + v.dump();
+        }
+        if (!lj.is_null()) patched["localizer"] = lj;
+        const std::string loc_label = lj.is_null() ? sanitize(patched.value("localizer", Json::object()).value("type", std::string("odometry_only"))) : llabel;
+        // Validate this combination once, before any run.
+        try {
+          parse_scenario(patched, sc.name);
+        } catch (const ConfigError& e) {
+          throw ConfigError("sweep " + path + ", scenario \"" + sc.name + "\", localizer \"" + loc_label + "\"" +
+                                (plabel.empty() ? "" : ", " + plabel) + ": " + (e.path().empty() ? "/" : e.path()),
+                            e.value(), e.expected());
+        }
+        for (std::uint64_t seed : seeds) {
+          SweepRun run;
+          run.index = spec.runs.size();
+          run.scenario_name = sc.name;
+          run.localizer_label = loc_label;
+          run.params_label = plabel.empty() ? "default" : plabel;
+          run.seed = seed;
+          run.scenario = patched;
+          run.scenario["seed"] = seed;
+          run.scenario["name"] = sc.name;
+          run.id = sanitize(sc.name) + "__" + loc_label + "__" + sanitize(run.params_label) + "__s" + std::to_string(seed);
+          if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two combinations give the same run id; add \"label\"s)");
+          spec.runs.push_back(std::move(run));
+        }
+      }
+  return spec;
+}
+
+SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
+  SweepOutcome out;
+  out.out_dir = o.out_dir.empty() ? "results/sweeps/" + spec.name : o.out_dir;
+  const fs::path dir(out.out_dir);
+  fs::create_directories(dir / "runs");
+  fs::create_directories(dir / "specs");
+  fs::create_directories(dir / "logs");
+  fs::create_directories(dir / "failed");
+  const std::string exe = o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe").string() : o.omniloc_exe;
+  auto finished = [&](const SweepRun& r) { return fs::exists(dir / "runs" / r.id / "summary.json"); };
+  // Staging folders of runs killed mid-write are hidden (".<id>.partial-<pid>"); clear them.
+  for (const auto& e : fs::directory_iterator(dir / "runs"))
+    if (e.path().filename().string().find(".partial-") != std::string::npos) fs::remove_all(e.path());
+
+  // This shard's runs that still need doing.
+  std::vector<const SweepRun*> todo;
+  for (const auto& r : spec.runs) {
+    if (static_cast<int>(r.index % o.shard_count) != o.shard_index) continue;
+    if (o.aggregate_only) continue;
+    if (o.resume && finished(r)) {
+      ++out.skipped;
+      continue;
+    }
+    todo.push_back(&r);
+  }
+  if (o.stop_after > 0 && todo.size() > o.stop_after) todo.resize(o.stop_after);
+
+  const bool tty = o.progress && ::isatty(2);
+  std::mutex mu;
+  std::atomic<std::size_t> next{0};
+  std::size_t done = 0, failed = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= todo.size()) return;
+      const SweepRun& r = *todo[i];
+      const std::string spec_path = (dir / "specs" / (r.id + ".json")).string();
+      write_file_atomic(spec_path, r.scenario.dump(2) + "\n");
+      const std::string log = (dir / "logs" / (r.id + ".log")).string();
+      const auto r0 = std::chrono::steady_clock::now();
+      const int st = spawn_run(exe, spec_path, (dir / "runs" / r.id).string(), log);
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+      const bool ok = st >= 0 && WIFEXITED(st) && WEXITSTATUS(st) == 0 && finished(r);
+      const fs::path fail_marker = dir / "failed" / (r.id + ".json");
+      if (ok) {
+        std::error_code ec;
+        fs::remove(fail_marker, ec);
+      } else {
+        Json f{{"id", r.id}, {"log", tail_of(log, 2000)}};
+        if (st >= 0 && WIFEXITED(st)) f["exit_code"] = WEXITSTATUS(st);
+        if (st >= 0 && WIFSIGNALED(st)) f["signal"] = WTERMSIG(st);
+        write_file_atomic(fail_marker.string(), f.dump(2) + "\n");
+      }
+      std::lock_guard<std::mutex> lock(mu);
+      ++done;
+      if (!ok) ++failed;
+      if (o.progress) {
+        const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double eta = el / done * (todo.size() - done);
+        if (tty) {
+          const int width = 30, filled = static_cast<int>(width * done / std::max<std::size_t>(1, todo.size()));
+          *o.progress << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done << "/" << todo.size()
+                      << " failed " << failed << " ETA " << fmt_duration(eta) << "   " << std::flush;
+        } else {
+          *o.progress << "[" << done << "/" << todo.size() << "] " << r.id << (ok ? " ok " : " FAILED ") << fmt(secs) << " s, ETA "
+                      << fmt_duration(eta) << "\n";
+        }
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 0; k < std::max(1, o.jobs); ++k) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  if (tty) *o.progress << "\n";
+  out.ran = done;
+  out.failed = failed;
+
+  // Aggregate over every run of the sweep found finished in the folder, in run order.
+  struct Group {
+    std::string scenario, localizer, params;
+    std::size_t finished = 0, failed = 0, missing = 0;
+    std::map<std::string, std::vector<double>> values;
+  };
+  std::vector<Group> groups;
+  std::map<std::string, std::size_t> gindex;
+  std::string runs_csv = "index,id,scenario,localizer,params,seed,status\n";
+  for (const auto& r : spec.runs) {
+    auto [it, inserted] = gindex.try_emplace(r.group(), groups.size());
+    if (inserted) groups.push_back({r.scenario_name, r.localizer_label, r.params_label});
+    Group& g = groups[it->second];
+    std::string status;
+    if (finished(r)) {
+      status = "ok";
+      ++g.finished;
+      const Json s = Json::parse(read_file((dir / "runs" / r.id / "summary.json").string()));
+      for (const auto& [k, v] : run_metrics(s)) g.values[k].push_back(v);
+    } else if (fs::exists(dir / "failed" / (r.id + ".json"))) {
+      status = "failed";
+      ++g.failed;
+    } else {
+      status = "missing";
+      ++g.missing;
+      ++out.missing;
+    }
+    runs_csv += std::to_string(r.index) + "," + r.id + "," + r.scenario_name + "," + r.localizer_label + ",\"" + r.params_label + "\"," +
+                std::to_string(r.seed) + "," + status + "\n";
+  }
+  std::string csv = "scenario,localizer,params,metric,n,mean,ci95_low,ci95_high\n";
+  Json agg{{"sweep", spec.name}, {"runs", spec.runs.size()}, {"groups", Json::array()}};
+  char line[512];
+  std::snprintf(line, sizeof line, "%-44s %4s %4s | %9s %9s %9s | %-26s\n", "scenario / localizer / params", "ok", "fail", "mean x cm",
+                "mean y cm", "mean th", "position RMSE m (95 % CI)");
+  out.table = line;
+  for (const auto& g : groups) {
+    Json gj{{"scenario", g.scenario}, {"localizer", g.localizer}, {"params", g.params}, {"finished", g.finished},
+            {"failed", g.failed}, {"missing", g.missing}, {"metrics", Json::object()}};
+    std::map<std::string, Interval> ivs;
+    for (const auto& [k, v] : g.values) {
+      const Interval iv = mean_ci95(v);
+      ivs[k] = iv;
+      gj["metrics"][k] = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}};
+      csv += g.scenario + "," + g.localizer + ",\"" + g.params + "\"," + k + "," + std::to_string(iv.n) + "," + fmt(iv.mean) + "," +
+             fmt(iv.low) + "," + fmt(iv.high) + "\n";
+    }
+    agg["groups"].push_back(gj);
+    auto m = [&](const char* k) { return ivs.count(k) ? ivs[k].mean : NAN; };
+    char ci[64];
+    if (ivs.count("r0/position_m/rmse"))
+      std::snprintf(ci, sizeof ci, "%.4f [%.4f, %.4f]", ivs["r0/position_m/rmse"].mean, ivs["r0/position_m/rmse"].low, ivs["r0/position_m/rmse"].high);
+    else
+      std::snprintf(ci, sizeof ci, "-");
+    const std::string label = g.scenario + " / " + g.localizer + " / " + g.params;
+    std::snprintf(line, sizeof line, "%-44s %4zu %4zu | %9.3f %9.3f %9.4f | %s\n", label.c_str(), g.finished, g.failed,
+                  m("r0/x_cm/mean"), m("r0/y_cm/mean"), m("r0/theta_rad/mean"), ci);
+    out.table += line;
+  }
+  write_file_atomic((dir / "runs.csv").string(), runs_csv);
+  write_file_atomic((dir / "aggregate.csv").string(), csv);
+  write_file_atomic((dir / "aggregate.json").string(), agg.dump(2) + "\n");
+  return out;
+}
+
+}  // namespace omniloc::harness

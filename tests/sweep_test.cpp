@@ -1,0 +1,120 @@
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <filesystem>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "harness/sweep.hpp"
+
+using namespace omniloc;
+using namespace omniloc::harness;
+namespace fs = std::filesystem;
+
+namespace {
+const fs::path kTmp = fs::temp_directory_path() / "omniloc_sweep_test";
+
+// A 48-run sweep of short dead-reckoning runs (2 speeds x 2 noise levels x 12 seeds).
+std::string make_sweep() {
+  fs::create_directories(kTmp);
+  const std::string scen = (kTmp / "short.json").string();
+  write_file_atomic(scen, R"({"name": "short", "duration": 3.0, "robots": [{"id": 0, "start": [0, 0, 0],
+    "motion": {"type": "waypoints", "speed": 1.0, "points": [[2, 0], [2, 2]]}}], "localizer": {"type": "odometry_only"}})");
+  const std::string sweep = (kTmp / "sweep.json").string();
+  write_file_atomic(sweep, R"({"name": "t", "scenarios": ["short.json"],
+    "parameters": {"/robots/0/motion/speed": [0.5, 1.5], "/robots/0/odometry": [{"trans_sigma": 0.01}, {"trans_sigma": 0.05}]},
+    "seeds": {"first": 1, "count": 12}})");
+  return sweep;
+}
+
+SweepOutcome sweep_into(const SweepSpec& spec, const std::string& name, int jobs, bool resume = false, std::size_t stop = 0,
+                        int shard = 0, int shards = 1, const std::string& exe = "./omniloc") {
+  SweepOptions o;
+  o.jobs = jobs;
+  o.resume = resume;
+  o.stop_after = stop;
+  o.shard_index = shard;
+  o.shard_count = shards;
+  o.out_dir = (kTmp / name).string();
+  o.omniloc_exe = exe;
+  return run_sweep(spec, o);
+}
+
+std::string aggregate(const std::string& name) {
+  return read_file((kTmp / name / "aggregate.json").string()) + read_file((kTmp / name / "aggregate.csv").string());
+}
+}  // namespace
+
+TEST(Sweep, AggregateIndependentOfWorkersResumeAndShards) {
+  fs::remove_all(kTmp);
+  const SweepSpec spec = load_sweep(make_sweep());
+  ASSERT_EQ(spec.runs.size(), 48u);
+  EXPECT_EQ(sweep_into(spec, "j1", 1).failed, 0u);
+  EXPECT_EQ(sweep_into(spec, "j2", 2).failed, 0u);
+  EXPECT_EQ(aggregate("j1"), aggregate("j2"));
+
+  // Interrupted after 17 runs, then resumed: only the rest runs, same aggregate.
+  const auto part = sweep_into(spec, "resumed", 2, false, 17);
+  EXPECT_EQ(part.missing, 48u - 17u);
+  EXPECT_NE(aggregate("resumed"), aggregate("j1"));
+  const auto rest = sweep_into(spec, "resumed", 2, true);
+  EXPECT_EQ(rest.skipped, 17u);
+  EXPECT_EQ(rest.ran, 31u);
+  EXPECT_EQ(aggregate("resumed"), aggregate("j1"));
+
+  // Two shards into one folder equal the whole.
+  sweep_into(spec, "sharded", 1, false, 0, 0, 2);
+  const auto second = sweep_into(spec, "sharded", 1, false, 0, 1, 2);
+  EXPECT_EQ(second.ran, 24u);
+  EXPECT_EQ(aggregate("sharded"), aggregate("j1"));
+}
+
+TEST(Sweep, CrashingRunIsRecordedAndTheSweepContinues) {
+  fs::remove_all(kTmp);
+  const SweepSpec spec = load_sweep(make_sweep());
+  // A stand-in binary that crashes on one run and is the real omniloc for the others.
+  const std::string fake = (kTmp / "crashy.sh").string();
+  write_file_atomic(fake, "#!/bin/sh\ncase \"$2\" in *__s5.json) kill -SEGV $$ ;; esac\nexec " + fs::absolute("omniloc").string() + " \"$@\"\n");
+  ::chmod(fake.c_str(), 0755);
+  const auto out = sweep_into(spec, "crash", 2, false, 0, 0, 1, fake);
+  EXPECT_EQ(out.failed, 4u);  // seed 5 in each of the 4 parameter groups
+  EXPECT_EQ(out.ran, 48u);
+  const std::string runs = read_file((kTmp / "crash" / "runs.csv").string());
+  EXPECT_NE(runs.find("__s5,short"), std::string::npos);
+  const auto failed = Json::parse(read_file((kTmp / "crash" / "failed" / (spec.runs[4].id + ".json")).string()));
+  EXPECT_EQ(failed["signal"], 11);
+  EXPECT_FALSE(fs::exists(kTmp / "crash" / "runs" / spec.runs[4].id));
+}
+
+TEST(Sweep, BadSweepFailsBeforeAnyRun) {
+  fs::create_directories(kTmp);
+  const std::string bad1 = (kTmp / "bad1.json").string();
+  write_file_atomic(bad1, R"({"scenarios": ["nope.json"]})");
+  try {
+    load_sweep(bad1);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "/scenarios/0");
+  }
+  make_sweep();
+  const std::string bad2 = (kTmp / "bad2.json").string();
+  write_file_atomic(bad2, R"({"scenarios": ["short.json"], "localizers": [{"type": "no_such_localizer"}]})");
+  try {
+    load_sweep(bad2);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(e.path().find("/localizer/type"), std::string::npos) << e.what();
+  }
+  const std::string bad3 = (kTmp / "bad3.json").string();
+  write_file_atomic(bad3, R"({"scenarios": ["short.json"], "parameters": {"/robots/0/motion/speed": [-3]}})");
+  EXPECT_THROW(load_sweep(bad3), ConfigError);
+}
+
+TEST(Sweep, ConfidenceInterval) {
+  const Interval iv = mean_ci95({1.0, 2.0, 3.0, 4.0});
+  EXPECT_DOUBLE_EQ(iv.mean, 2.5);
+  // sd = 1.29099, t(3) = 3.182: half width 3.182 * 1.29099 / 2 = 2.05397
+  EXPECT_NEAR(iv.high - iv.mean, 2.05397, 1e-4);
+  EXPECT_EQ(mean_ci95({5.0}).low, 5.0);
+}
