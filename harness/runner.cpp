@@ -10,6 +10,7 @@
 
 #include "harness/localizer_registry.hpp"
 #include "harness/perception.hpp"
+#include "harness/recovery.hpp"
 #include "harness/run_directory.hpp"
 #include "sim/motion.hpp"
 #include "sim/sensors.hpp"
@@ -49,6 +50,7 @@ struct Tracked {
   std::unique_ptr<Localizer> localizer;
   std::vector<FrameError> errors;
   std::vector<FrameRow> rows;
+  std::vector<ScoredFrame> scored;
   std::string gt_tum, est_tum;
   double covered_until = -1.0;
   std::string last_mode;
@@ -153,6 +155,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
                    po.obs.line_points.size(), est.match_error, est.extra, po.render_ms, po.vision_ms, loc_ms};
       tr.rows.push_back(row);
       tr.gt_tum += tum_line(ws.t, truth.pose);
+      tr.scored.push_back({ws.t, truth.pose, est.pose, est.valid});
       if (est.valid) {
         ++tr.valid;
         tr.est_tum += tum_line(ws.t, est.pose);
@@ -214,6 +217,21 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
     rj["robot"] = tr.id;
     rj["frames_total"] = tr.frames;
     rj["valid_fraction"] = tr.frames ? static_cast<double>(tr.valid) / tr.frames : 0.0;
+    // Kidnap episodes of this robot: from each kidnap's uncovering to the next kidnap or the end.
+    std::vector<Episode> episodes;
+    for (const auto& e : sc.events)
+      if (e.type == "kidnap" && e.robot == tr.id) episodes.push_back({e.t, e.t + e.duration, sc.duration + 1.0});
+    for (std::size_t k = 0; k + 1 < episodes.size(); ++k) episodes[k].t_end = episodes[k + 1].t_kidnap;
+    if (!episodes.empty()) {
+      std::vector<EpisodeResult> res;
+      for (const auto& e : episodes) res.push_back(score_episode(tr.scored, e));
+      rj["recovery"] = recovery_summary(res);
+      Json per = Json::array();
+      for (std::size_t k = 0; k < res.size(); ++k)
+        per.push_back({{"t_kidnap", episodes[k].t_kidnap}, {"recovered", res[k].recovered}, {"recovery_time_s", res[k].recovery_time},
+                       {"false_recovery", res[k].false_recovery}, {"mirrored", res[k].mirrored}});
+      rj["recovery"]["per_kidnap"] = per;
+    }
     summary["robots"].push_back(rj);
     rows.push_back({sc.name + " r" + std::to_string(tr.id) + " " + info.type, rr.all});
   }
