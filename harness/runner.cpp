@@ -77,7 +77,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   std::map<int, std::unique_ptr<sim::MotionScript>> scripts;
   for (const auto& rc : sc.robots) {
     world.add_robot(rc.spec);
-    scripts[rc.spec.id] = sim::MotionScript::from_json(rc.motion, rc.motion_path, derive_seed(seed, "motion/" + std::to_string(rc.spec.id)));
+    scripts[rc.spec.id] = sim::MotionScript::from_json(rc.motion, rc.motion_path, derive_seed(seed, "motion/" + std::to_string(rc.spec.id)), &sc.field);
   }
   if (sc.has_ball) world.set_ball(sc.ball_position, sc.ball_velocity);
 

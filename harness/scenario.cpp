@@ -113,7 +113,7 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
     check_on_floor(s.field, rc.spec.start.translation(), rc.spec.radius, rp + "/start", "a start position with the whole robot");
     rc.motion = rr.raw("motion") ? *rr.raw("motion") : Json{{"type", "still"}};
     rc.motion_path = rp + "/motion";
-    sim::MotionScript::from_json(rc.motion, rc.motion_path, 0);  // validate now
+    sim::MotionScript::from_json(rc.motion, rc.motion_path, 0, &s.field);  // validate now
     rc.odometry = s.noise.odometry;
     rc.heading = s.noise.heading;
     if (auto o = rr.object("odometry")) {
@@ -145,6 +145,15 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
         throw ConfigError(json_child("/robots", b) + "/start", "robot " + std::to_string(B.id) + " overlapping robot " + std::to_string(A.id),
                           "start positions at least the sum of the radii apart");
     }
+  // Behaviours that mark a robot must name another robot of the scenario.
+  for (std::size_t i = 0; i < s.robots.size(); ++i) {
+    const Json& m = s.robots[i].motion;
+    if (m.value("type", "") == "behaviour" && m.value("kind", "") == "mark") {
+      const int target = m.value("target", -1);
+      if (!s.robot(target) || target == s.robots[i].spec.id)
+        throw ConfigError(s.robots[i].motion_path + "/target", std::to_string(target), "the id of another robot in /robots");
+    }
+  }
   if (s.localized_robots().empty())
     throw ConfigError("/robots", "no robot with \"localize\": true", "at least one localized robot");
 

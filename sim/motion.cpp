@@ -1,5 +1,7 @@
 #include "sim/motion.hpp"
 
+#include "sim/behaviour.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -50,10 +52,10 @@ DriveCommand WaypointScript::command(const WorldState& world, int self, double) 
   return c;
 }
 
-std::vector<std::string> MotionScript::types() { return {"still", "constant", "waypoints"}; }
+std::vector<std::string> MotionScript::types() { return {"still", "constant", "waypoints", "behaviour"}; }
 
-std::unique_ptr<MotionScript> MotionScript::from_json(const Json& j, const std::string& path, std::uint64_t seed) {
-  (void)seed;
+std::unique_ptr<MotionScript> MotionScript::from_json(const Json& j, const std::string& path, std::uint64_t seed,
+                                                     const Field* field) {
   JsonReader r(j, path);
   r.allow("comment");
   const std::string type = r.string("type", std::nullopt, types());
@@ -65,6 +67,22 @@ std::unique_ptr<MotionScript> MotionScript::from_json(const Json& j, const std::
     const double omega = r.number("omega", 0.0, -20.0, 20.0);
     const std::string frame = r.string("frame", std::string("world"), {"world", "robot"});
     out = std::make_unique<ConstantScript>(Eigen::Vector2d(v[0], v[1]), omega, frame == "robot");
+  } else if (type == "behaviour") {
+    BehaviourParams p;
+    p.kind = r.string("kind", std::nullopt, {"chase_ball", "mark", "hold", "wander"});
+    p.speed = r.positive("speed", 2.0, 6.0);
+    p.attack_side = r.integer("attack_side", 1, -1, 1) >= 0 ? 1 : -1;
+    if (p.kind == "mark") p.target_robot = static_cast<int>(r.integer("target", std::nullopt, 0, 99));
+    if (p.kind == "hold") {
+      const auto h = r.numbers("home", std::nullopt, 2);
+      p.home = {h[0], h[1]};
+      p.radius = r.number("radius", 0.5, 0.0, 5.0);
+    }
+    if (field) {
+      p.field_half_x = 0.5 * field->length;
+      p.field_half_y = 0.5 * field->width;
+    }
+    out = std::make_unique<BehaviourScript>(p, Rng(seed));
   } else {
     const Json* pts = r.raw("points", true);
     const std::string pp = r.child_path("points");

@@ -23,8 +23,10 @@ class MotionScript {
   /// Called after the robot was teleported (scripts may re-plan).
   virtual void on_teleport() {}
 
-  /// Builds a script from JSON {"type": ...}. `seed` seeds scripts with randomness (wander...).
-  static std::unique_ptr<MotionScript> from_json(const Json& j, const std::string& path, std::uint64_t seed);
+  /// Builds a script from JSON {"type": ...}. `seed` seeds scripts with randomness (wander...);
+  /// `field` bounds behaviours (defaults to the 18 x 12 MSL field when null).
+  static std::unique_ptr<MotionScript> from_json(const Json& j, const std::string& path, std::uint64_t seed,
+                                                 const Field* field = nullptr);
   static std::vector<std::string> types();
 };
 

@@ -89,7 +89,7 @@ void World::add_robot(const RobotSpec& spec) {
   b2FixtureDef fd;
   fd.shape = &shape;
   fd.density = static_cast<float>(spec.mass / (kPi * spec.radius * spec.radius));
-  fd.friction = 0.4f;
+  fd.friction = 0.1f;  // hard plastic bumpers: little tangential grip, so bumps push more than they spin
   fd.restitution = 0.1f;
   r->body->CreateFixture(&fd);
   specs_.push_back(spec);
