@@ -9,9 +9,16 @@
 #include "core/rng.hpp"
 #include "harness/scenario.hpp"
 #include "localization/localizer.hpp"
+#include "sim/occlusion.hpp"
 #include "sim/world_state.hpp"
 
 namespace omniloc::harness {
+
+/// What the harness imposes on one camera frame (scripted events), beyond the world itself.
+struct FrameConditions {
+  bool covered = false;                   ///< lens covered (kidnapping): black image
+  std::vector<sim::Sector> occlusion;     ///< black sectors, robot-frame bearings
+};
 
 struct PerceptionOutput {
   Observations obs;
@@ -19,22 +26,24 @@ struct PerceptionOutput {
   CameraSettings settings;             ///< settings the image was taken with
   double render_ms = 0.0;              ///< wall time, for timing.csv only (never in summaries)
   double vision_ms = 0.0;
+  bool stop_robot = false;             ///< the robot must stand still (camera adjusting, paper 002)
+  std::vector<std::string> warnings;   ///< written to events.jsonl
 };
 
 class Perception {
  public:
   virtual ~Perception() = default;
-  /// One camera frame of robot `robot_id`. `covered`: the lens is covered (kidnapping): black image.
-  virtual PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, bool covered) = 0;
+  /// One camera frame of robot `robot_id` under the scripted conditions.
+  virtual PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) = 0;
 };
 
 /// No camera: empty observations (for localizers that need no vision, e.g. odometry_only).
 class NoPerception : public Perception {
  public:
-  PerceptionOutput observe(const sim::WorldState&, int, double t, bool covered) override {
+  PerceptionOutput observe(const sim::WorldState&, int, double t, const FrameConditions& cond) override {
     PerceptionOutput o;
     o.obs.t = t;
-    o.obs.camera_ok = !covered;
+    o.obs.camera_ok = !cond.covered;
     return o;
   }
 };

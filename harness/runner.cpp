@@ -53,6 +53,9 @@ struct Tracked {
   std::vector<ScoredFrame> scored;
   std::string gt_tum, est_tum;
   double covered_until = -1.0;
+  double occluded_until = -1.0;
+  sim::OcclusionMask event_mask;
+  bool paused = false;
   std::string last_mode;
   std::size_t frames = 0, valid = 0;
 };
@@ -127,25 +130,51 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
             if (tr.id == e.robot) tr.covered_until = world.time() + e.duration;
           ej["duration"] = e.duration;
         }
+        if (e.type == "occlude") {
+          for (auto& tr : tracked)
+            if (tr.id == e.robot) {
+              tr.occluded_until = world.time() + e.duration;
+              tr.event_mask = e.mask;
+            }
+          ej["duration"] = e.duration;
+          ej["fraction"] = e.mask.fraction();
+        }
+        if (e.type == "lights") {
+          ej["level"] = e.level;
+          ej["transition"] = e.transition;
+        }
         log_event(ej);
       }
       const sim::WorldState ws = world.state();
-      for (const auto& rc : sc.robots) world.command(rc.spec.id, scripts[rc.spec.id]->command(ws, rc.spec.id, world.time()));
+      for (const auto& rc : sc.robots) {
+        bool paused = false;
+        for (const auto& tr : tracked) paused = paused || (tr.id == rc.spec.id && tr.paused);
+        world.command(rc.spec.id, paused ? sim::DriveCommand{} : scripts[rc.spec.id]->command(ws, rc.spec.id, world.time()));
+      }
       world.step();
       for (auto& tr : tracked) {
         tr.odometry->accumulate(world.wheel_motion(tr.id));
         tr.heading->advance(dt);
       }
     }
-    const sim::WorldState ws = world.state();
+    sim::WorldState ws = world.state();
+    ws.lighting = sc.lighting_at(ws.t);
     for (auto& tr : tracked) {
       const sim::RobotState& truth = *ws.robot(tr.id);
-      const bool covered = ws.t < tr.covered_until;
+      FrameConditions cond;
+      cond.covered = ws.t < tr.covered_until;
+      // Whole-run mask and event masks together (event masks may overlap the run's mask).
+      cond.occlusion = sc.occlusion.robot_frame(truth.pose.theta);
+      if (ws.t < tr.occluded_until)
+        for (const auto& sct : tr.event_mask.robot_frame(truth.pose.theta)) cond.occlusion.push_back(sct);
       const Odometry odo = tr.odometry->read(ws.t);
       std::optional<double> heading;
       if (tr.has_heading) heading = tr.heading->read(ws.t, truth.pose.theta).heading;
 
-      PerceptionOutput po = perception->observe(ws, tr.id, ws.t, covered);
+      PerceptionOutput po = perception->observe(ws, tr.id, ws.t, cond);
+      for (const auto& w : po.warnings) log_event(Json{{"t", ws.t}, {"type", "warning"}, {"robot", tr.id}, {"message", w}});
+      if (po.stop_robot != tr.paused) log_event(Json{{"t", ws.t}, {"type", po.stop_robot ? "pause" : "resume"}, {"robot", tr.id}});
+      tr.paused = po.stop_robot;
       const auto t0 = Clock::now();
       const Estimate est = tr.localizer->update(po.obs, odo, heading);
       const double loc_ms = ms_since(t0);

@@ -50,6 +50,19 @@ NoiseProfile NoiseProfile::named(const std::string& name, const std::string& pat
   throw ConfigError(path, "\"" + name + "\"", "a noise profile: \"ideal\" or \"robot\"");
 }
 
+sim::Lighting Scenario::lighting_at(double t) const {
+  sim::Lighting l = lighting;
+  for (std::size_t i = 0; i < l.sun.size(); ++i) l.sun[i].centre += sun_velocity[i] * t;
+  double level = lighting.level;
+  for (const auto& e : events) {
+    if (e.type != "lights" || e.t > t) continue;
+    const double f = e.transition > 0 ? std::min(1.0, (t - e.t) / e.transition) : 1.0;
+    level = level + f * (e.level - level);
+  }
+  l.level = level;
+  return l;
+}
+
 const RobotConfig* Scenario::robot(int id) const {
   for (const auto& r : robots)
     if (r.spec.id == id) return &r;
@@ -176,7 +189,7 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
       er.allow("comment");
       EventConfig e;
       e.path = ep;
-      e.type = er.string("type", std::nullopt, {"teleport", "cover", "kidnap"});
+      e.type = er.string("type", std::nullopt, {"teleport", "cover", "kidnap", "occlude", "lights"});
       e.t = er.number("t", std::nullopt, 0.0, s.duration);
       e.robot = static_cast<int>(er.integer("robot", s.localized_robots().front(), 0, 99));
       if (!s.robot(e.robot)) throw ConfigError(ep + "/robot", std::to_string(e.robot), "the id of a robot in /robots");
@@ -184,11 +197,47 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
         e.pose = read_pose(er, "pose");
         check_on_floor(s.field, e.pose.translation(), s.robot(e.robot)->spec.radius, ep + "/pose", "a target with the whole robot");
       }
-      if (e.type == "cover" || e.type == "kidnap") e.duration = er.positive("duration", e.type == "kidnap" ? 2.0 : 1.0, 600.0);
+      if (e.type == "cover" || e.type == "kidnap" || e.type == "occlude")
+        e.duration = er.positive("duration", e.type == "kidnap" ? 2.0 : 1.0, 3600.0);
+      if (e.type == "occlude") {
+        // The mask's keys sit beside the event's own keys.
+        Json mask = (*ev)[i];
+        for (const char* k : {"type", "t", "robot", "duration", "comment"}) mask.erase(k);
+        e.mask = sim::OcclusionMask::from_json(mask, ep);
+        for (auto it = mask.begin(); it != mask.end(); ++it) er.allow(it.key());
+      }
+      if (e.type == "lights") {
+        e.level = er.number("level", std::nullopt, 0.0, 20.0);
+        e.transition = er.number("transition", 0.5, 0.0, 600.0);
+      }
       er.finish();
       s.events.push_back(e);
     }
     std::stable_sort(s.events.begin(), s.events.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  }
+
+  if (const Json* occ = r.raw("occlusion")) s.occlusion = sim::OcclusionMask::from_json(*occ, "/occlusion");
+  if (auto l = r.object("lighting")) {
+    s.lighting.level = l->number("level", 1.0, 0.0, 20.0);
+    if (const Json* sun = l->raw("sun")) {
+      const std::string sp = l->child_path("sun");
+      if (!sun->is_array()) throw ConfigError(sp, json_brief(*sun), "an array of sun patches");
+      for (std::size_t i = 0; i < sun->size(); ++i) {
+        JsonReader pr((*sun)[i], json_child(sp, i));
+        sim::SunPatch p;
+        const auto c = pr.numbers("centre", std::nullopt, 2);
+        const auto h = pr.numbers("half_size", std::vector<double>{1.0, 0.5}, 2);
+        const auto v = pr.numbers("velocity", std::vector<double>{0.0, 0.0}, 2);
+        p.centre = {c[0], c[1]};
+        p.half_size = {h[0], h[1]};
+        if (h[0] <= 0 || h[1] <= 0) throw ConfigError(json_child(sp, i) + "/half_size", json_brief((*sun)[i]["half_size"]), "two positive half sizes (metres)");
+        p.strength = pr.number("strength", 3.0, 0.0, 50.0);
+        pr.finish();
+        s.lighting.sun.push_back(p);
+        s.sun_velocity.emplace_back(v[0], v[1]);
+      }
+    }
+    l->finish();
   }
 
   const Json* loc = r.raw("localizer");

@@ -10,7 +10,9 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
+#include "sim/occlusion.hpp"
 #include "sim/sensors.hpp"
+#include "sim/world_state.hpp"
 #include "sim/world.hpp"
 
 namespace omniloc::harness {
@@ -37,10 +39,13 @@ struct RobotConfig {
 
 struct EventConfig {
   double t = 0.0;            ///< seconds
-  std::string type;          ///< "teleport", "cover", "kidnap"
+  std::string type;          ///< "teleport", "cover", "kidnap", "occlude", "lights"
   int robot = 0;
   Pose2 pose;                ///< teleport / kidnap target
-  double duration = 0.0;     ///< cover / kidnap: how long the camera is covered, seconds
+  double duration = 0.0;     ///< cover / kidnap / occlude: how long, seconds
+  sim::OcclusionMask mask;   ///< occlude
+  double level = 1.0;        ///< lights: new global illumination level
+  double transition = 0.0;   ///< lights: seconds to reach it (lamps warming up / dimming)
   std::string path;          ///< JSON path, for messages
 };
 
@@ -59,11 +64,16 @@ struct Scenario {
   Eigen::Vector2d ball_position = Eigen::Vector2d::Zero();
   Eigen::Vector2d ball_velocity = Eigen::Vector2d::Zero();
   std::vector<EventConfig> events;  ///< sorted by time
+  sim::OcclusionMask occlusion;     ///< for the whole run (paper 002 table 1)
+  sim::Lighting lighting;           ///< at t = 0
+  std::vector<Eigen::Vector2d> sun_velocity;  ///< m/s per sun patch (sun moving slowly)
   Json localizer;            ///< {"type": ..., params}
   Json camera;               ///< camera configuration (profile defaults merged)
   Json effective;            ///< every value read, defaults filled in: saved as config.json
 
   const RobotConfig* robot(int id) const;
+  /// Lighting at time t: lamp events applied with their transitions, sun patches moved.
+  sim::Lighting lighting_at(double t) const;
   std::vector<int> localized_robots() const;
 };
 

@@ -71,12 +71,35 @@ TEST(ScenarioValidation, EveryErrorNamesItsJsonPath) {
       {"localizer unknown", [](Json& j) { j["localizer"]["type"] = "magic"; }, "/localizer/type"},
       {"localizer param typo", [](Json& j) { j["localizer"]["particels"] = 5; }, "/localizer/particels"},
       {"camera not an object", [](Json& j) { j["camera"] = 3; }, "/camera"},
+      {"occlusion fraction > 1", [](Json& j) { j["occlusion"] = {{"fraction", 1.5}}; }, "/occlusion/fraction"},
+      {"occlusion frame", [](Json& j) { j["occlusion"] = {{"fraction", 0.5}, {"frame", "camera"}}; }, "/occlusion/frame"},
+      {"overlapping event sectors",
+       [](Json& j) { j["events"].push_back(Json::parse(R"({"type": "occlude", "t": 0.5, "sectors": [[0, 90], [80, 20]]})")); },
+       "/events/1/sectors/1"},
+      {"occlude typo", [](Json& j) { j["events"].push_back(Json::parse(R"({"type": "occlude", "t": 0.5, "fracton": 0.2})")); }, "/events/1/fraction"},
+      {"lights without level", [](Json& j) { j["events"].push_back(Json::parse(R"({"type": "lights", "t": 0.5})")); }, "/events/1/level"},
+      {"negative lamp level", [](Json& j) { j["lighting"] = {{"level", -1}}; }, "/lighting/level"},
+      {"sun patch typo", [](Json& j) { j["lighting"] = Json::parse(R"({"sun": [{"centre": [0, 0], "strenght": 2}]})"); }, "/lighting/sun/0/strenght"},
+      {"mark unknown robot", [](Json& j) { j["robots"][1]["motion"] = Json::parse(R"({"type": "behaviour", "kind": "mark", "target": 5})"); }, "/robots/1/motion/target"},
+      {"unknown behaviour", [](Json& j) { j["robots"][1]["motion"] = Json::parse(R"({"type": "behaviour", "kind": "dance"})"); }, "/robots/1/motion/kind"},
   };
   for (const auto& c : cases) {
     Json j = base();
     c.mutate(j);
     EXPECT_EQ(error_path(j), c.path) << c.name;
   }
+}
+
+TEST(Scenario, LightingScriptInterpolatesLampsAndMovesTheSun) {
+  Json j = base();
+  j["lighting"] = Json::parse(R"({"level": 1.0, "sun": [{"centre": [0, 0], "velocity": [0.1, 0], "strength": 4}]})");
+  j["events"] = Json::parse(R"([{"type": "lights", "t": 0.5, "level": 0.2, "transition": 1.0}])");
+  j["duration"] = 3.0;
+  const Scenario s = parse_scenario(j, "light");
+  EXPECT_DOUBLE_EQ(s.lighting_at(0.4).level, 1.0);
+  EXPECT_NEAR(s.lighting_at(1.0).level, 0.6, 1e-12);  // half way through the dimming
+  EXPECT_NEAR(s.lighting_at(2.0).level, 0.2, 1e-12);
+  EXPECT_NEAR(s.lighting_at(2.0).sun[0].centre.x(), 0.2, 1e-12);
 }
 
 TEST(ScenarioValidation, SyntaxErrorNamesTheFile) {

@@ -1,0 +1,76 @@
+#include "sim/occlusion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/angles.hpp"
+#include "core/error.hpp"
+
+namespace omniloc::sim {
+
+double OcclusionMask::fraction() const {
+  double w = 0;
+  for (const auto& s : sectors) w += s.width;
+  return std::min(1.0, w / kTwoPi);
+}
+
+std::vector<Sector> OcclusionMask::robot_frame(double theta) const {
+  if (!world_fixed) return sectors;
+  std::vector<Sector> out = sectors;
+  for (auto& s : out) s.start = wrap_angle_positive(s.start - theta);
+  return out;
+}
+
+OcclusionMask OcclusionMask::from_json(const Json& j, const std::string& path) {
+  JsonReader r(j, path);
+  r.allow("comment");
+  OcclusionMask m;
+  m.world_fixed = r.string("frame", std::string("robot"), {"robot", "world"}) == "world";
+  const Json* sj = r.raw("sectors");
+  if (sj && sj->is_array()) {
+    const std::string sp = r.child_path("sectors");
+    for (std::size_t i = 0; i < sj->size(); ++i) {
+      const Json& e = (*sj)[i];
+      if (!e.is_array() || e.size() != 2 || !e[0].is_number() || !e[1].is_number() || e[1].get<double>() <= 0 || e[1].get<double>() > 360)
+        throw ConfigError(json_child(sp, i), json_brief(e), "a sector [start_deg, width_deg] with 0 < width <= 360");
+      m.sectors.push_back({wrap_angle_positive(deg2rad(e[0].get<double>())), deg2rad(e[1].get<double>())});
+    }
+    // Overlap check on the circle.
+    for (std::size_t a = 0; a < m.sectors.size(); ++a)
+      for (std::size_t b = 0; b < m.sectors.size(); ++b) {
+        if (a == b) continue;
+        const double off = wrap_angle_positive(m.sectors[b].start - m.sectors[a].start);
+        if (off < m.sectors[a].width - 1e-9)
+          throw ConfigError(json_child(sp, b), json_brief((*sj)[b]), "sectors that do not overlap (it overlaps sector " + std::to_string(a) + ")");
+      }
+  } else {
+    const double f = r.number("fraction", std::nullopt, 0.0, 1.0);
+    const long long n = sj ? r.integer("sectors", 1, 1, 36) : 1;
+    const double start = deg2rad(r.number("start_deg", 0.0, -360.0, 360.0));
+    if (f > 0)
+      for (long long k = 0; k < n; ++k)
+        m.sectors.push_back({wrap_angle_positive(start + k * kTwoPi / n), f * kTwoPi / n});
+  }
+  r.finish();
+  return m;
+}
+
+void paint_sectors(Image& image, const Eigen::Vector2d& c, const std::vector<Sector>& sectors) {
+  if (sectors.empty()) return;
+  for (int v = 0; v < image.height; ++v) {
+    std::uint8_t* row = image.row(v);
+    for (int u = 0; u < image.width; ++u) {
+      const double du = u + 0.5 - c.x(), dv = v + 0.5 - c.y();
+      // Inverse of image_direction: forward = -v, left = -u.
+      const double bearing = wrap_angle_positive(std::atan2(-du, -dv));
+      for (const auto& s : sectors) {
+        if (wrap_angle_positive(bearing - s.start) < s.width) {
+          row[3 * u] = row[3 * u + 1] = row[3 * u + 2] = 0;
+          break;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace omniloc::sim
