@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Regenerates the committed regression numbers (results/reference/regression/*.summary.json) from
+# scenarios/regression/*.json. Run it only when a change of numbers is deliberate; the diff of the
+# reference files then shows exactly what moved, and belongs in the same commit as its cause.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ -x build/omniloc ] || scripts/build.sh
+for s in scenarios/regression/*.json; do
+  name=$(basename "$s" .json)
+  out=$(mktemp -d)
+  ./build/omniloc run "$s" -o "$out/run" --quiet >/dev/null
+  cp "$out/run/summary.json" "results/reference/regression/$name.summary.json"
+  rm -rf "$out"
+  echo "updated results/reference/regression/$name.summary.json"
+done

@@ -1,0 +1,33 @@
+// Regression gates: every scenario in scenarios/regression/ must reproduce the summary committed in
+// results/reference/regression/ byte for byte. A deliberate change is made with
+// scripts/update_reference.sh and shows in the diff.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/atomic_file.hpp"
+#include "harness/runner.hpp"
+#include "harness/scenario.hpp"
+
+using namespace omniloc;
+namespace fs = std::filesystem;
+
+TEST(Regression, SummariesMatchTheCommittedReference) {
+  const fs::path dir = fs::path(OMNILOC_SOURCE_DIR) / "scenarios" / "regression";
+  int checked = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() != ".json") continue;
+    const std::string name = e.path().stem().string();
+    const fs::path ref = fs::path(OMNILOC_SOURCE_DIR) / "results" / "reference" / "regression" / (name + ".summary.json");
+    ASSERT_TRUE(fs::exists(ref)) << "no committed reference for " << name << " (run scripts/update_reference.sh)";
+    const auto s = harness::load_scenario(e.path().string());
+    harness::RunOptions o;
+    o.out_dir = (fs::temp_directory_path() / ("omniloc_regression_" + name)).string();
+    harness::run_scenario(s, o);
+    EXPECT_EQ(read_file(o.out_dir + "/summary.json"), read_file(ref.string()))
+        << name << ": the numbers moved. If that is deliberate, run scripts/update_reference.sh and commit the diff.";
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+}
