@@ -348,7 +348,13 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
   std::string runs_csv = "index,id,scenario,localizer,params,seed,status\n";
   for (const auto& r : spec.runs) {
     auto [it, inserted] = gindex.try_emplace(r.group(), groups.size());
-    if (inserted) groups.push_back({r.scenario_name, r.localizer_label, r.params_label});
+    if (inserted) {
+      Group g;
+      g.scenario = r.scenario_name;
+      g.localizer = r.localizer_label;
+      g.params = r.params_label;
+      groups.push_back(std::move(g));
+    }
     Group& g = groups[it->second];
     std::string status;
     if (finished(r)) {
