@@ -89,7 +89,8 @@ int spawn_run(const std::string& exe, const std::string& spec, const std::string
   const pid_t pid = ::fork();
   if (pid < 0) return -1;
   if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) fd = ::open("/dev/null", O_WRONLY);
     if (fd >= 0) {
       ::dup2(fd, 1);
       ::dup2(fd, 2);

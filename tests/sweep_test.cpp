@@ -13,15 +13,19 @@ using namespace omniloc::harness;
 namespace fs = std::filesystem;
 
 namespace {
-const fs::path kTmp = fs::temp_directory_path() / "omniloc_sweep_test";
+// Each test gets its own folder: ctest runs tests in parallel.
+fs::path test_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  return fs::temp_directory_path() / ("omniloc_sweep_" + std::string(info->name()));
+}
 
 // A 48-run sweep of short dead-reckoning runs (2 speeds x 2 noise levels x 12 seeds).
 std::string make_sweep() {
-  fs::create_directories(kTmp);
-  const std::string scen = (kTmp / "short.json").string();
+  fs::create_directories(test_dir());
+  const std::string scen = (test_dir() / "short.json").string();
   write_file_atomic(scen, R"({"name": "short", "duration": 3.0, "robots": [{"id": 0, "start": [0, 0, 0],
     "motion": {"type": "waypoints", "speed": 1.0, "points": [[2, 0], [2, 2]]}}], "localizer": {"type": "odometry_only"}})");
-  const std::string sweep = (kTmp / "sweep.json").string();
+  const std::string sweep = (test_dir() / "sweep.json").string();
   write_file_atomic(sweep, R"({"name": "t", "scenarios": ["short.json"],
     "parameters": {"/robots/0/motion/speed": [0.5, 1.5], "/robots/0/odometry": [{"trans_sigma": 0.01}, {"trans_sigma": 0.05}]},
     "seeds": {"first": 1, "count": 12}})");
@@ -36,18 +40,18 @@ SweepOutcome sweep_into(const SweepSpec& spec, const std::string& name, int jobs
   o.stop_after = stop;
   o.shard_index = shard;
   o.shard_count = shards;
-  o.out_dir = (kTmp / name).string();
+  o.out_dir = (test_dir() / name).string();
   o.omniloc_exe = exe;
   return run_sweep(spec, o);
 }
 
 std::string aggregate(const std::string& name) {
-  return read_file((kTmp / name / "aggregate.json").string()) + read_file((kTmp / name / "aggregate.csv").string());
+  return read_file((test_dir() / name / "aggregate.json").string()) + read_file((test_dir() / name / "aggregate.csv").string());
 }
 }  // namespace
 
 TEST(Sweep, AggregateIndependentOfWorkersResumeAndShards) {
-  fs::remove_all(kTmp);
+  fs::remove_all(test_dir());
   const SweepSpec spec = load_sweep(make_sweep());
   ASSERT_EQ(spec.runs.size(), 48u);
   EXPECT_EQ(sweep_into(spec, "j1", 1).failed, 0u);
@@ -71,25 +75,25 @@ TEST(Sweep, AggregateIndependentOfWorkersResumeAndShards) {
 }
 
 TEST(Sweep, CrashingRunIsRecordedAndTheSweepContinues) {
-  fs::remove_all(kTmp);
+  fs::remove_all(test_dir());
   const SweepSpec spec = load_sweep(make_sweep());
   // A stand-in binary that crashes on one run and is the real omniloc for the others.
-  const std::string fake = (kTmp / "crashy.sh").string();
+  const std::string fake = (test_dir() / "crashy.sh").string();
   write_file_atomic(fake, "#!/bin/sh\ncase \"$2\" in *__s5.json) kill -SEGV $$ ;; esac\nexec " + fs::absolute("omniloc").string() + " \"$@\"\n");
   ::chmod(fake.c_str(), 0755);
   const auto out = sweep_into(spec, "crash", 2, false, 0, 0, 1, fake);
   EXPECT_EQ(out.failed, 4u);  // seed 5 in each of the 4 parameter groups
   EXPECT_EQ(out.ran, 48u);
-  const std::string runs = read_file((kTmp / "crash" / "runs.csv").string());
+  const std::string runs = read_file((test_dir() / "crash" / "runs.csv").string());
   EXPECT_NE(runs.find("__s5,short"), std::string::npos);
-  const auto failed = Json::parse(read_file((kTmp / "crash" / "failed" / (spec.runs[4].id + ".json")).string()));
+  const auto failed = Json::parse(read_file((test_dir() / "crash" / "failed" / (spec.runs[4].id + ".json")).string()));
   EXPECT_EQ(failed["signal"], 11);
-  EXPECT_FALSE(fs::exists(kTmp / "crash" / "runs" / spec.runs[4].id));
+  EXPECT_FALSE(fs::exists(test_dir() / "crash" / "runs" / spec.runs[4].id));
 }
 
 TEST(Sweep, BadSweepFailsBeforeAnyRun) {
-  fs::create_directories(kTmp);
-  const std::string bad1 = (kTmp / "bad1.json").string();
+  fs::create_directories(test_dir());
+  const std::string bad1 = (test_dir() / "bad1.json").string();
   write_file_atomic(bad1, R"({"scenarios": ["nope.json"]})");
   try {
     load_sweep(bad1);
@@ -98,7 +102,7 @@ TEST(Sweep, BadSweepFailsBeforeAnyRun) {
     EXPECT_EQ(e.path(), "/scenarios/0");
   }
   make_sweep();
-  const std::string bad2 = (kTmp / "bad2.json").string();
+  const std::string bad2 = (test_dir() / "bad2.json").string();
   write_file_atomic(bad2, R"({"scenarios": ["short.json"], "localizers": [{"type": "no_such_localizer"}]})");
   try {
     load_sweep(bad2);
@@ -106,7 +110,7 @@ TEST(Sweep, BadSweepFailsBeforeAnyRun) {
   } catch (const ConfigError& e) {
     EXPECT_NE(e.path().find("/localizer/type"), std::string::npos) << e.what();
   }
-  const std::string bad3 = (kTmp / "bad3.json").string();
+  const std::string bad3 = (test_dir() / "bad3.json").string();
   write_file_atomic(bad3, R"({"scenarios": ["short.json"], "parameters": {"/robots/0/motion/speed": [-3]}})");
   EXPECT_THROW(load_sweep(bad3), ConfigError);
 }
