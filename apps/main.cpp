@@ -9,6 +9,7 @@
 #include "core/field.hpp"
 #include "harness/experiment.hpp"
 #include "harness/localizer_registry.hpp"
+#include "harness/render_frame.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
@@ -23,6 +24,8 @@ const char* kUsage = R"(usage: omniloc <command> [options]
 commands:
   run FILE [--seed N] [-o DIR] [--frames DIR] [--frames-every N] [--quiet]
                          run a scenario; results in results/runs/<scenario>/<seed>/
+  render FILE --t SECONDS [--robot ID] [--seed N] [--labels] -o frame.png
+                         the panorama robot ID (default: the first localized) sees at time t
   validate FILE          check a scenario file (exit 2 with the JSON path of the first problem)
   list                   field presets, motion scripts, localizers, noise profiles, experiments
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
@@ -141,6 +144,24 @@ int cmd_sweep(const Args& a) {
   return r.failed > 0 ? 1 : 0;
 }
 
+int cmd_render(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("render takes one scenario file");
+  const auto s = harness::load_scenario(a.positional[0]);
+  const std::string out = opt(a, "-o");
+  if (out.empty()) throw UsageError("render needs -o frame.png");
+  double t = 0;
+  try {
+    t = std::stod(opt(a, "--t", "0"));
+  } catch (const std::exception&) {
+    throw UsageError("--t needs a time in seconds");
+  }
+  const int robot = opt(a, "--robot").empty() ? s.localized_robots().front() : std::atoi(opt(a, "--robot").c_str());
+  const std::uint64_t seed = opt(a, "--seed").empty() ? s.seed : parse_seed(opt(a, "--seed"));
+  harness::render_to_png(s, t, robot, seed, flag(a, "--labels"), out);
+  std::cout << "wrote " << out << "\n";
+  return 0;
+}
+
 int cmd_list() {
   std::cout << "field presets:";
   for (const auto& n : Field::preset_names()) std::cout << " " << n;
@@ -180,6 +201,7 @@ int main(int argc, char** argv) {
     if (cmd == "validate") return cmd_validate(parse(argc, argv, 2, {}, {}));
     if (cmd == "run") return cmd_run(parse(argc, argv, 2, {"--seed", "-o", "--frames", "--frames-every"}, {"--quiet"}));
     if (cmd == "list") return cmd_list();
+    if (cmd == "render") return cmd_render(parse(argc, argv, 2, {"--t", "--robot", "--seed", "-o"}, {"--labels"}));
     if (cmd == "sweep")
       return cmd_sweep(parse(argc, argv, 2, {"-j", "--shard", "-o", "--stop-after"}, {"--resume", "--aggregate-only"}));
     if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o"}, {"--quick"}));

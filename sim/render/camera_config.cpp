@@ -1,0 +1,53 @@
+#include "sim/render/camera_config.hpp"
+
+#include "core/angles.hpp"
+#include "sim/render/gl_context.hpp"
+#include "sim/render/mirror.hpp"
+
+namespace omniloc::sim {
+
+CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Json* effective) {
+  JsonReader r(j, path, effective);
+  r.allow("comment");
+  CameraConfig c;
+  c.width = static_cast<int>(r.integer("width", 640, 1, 4096));
+  c.height = static_cast<int>(r.integer("height", 640, 1, 4096));
+  if (c.width < 64 || c.height < 64)
+    throw ConfigError(r.child_path(c.width < 64 ? "width" : "height"), std::to_string(std::min(c.width, c.height)),
+                      "an image size of at least 64 pixels");
+  c.mount_height = r.number("mount_height", 0.75, 0.2, 2.0);
+  c.mirror = r.string("mirror", std::string("nubot_composite"), MirrorProfile::presets());
+  c.rim_fraction = r.number("rim_fraction", 0.49, 0.2, 0.5);
+  const auto off = r.numbers("centre_offset_px", std::vector<double>{0.0, 0.0}, 2);
+  c.centre_offset_px = {off[0], off[1]};
+  c.mirror_tilt = deg2rad(r.number("mirror_tilt_deg", 0.0, -5.0, 5.0));
+  c.vibration_std = deg2rad(r.number("vibration_deg", 0.3, 0.0, 5.0));
+  c.read_noise = r.number("read_noise", 1.5, 0.0, 50.0);
+  c.shot_noise = r.number("shot_noise", 0.35, 0.0, 10.0);
+  c.backend = r.string("backend", std::string("osmesa"), gl_backends());
+  c.quality = r.string("quality", std::string("default"), {"low", "default", "high"});
+  c.exposure_min = r.positive("exposure_min", 1.0, 1000.0);
+  c.exposure_max = r.positive("exposure_max", 60.0, 1000.0);
+  c.gain_min = r.positive("gain_min", 1.0, 1000.0);
+  c.gain_max = r.positive("gain_max", 60.0, 1000.0);
+  c.initial.exposure_ms = r.positive("exposure", 18.0, 1000.0);
+  c.initial.gain = r.positive("gain", 18.0, 1000.0);
+  if (c.exposure_min >= c.exposure_max) throw ConfigError(r.child_path("exposure_max"), std::to_string(c.exposure_max), "exposure_max > exposure_min");
+  if (c.gain_min >= c.gain_max) throw ConfigError(r.child_path("gain_max"), std::to_string(c.gain_max), "gain_max > gain_min");
+  if (c.initial.exposure_ms < c.exposure_min || c.initial.exposure_ms > c.exposure_max)
+    throw ConfigError(r.child_path("exposure"), std::to_string(c.initial.exposure_ms), "an exposure within [exposure_min, exposure_max]");
+  if (c.initial.gain < c.gain_min || c.initial.gain > c.gain_max)
+    throw ConfigError(r.child_path("gain"), std::to_string(c.initial.gain), "a gain within [gain_min, gain_max]");
+  r.finish();
+  return c;
+}
+
+Json CameraConfig::to_json() const {
+  return Json{{"width", width}, {"height", height}, {"mount_height", mount_height}, {"mirror", mirror}, {"rim_fraction", rim_fraction},
+              {"centre_offset_px", {centre_offset_px.x(), centre_offset_px.y()}}, {"mirror_tilt_deg", rad2deg(mirror_tilt)},
+              {"vibration_deg", rad2deg(vibration_std)}, {"read_noise", read_noise}, {"shot_noise", shot_noise}, {"backend", backend},
+              {"quality", quality}, {"exposure", initial.exposure_ms}, {"gain", initial.gain}, {"exposure_min", exposure_min},
+              {"exposure_max", exposure_max}, {"gain_min", gain_min}, {"gain_max", gain_max}};
+}
+
+}  // namespace omniloc::sim

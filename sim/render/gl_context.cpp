@@ -1,0 +1,188 @@
+#include "sim/render/gl_context.hpp"
+
+#include <dlfcn.h>
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/osmesa.h>
+
+#include <cstring>
+
+#include "core/error.hpp"
+
+namespace omniloc::sim {
+
+GlContext::~GlContext() = default;
+
+void GlContext::load(void* (*proc)(const char*)) {
+  std::string missing;
+#define OMNILOC_GL_LOAD(ret, name, args)                                         \
+  gl_.name = reinterpret_cast<ret(*) args>(proc("gl" #name));                    \
+  if (!gl_.name) missing += std::string(missing.empty() ? "" : ", ") + "gl" #name;
+  OMNILOC_GL_FUNCS(OMNILOC_GL_LOAD)
+#undef OMNILOC_GL_LOAD
+  if (!missing.empty()) throw RuntimeFailure("GL back-end \"" + backend_ + "\": missing entry points " + missing);
+}
+
+bool GlContext::has_extension(const std::string& name) const {
+  const char* ext = reinterpret_cast<const char*>(gl_.GetString(GL_EXTENSIONS));
+  return ext && std::strstr(ext, name.c_str()) != nullptr;
+}
+
+void GlContext::release_framebuffer() {
+  if (fbo_) gl_.DeleteFramebuffers(1, &fbo_);
+  if (color_) gl_.DeleteRenderbuffers(1, &color_);
+  if (depth_) gl_.DeleteRenderbuffers(1, &depth_);
+  fbo_ = color_ = depth_ = 0;
+}
+
+void GlContext::bind_framebuffer(int width, int height) {
+  if (fbo_ && width == fb_w_ && height == fb_h_) {
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    return;
+  }
+  release_framebuffer();
+  gl_.GenFramebuffers(1, &fbo_);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  gl_.GenRenderbuffers(1, &color_);
+  gl_.BindRenderbuffer(GL_RENDERBUFFER, color_);
+  gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
+  gl_.GenRenderbuffers(1, &depth_);
+  gl_.BindRenderbuffer(GL_RENDERBUFFER, depth_);
+  gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+  const GLenum st = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (st != GL_FRAMEBUFFER_COMPLETE)
+    throw RuntimeFailure("GL back-end \"" + backend_ + "\": framebuffer " + std::to_string(width) + "x" + std::to_string(height) +
+                         " incomplete (status 0x" + std::to_string(st) + ")");
+  fb_w_ = width;
+  fb_h_ = height;
+}
+
+void GlContext::read_rgba(std::vector<unsigned char>& out) const {
+  out.resize(static_cast<std::size_t>(fb_w_) * fb_h_ * 4);
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl_.ReadPixels(0, 0, fb_w_, fb_h_, GL_RGBA, GL_UNSIGNED_BYTE, out.data());
+  const GLenum err = gl_.GetError();
+  if (err != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + backend_ + "\": glReadPixels failed (error 0x" + std::to_string(err) + ")");
+}
+
+namespace {
+
+void* open_library(const std::string& backend, const char* lib) {
+  void* h = ::dlopen(lib, RTLD_NOW | RTLD_LOCAL);
+  if (!h) throw RuntimeFailure("GL back-end \"" + backend + "\": cannot load " + lib + " (" + ::dlerror() + ")");
+  return h;
+}
+
+// The resolver handed to GlContext::load needs a plain function; each back-end sets its own.
+thread_local void* (*t_osmesa_gpa)(const char*) = nullptr;
+thread_local void* (*t_egl_gpa)(const char*) = nullptr;
+void* osmesa_proc(const char* n) { return t_osmesa_gpa(n); }
+void* egl_proc(const char* n) { return t_egl_gpa(n); }
+
+class OsmesaContext : public GlContext {
+ public:
+  OsmesaContext() {
+    backend_ = "osmesa";
+    lib_ = open_library(backend_, "libOSMesa.so.8");
+    create_ = reinterpret_cast<OSMesaContext (*)(const int*, OSMesaContext)>(::dlsym(lib_, "OSMesaCreateContextAttribs"));
+    make_ = reinterpret_cast<GLboolean (*)(OSMesaContext, void*, GLenum, GLsizei, GLsizei)>(::dlsym(lib_, "OSMesaMakeCurrent"));
+    destroy_ = reinterpret_cast<void (*)(OSMesaContext)>(::dlsym(lib_, "OSMesaDestroyContext"));
+    t_osmesa_gpa = reinterpret_cast<void* (*)(const char*)>(::dlsym(lib_, "OSMesaGetProcAddress"));
+    if (!create_ || !make_ || !destroy_ || !t_osmesa_gpa) throw RuntimeFailure("GL back-end \"osmesa\": libOSMesa lacks the OSMesa 11.2 API");
+    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE,
+                           OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 0, 0};
+    ctx_ = create_(attribs, nullptr);
+    if (!ctx_) throw RuntimeFailure("GL back-end \"osmesa\": OSMesaCreateContextAttribs failed (no GL 3.0 compatibility context)");
+    make_current();
+    load(osmesa_proc);
+  }
+  ~OsmesaContext() override {
+    release_framebuffer();
+    if (ctx_) destroy_(ctx_);
+  }
+  void make_current() override {
+    // OSMesa needs a client buffer even though we render into an FBO.
+    if (!make_(ctx_, dummy_, GL_UNSIGNED_BYTE, 1, 1)) throw RuntimeFailure("GL back-end \"osmesa\": OSMesaMakeCurrent failed");
+  }
+
+ private:
+  void* lib_ = nullptr;
+  OSMesaContext ctx_ = nullptr;
+  unsigned char dummy_[16] = {};
+  OSMesaContext (*create_)(const int*, OSMesaContext) = nullptr;
+  GLboolean (*make_)(OSMesaContext, void*, GLenum, GLsizei, GLsizei) = nullptr;
+  void (*destroy_)(OSMesaContext) = nullptr;
+};
+
+class EglContext : public GlContext {
+ public:
+  EglContext() {
+    backend_ = "egl";
+    lib_ = open_library(backend_, "libEGL.so.1");
+    t_egl_gpa = reinterpret_cast<void* (*)(const char*)>(::dlsym(lib_, "eglGetProcAddress"));
+    auto sym = [&](const char* n) {
+      void* p = ::dlsym(lib_, n);
+      if (!p) throw RuntimeFailure(std::string("GL back-end \"egl\": libEGL lacks ") + n);
+      return p;
+    };
+    auto initialize = reinterpret_cast<EGLBoolean (*)(EGLDisplay, EGLint*, EGLint*)>(sym("eglInitialize"));
+    auto bind_api = reinterpret_cast<EGLBoolean (*)(EGLenum)>(sym("eglBindAPI"));
+    auto choose = reinterpret_cast<EGLBoolean (*)(EGLDisplay, const EGLint*, EGLConfig*, EGLint, EGLint*)>(sym("eglChooseConfig"));
+    auto create = reinterpret_cast<EGLContext (*)(EGLDisplay, EGLConfig, EGLContext, const EGLint*)>(sym("eglCreateContext"));
+    make_ = reinterpret_cast<EGLBoolean (*)(EGLDisplay, EGLSurface, EGLSurface, EGLContext)>(sym("eglMakeCurrent"));
+    destroy_ = reinterpret_cast<EGLBoolean (*)(EGLDisplay, EGLContext)>(sym("eglDestroyContext"));
+    auto get_error = reinterpret_cast<EGLint (*)()>(sym("eglGetError"));
+    if (!t_egl_gpa) throw RuntimeFailure("GL back-end \"egl\": libEGL lacks eglGetProcAddress");
+    auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(t_egl_gpa("eglGetPlatformDisplayEXT"));
+    if (!get_display) throw RuntimeFailure("GL back-end \"egl\": no eglGetPlatformDisplayEXT (EGL_EXT_platform_base)");
+    dpy_ = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0, minor = 0;
+    if (dpy_ == EGL_NO_DISPLAY || !initialize(dpy_, &major, &minor))
+      throw RuntimeFailure("GL back-end \"egl\": no surfaceless Mesa display (EGL error 0x" + std::to_string(get_error()) + ")");
+    if (!bind_api(EGL_OPENGL_API)) throw RuntimeFailure("GL back-end \"egl\": desktop OpenGL API not available");
+    // Surfaceless rendering needs no config (EGL_KHR_no_config_context); fall back to choosing one.
+    EGLConfig cfg = EGL_NO_CONFIG_KHR;
+    const EGLint cfg_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    EGLint n = 0;
+    auto query = reinterpret_cast<const char* (*)(EGLDisplay, EGLint)>(sym("eglQueryString"));
+    const char* exts = query(dpy_, EGL_EXTENSIONS);
+    if (!exts || !std::strstr(exts, "EGL_KHR_no_config_context")) {
+      if (!choose(dpy_, cfg_attribs, &cfg, 1, &n) || n < 1) throw RuntimeFailure("GL back-end \"egl\": no OpenGL config and no EGL_KHR_no_config_context");
+    }
+    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                  EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT, EGL_NONE};
+    ctx_ = create(dpy_, cfg, EGL_NO_CONTEXT, ctx_attribs);
+    if (ctx_ == EGL_NO_CONTEXT) throw RuntimeFailure("GL back-end \"egl\": eglCreateContext failed (error 0x" + std::to_string(get_error()) + ")");
+    make_current();
+    load(egl_proc);
+  }
+  ~EglContext() override {
+    release_framebuffer();
+    if (ctx_ != EGL_NO_CONTEXT) destroy_(dpy_, ctx_);
+  }
+  void make_current() override {
+    if (!make_(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) throw RuntimeFailure("GL back-end \"egl\": eglMakeCurrent (surfaceless) failed");
+  }
+
+ private:
+  void* lib_ = nullptr;
+  EGLDisplay dpy_ = EGL_NO_DISPLAY;
+  EGLContext ctx_ = EGL_NO_CONTEXT;
+  EGLBoolean (*make_)(EGLDisplay, EGLSurface, EGLSurface, EGLContext) = nullptr;
+  EGLBoolean (*destroy_)(EGLDisplay, EGLContext) = nullptr;
+};
+
+}  // namespace
+
+std::vector<std::string> gl_backends() { return {"osmesa", "egl"}; }
+
+std::unique_ptr<GlContext> make_gl_context(const std::string& backend) {
+  if (backend == "osmesa") return std::make_unique<OsmesaContext>();
+  if (backend == "egl") return std::make_unique<EglContext>();
+  throw RuntimeFailure("unknown GL back-end \"" + backend + "\" (known: osmesa, egl)");
+}
+
+}  // namespace omniloc::sim

@@ -1,0 +1,581 @@
+#include "sim/render/panoramic_camera.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/angles.hpp"
+#include "core/error.hpp"
+
+namespace omniloc::sim {
+
+namespace {
+
+// Linear albedos (reflectances) of the scene's surfaces.
+const Eigen::Vector3f kCarpet(0.10f, 0.34f, 0.12f);
+const Eigen::Vector3f kLineWhite(0.85f, 0.85f, 0.85f);
+const Eigen::Vector3f kHallFloor(0.30f, 0.29f, 0.27f);
+const Eigen::Vector3f kBackground(0.08f, 0.08f, 0.09f);
+const Eigen::Vector3f kWall(0.14f, 0.14f, 0.20f);
+const Eigen::Vector3f kRobot(0.05f, 0.05f, 0.05f);
+const Eigen::Vector3f kBall(0.85f, 0.30f, 0.05f);
+const Eigen::Vector3f kPost(0.85f, 0.85f, 0.85f);
+const Eigen::Vector3f kNet(0.50f, 0.52f, 0.50f);
+const Eigen::Vector3f kBody(0.35f, 0.35f, 0.35f);
+const Eigen::Vector3f kBlack(0.03f, 0.03f, 0.03f);
+
+// GL colours carry albedo * illumination / kRadianceScale, so illumination up to 4x normal fits.
+constexpr float kRadianceScale = 4.0f;
+// Camera response: value (DN) = kResponse * albedo * illumination * exposure_ms * gain. Chosen so
+// that exposure = gain = 18 (paper 002's entropy peak under normal light) puts the white lines at
+// 200 DN and the carpet's green channel near 80 DN: well exposed, nothing clipped.
+constexpr double kResponse = 200.0 / (0.85 * 18.0 * 18.0);
+
+Eigen::Vector3f colour_of(const std::string& c) {
+  if (c == "yellow") return {0.85f, 0.78f, 0.08f};
+  if (c == "blue") return {0.08f, 0.18f, 0.75f};
+  if (c == "red") return {0.80f, 0.08f, 0.08f};
+  if (c == "green") return {0.10f, 0.60f, 0.15f};
+  if (c == "magenta") return {0.75f, 0.10f, 0.65f};
+  if (c == "cyan") return {0.10f, 0.65f, 0.75f};
+  return kPost;
+}
+std::uint8_t label_of(const std::string& c) {
+  if (c == "yellow") return kLabelYellow;
+  if (c == "blue") return kLabelBlue;
+  if (c == "red") return kLabelRed;
+  return kLabelGoal;
+}
+
+struct Tri {
+  std::array<Eigen::Vector3d, 3> p;  // world frame, metres
+  Eigen::Vector3f albedo;
+  std::uint8_t label;
+};
+
+// Tessellated primitives in world coordinates.
+void add_quad(std::vector<Tri>& out, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+              const Eigen::Vector3d& d, const Eigen::Vector3f& alb, std::uint8_t lab, double max_edge) {
+  // Subdivide a planar quad a-b-c-d (in order) into a grid whose cells are at most max_edge.
+  const int nu = std::max(1, static_cast<int>(std::ceil(std::max((b - a).norm(), (c - d).norm()) / max_edge)));
+  const int nv = std::max(1, static_cast<int>(std::ceil(std::max((d - a).norm(), (c - b).norm()) / max_edge)));
+  auto at = [&](int i, int j) {
+    const double u = static_cast<double>(i) / nu, v = static_cast<double>(j) / nv;
+    return Eigen::Vector3d((1 - v) * ((1 - u) * a + u * b) + v * ((1 - u) * d + u * c));
+  };
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      out.push_back({{at(i, j), at(i + 1, j), at(i + 1, j + 1)}, alb, lab});
+      out.push_back({{at(i, j), at(i + 1, j + 1), at(i, j + 1)}, alb, lab});
+    }
+}
+
+void add_box(std::vector<Tri>& out, const Eigen::Vector2d& c, double hx, double hy, double angle, double z0, double z1,
+             const Eigen::Vector3f& alb, std::uint8_t lab, double max_edge) {
+  const double ca = std::cos(angle), sa = std::sin(angle);
+  auto corner = [&](double sx, double sy, double z) {
+    return Eigen::Vector3d(c.x() + ca * sx * hx - sa * sy * hy, c.y() + sa * sx * hx + ca * sy * hy, z);
+  };
+  const double xs[4] = {-1, 1, 1, -1}, ys[4] = {-1, -1, 1, 1};
+  for (int k = 0; k < 4; ++k) {
+    const int n = (k + 1) % 4;
+    add_quad(out, corner(xs[k], ys[k], z0), corner(xs[n], ys[n], z0), corner(xs[n], ys[n], z1), corner(xs[k], ys[k], z1), alb, lab, max_edge);
+  }
+  add_quad(out, corner(-1, -1, z1), corner(1, -1, z1), corner(1, 1, z1), corner(-1, 1, z1), alb, lab, max_edge);
+}
+
+void add_cylinder(std::vector<Tri>& out, const Eigen::Vector2d& c, double r, double z0, double z1, const Eigen::Vector3f& alb,
+                  std::uint8_t lab, int sides, int rows) {
+  for (int k = 0; k < sides; ++k) {
+    const double a0 = kTwoPi * k / sides, a1 = kTwoPi * (k + 1) / sides;
+    const Eigen::Vector2d p0 = c + r * Eigen::Vector2d(std::cos(a0), std::sin(a0));
+    const Eigen::Vector2d p1 = c + r * Eigen::Vector2d(std::cos(a1), std::sin(a1));
+    for (int j = 0; j < rows; ++j) {
+      const double za = z0 + (z1 - z0) * j / rows, zb = z0 + (z1 - z0) * (j + 1) / rows;
+      out.push_back({{Eigen::Vector3d(p0.x(), p0.y(), za), Eigen::Vector3d(p1.x(), p1.y(), za), Eigen::Vector3d(p1.x(), p1.y(), zb)}, alb, lab});
+      out.push_back({{Eigen::Vector3d(p0.x(), p0.y(), za), Eigen::Vector3d(p1.x(), p1.y(), zb), Eigen::Vector3d(p0.x(), p0.y(), zb)}, alb, lab});
+    }
+    out.push_back({{Eigen::Vector3d(c.x(), c.y(), z1), Eigen::Vector3d(p0.x(), p0.y(), z1), Eigen::Vector3d(p1.x(), p1.y(), z1)}, alb, lab});
+  }
+}
+
+void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const Eigen::Vector3f& alb, std::uint8_t lab) {
+  const int nl = 8, na = 14;
+  auto pt = [&](int i, int j) {
+    const double th = kPi * i / nl, ph = kTwoPi * j / na;
+    return Eigen::Vector3d(c + r * Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
+  };
+  for (int i = 0; i < nl; ++i)
+    for (int j = 0; j < na; ++j) {
+      out.push_back({{pt(i, j), pt(i + 1, j), pt(i + 1, j + 1)}, alb, lab});
+      out.push_back({{pt(i, j), pt(i + 1, j + 1), pt(i, j + 1)}, alb, lab});
+    }
+}
+
+double illumination_at(const Lighting& l, const Eigen::Vector2d& p) {
+  double e = l.level;
+  for (const auto& s : l.sun)
+    if (std::fabs(p.x() - s.centre.x()) <= s.half_size.x() && std::fabs(p.y() - s.centre.y()) <= s.half_size.y()) e += s.strength;
+  return e;
+}
+
+}  // namespace
+
+struct PanoramicCameraImpl {
+  std::unique_ptr<GlContext> ctx;
+  Field field;
+  int ss = 2;                // supersampling factor
+  int W = 0, H = 0;          // render size (W * ss ...)
+  unsigned tex_albedo = 0, tex_label = 0;
+  double hx = 0, hy = 0;     // floor half extents covered by the texture
+  // Polar floor mesh, fixed in the image.
+  std::vector<float> mesh_xy;          // render-space positions
+  std::vector<Eigen::Vector3d> mesh_dir;  // camera-frame unit ray of each vertex
+  std::vector<unsigned> mesh_idx;
+  std::vector<Tri> static_tris;        // walls, goals, landmarks
+  std::vector<unsigned char> readback;
+  std::vector<float> noise;            // standard normals, drawn once from the first render's Rng
+  // Per-draw scratch.
+  std::vector<float> pos, col, tex;
+};
+
+PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
+    : impl_(std::make_unique<PanoramicCameraImpl>()),
+      cfg_(config),
+      mirror_(MirrorProfile::preset(config.mirror, config.rim_fraction * std::min(config.width, config.height), config.mount_height)) {
+  PanoramicCameraImpl& m = *impl_;
+  m.field = field;
+  m.ss = cfg_.quality == "high" ? 2 : 1;
+  m.W = cfg_.width * m.ss;
+  m.H = cfg_.height * m.ss;
+  m.ctx = make_gl_context(cfg_.backend);
+  const GlApi& gl = m.ctx->gl();
+  m.ctx->bind_framebuffer(m.W, m.H);
+
+  // Field textures: 1 cm texels over the floor inside the walls; lines anti-aliased by coverage.
+  m.hx = field.half_floor_x();
+  m.hy = field.half_floor_y();
+  const double texel = 0.01;
+  const int tw = static_cast<int>(std::ceil(2 * m.hx / texel)), th = static_cast<int>(std::ceil(2 * m.hy / texel));
+  std::vector<unsigned char> albedo(static_cast<std::size_t>(tw) * th * 4), label(static_cast<std::size_t>(tw) * th * 4);
+  const double half_w = 0.5 * field.line_width;
+  for (int j = 0; j < th; ++j)
+    for (int i = 0; i < tw; ++i) {
+      const Eigen::Vector2d p(-m.hx + (i + 0.5) * texel, -m.hy + (j + 0.5) * texel);
+      const double d = field.distance_to_marking(p);
+      const double cover = std::clamp(0.5 + (half_w - d) / texel, 0.0, 1.0);
+      const Eigen::Vector3f c = kCarpet * static_cast<float>(1 - cover) + kLineWhite * static_cast<float>(cover);
+      unsigned char* a = &albedo[(static_cast<std::size_t>(j) * tw + i) * 4];
+      for (int k = 0; k < 3; ++k) a[k] = static_cast<unsigned char>(std::lround(255 * c[k]));
+      a[3] = 255;
+      unsigned char* l = &label[(static_cast<std::size_t>(j) * tw + i) * 4];
+      l[0] = l[1] = l[2] = static_cast<unsigned char>(d <= half_w ? kLabelLine : kLabelField);
+      l[3] = 255;
+    }
+  auto upload = [&](unsigned& id, const std::vector<unsigned char>& px, bool filtered, const Eigen::Vector3f& border, std::uint8_t border_label) {
+    gl.GenTextures(1, &id);
+    gl.BindTexture(GL_TEXTURE_2D, id);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float bc[4] = {filtered ? border[0] : border_label / 255.0f, filtered ? border[1] : border_label / 255.0f,
+                         filtered ? border[2] : border_label / 255.0f, 1.0f};
+    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, bc);
+    if (filtered) {
+      gl.TexParameteri(GL_TEXTURE_2D, GL_GENERATE_MIPMAP, GL_TRUE);
+      // Trilinear mip-mapping anti-aliases the far lines. (Anisotropic filtering would be sharper
+      // along the radius, but llvmpipe takes seconds per frame with it: measured, not used.)
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    } else {
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, tw, th, 0, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+    if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + m.ctx->backend() + "\": field texture upload failed");
+  };
+  upload(m.tex_albedo, albedo, true, kHallFloor, kLabelFloorOutside);
+  upload(m.tex_label, label, false, kHallFloor, kLabelFloorOutside);
+
+  // Polar floor mesh in render space. Texture coordinates are interpolated linearly across each
+  // cell, so rings are placed where the floor distance stops being linear in the image radius: a
+  // new ring whenever the midpoint of the floor distance deviates by more than `tol` from the chord
+  // (the mirror's isometric part needs few rings, the inner and outer parts many). Sectors of 3
+  // degrees bend a line by at most 4 mm at 8 m (chord against arc).
+  const double tol = cfg_.quality == "low" ? 0.01 : 0.003;
+  const int sectors = cfg_.quality == "low" ? 90 : 120;
+  auto floor_dist = [&](double r) {
+    const double e = mirror_.elevation(std::clamp(r, mirror_.body_radius(), mirror_.rim()));
+    return e < -1e-3 ? cfg_.mount_height / std::tan(-e) : 1e3;
+  };
+  std::vector<double> radii;
+  double r0 = mirror_.body_radius() - 1.0;
+  radii.push_back(r0);
+  while (r0 < mirror_.rim() + 1.0) {
+    double step = 16.0;
+    while (step > 0.5) {
+      const double a = floor_dist(r0), b = floor_dist(r0 + step), mid = floor_dist(r0 + 0.5 * step);
+      if (b > 30.0 || std::fabs(mid - 0.5 * (a + b)) <= tol) break;  // beyond 30 m nothing is resolved anyway
+      step *= 0.5;
+    }
+    r0 = std::min(r0 + step, mirror_.rim() + 1.0);
+    radii.push_back(r0);
+    if (r0 >= mirror_.rim() + 1.0) break;
+  }
+  const Eigen::Vector2d c = centre();
+  for (double r : radii) {
+    const double e = mirror_.elevation(std::clamp(r, mirror_.body_radius(), mirror_.rim()));
+    for (int k = 0; k <= sectors; ++k) {
+      const double b = kTwoPi * k / sectors;
+      m.mesh_xy.push_back(static_cast<float>((c.x() - r * std::sin(b)) * m.ss));
+      m.mesh_xy.push_back(static_cast<float>((c.y() - r * std::cos(b)) * m.ss));
+      m.mesh_dir.emplace_back(std::cos(e) * std::cos(b), std::cos(e) * std::sin(b), std::sin(e));
+    }
+  }
+  const unsigned row = static_cast<unsigned>(sectors) + 1;
+  for (unsigned i = 0; i + 1 < radii.size(); ++i)
+    for (unsigned k = 0; k < static_cast<unsigned>(sectors); ++k) {
+      const unsigned a = i * row + k, b = a + 1, cc = a + row, d = cc + 1;
+      m.mesh_idx.insert(m.mesh_idx.end(), {a, b, d, a, d, cc});
+    }
+
+  // Static scene: walls, goals, landmarks.
+  const double wall_t = 0.1, wh = field.wall_height;
+  if (wh > 0) {
+    add_box(m.static_tris, {0, m.hy + wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.static_tris, {0, -m.hy - wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.static_tris, {m.hx + wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.static_tris, {-m.hx - wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
+  }
+  for (const auto& g : field.goals) {
+    const bool coloured = g.colour != "white";
+    const Eigen::Vector3f post = coloured ? colour_of(g.colour) : kPost;
+    const std::uint8_t plab = coloured ? label_of(g.colour) : std::uint8_t{kLabelGoal};
+    const double hp = 0.5 * g.post_width, s = g.side();
+    for (const Eigen::Vector2d& pp : {g.left_post(), g.right_post()}) add_box(m.static_tris, pp, hp, hp, 0, 0, g.height, post, plab, 0.15);
+    const double yw = 0.5 * g.width + g.post_width;
+    add_box(m.static_tris, {g.goal_line_x, 0}, hp, yw, 0, g.height - g.post_width, g.height, post, plab, 0.15);
+    // Net: back and side panels (coloured inside on the legacy field).
+    const Eigen::Vector3f net = coloured ? colour_of(g.colour) : kNet;
+    const std::uint8_t nlab = coloured ? label_of(g.colour) : std::uint8_t{kLabelGoal};
+    const double x0 = g.goal_line_x + s * hp, x1 = g.goal_line_x + s * g.depth;
+    add_quad(m.static_tris, {x1, -yw, 0}, {x1, yw, 0}, {x1, yw, g.height}, {x1, -yw, g.height}, net, nlab, 0.2);
+    add_quad(m.static_tris, {x0, -yw, 0}, {x1, -yw, 0}, {x1, -yw, g.height}, {x0, -yw, g.height}, net, nlab, 0.2);
+    add_quad(m.static_tris, {x0, yw, 0}, {x1, yw, 0}, {x1, yw, g.height}, {x0, yw, g.height}, net, nlab, 0.2);
+    add_quad(m.static_tris, {x0, -yw, g.height}, {x1, -yw, g.height}, {x1, yw, g.height}, {x0, yw, g.height}, net, nlab, 0.2);
+  }
+  for (const auto& l : field.landmarks) {
+    if (l.shape == "post")
+      add_cylinder(m.static_tris, l.position, 0.5 * l.size, 0, l.height, colour_of(l.colour), label_of(l.colour), 16, 6);
+    else
+      add_box(m.static_tris, l.position, 0.5 * l.size, 0.5 * l.size, 0, 0, l.height, colour_of(l.colour), label_of(l.colour), 0.1);
+  }
+}
+
+PanoramicCamera::~PanoramicCamera() {
+  if (impl_ && impl_->ctx) {
+    impl_->ctx->make_current();
+    impl_->ctx->gl().DeleteTextures(1, &impl_->tex_albedo);
+    impl_->ctx->gl().DeleteTextures(1, &impl_->tex_label);
+  }
+}
+
+const std::string& PanoramicCamera::backend() const { return impl_->ctx->backend(); }
+
+Eigen::Vector2d PanoramicCamera::centre() const {
+  return Eigen::Vector2d(0.5 * cfg_.width, 0.5 * cfg_.height) + cfg_.centre_offset_px;
+}
+
+double PanoramicCamera::response(double albedo, double illumination, const CameraSettings& s) {
+  return kResponse * albedo * illumination * s.exposure_ms * s.gain;
+}
+
+CameraSettings PanoramicCamera::clamp(const CameraSettings& s, bool* clamped) const {
+  CameraSettings o;
+  o.exposure_ms = std::clamp(s.exposure_ms, cfg_.exposure_min, cfg_.exposure_max);
+  o.gain = std::clamp(s.gain, cfg_.gain_min, cfg_.gain_max);
+  if (!std::isfinite(s.exposure_ms)) o.exposure_ms = cfg_.exposure_min;
+  if (!std::isfinite(s.gain)) o.gain = cfg_.gain_min;
+  if (clamped) *clamped = o.exposure_ms != s.exposure_ms || o.gain != s.gain;
+  return o;
+}
+
+namespace {
+
+// Camera-to-robot rotation: fixed mirror tilt about x, plus per-frame vibration (roll, pitch).
+Eigen::Matrix3d camera_rotation(double roll, double pitch) {
+  const double cr = std::cos(roll), sr = std::sin(roll), cp = std::cos(pitch), sp = std::sin(pitch);
+  Eigen::Matrix3d rx, ry;
+  rx << 1, 0, 0, 0, cr, -sr, 0, sr, cr;
+  ry << cp, 0, sp, 0, 1, 0, -sp, 0, cp;
+  return rx * ry;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector2d> PanoramicCamera::project(const Eigen::Vector3d& p) const {
+  const Eigen::Matrix3d R = camera_rotation(cfg_.mirror_tilt, 0.0);
+  const Eigen::Vector3d q = R.transpose() * (p - Eigen::Vector3d(0, 0, cfg_.mount_height));
+  const double rho = std::hypot(q.x(), q.y());
+  if (rho < 1e-9) return std::nullopt;
+  const double e = std::atan2(q.z(), rho), b = std::atan2(q.y(), q.x());
+  const double r = mirror_.radius(e);
+  if (r < mirror_.body_radius() || r > mirror_.rim()) return std::nullopt;
+  return centre() + r * Eigen::Vector2d(-std::sin(b), -std::cos(b));
+}
+
+std::optional<Eigen::Vector2d> PanoramicCamera::floor_point(double u, double v) const {
+  const Eigen::Vector2d d = Eigen::Vector2d(u, v) - centre();
+  const double r = d.norm();
+  if (r < mirror_.body_radius() || r > mirror_.rim()) return std::nullopt;
+  const double e = mirror_.elevation(r), b = std::atan2(-d.x(), -d.y());
+  const Eigen::Vector3d dir = camera_rotation(cfg_.mirror_tilt, 0.0) * Eigen::Vector3d(std::cos(e) * std::cos(b), std::cos(e) * std::sin(b), std::sin(e));
+  if (dir.z() >= -1e-9) return std::nullopt;
+  const double t = cfg_.mount_height / -dir.z();
+  return Eigen::Vector2d(t * dir.x(), t * dir.y());
+}
+
+namespace {
+
+// One draw of the scene into the bound framebuffer. `labels`: flat class colours, no lighting.
+void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorProfile& mirror, const Eigen::Vector2d& centre,
+                const WorldState& world, const RobotState& me, const Eigen::Matrix3d& R, bool labels) {
+  const GlApi& gl = m.ctx->gl();
+  const Pose2& pose = me.pose;
+  const double h = cfg.mount_height;
+  gl.Viewport(0, 0, m.W, m.H);
+  gl.MatrixMode(GL_PROJECTION);
+  gl.LoadIdentity();
+  gl.Ortho(0, m.W, m.H, 0, 0.0, 1000.0);  // render space: x right, y down; z = -depth
+  gl.MatrixMode(GL_MODELVIEW);
+  gl.LoadIdentity();
+  gl.ShadeModel(GL_SMOOTH);
+  const Eigen::Vector3f bg = labels ? Eigen::Vector3f::Zero() : Eigen::Vector3f(kBackground * (world.lighting.level / kRadianceScale));
+  gl.ClearColor(bg[0], bg[1], bg[2], 1.0f);
+  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  gl.EnableClientState(GL_VERTEX_ARRAY);
+  gl.EnableClientState(GL_COLOR_ARRAY);
+
+  // Floor: texture coordinates are this frame's floor points of the image-fixed rays.
+  const std::size_t nv = m.mesh_dir.size();
+  m.pos.resize(nv * 3);
+  m.col.resize(nv * 4);
+  m.tex.resize(nv * 2);
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  for (std::size_t i = 0; i < nv; ++i) {
+    const Eigen::Vector3d d = R * m.mesh_dir[i];
+    Eigen::Vector2d w;
+    if (d.z() < -1e-6) {
+      const double t = h / -d.z();
+      const double rx = t * d.x(), ry = t * d.y();
+      w = {pose.x + c * rx - s * ry, pose.y + s * rx + c * ry};
+    } else {
+      w = {pose.x + 1e4 * (c * d.x() - s * d.y()), pose.y + 1e4 * (s * d.x() + c * d.y())};  // no floor: far beyond the walls
+    }
+    m.pos[3 * i] = m.mesh_xy[2 * i];
+    m.pos[3 * i + 1] = m.mesh_xy[2 * i + 1];
+    m.pos[3 * i + 2] = -999.0f;
+    m.tex[2 * i] = static_cast<float>((w.x() + m.hx) / (2 * m.hx));
+    m.tex[2 * i + 1] = static_cast<float>((w.y() + m.hy) / (2 * m.hy));
+    const float illum = labels ? 1.0f : static_cast<float>(std::min(1.0, illumination_at(world.lighting, w) / kRadianceScale));
+    m.col[4 * i] = m.col[4 * i + 1] = m.col[4 * i + 2] = illum;
+    m.col[4 * i + 3] = 1.0f;
+  }
+  gl.Disable(GL_DEPTH_TEST);
+  gl.DepthMask(GL_FALSE);
+  gl.Enable(GL_TEXTURE_2D);
+  gl.BindTexture(GL_TEXTURE_2D, labels ? m.tex_label : m.tex_albedo);
+  gl.TexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, labels ? GL_REPLACE : GL_MODULATE);
+  gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
+  gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
+  gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
+  gl.TexCoordPointer(2, GL_FLOAT, 0, m.tex.data());
+  gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.mesh_idx.size()), GL_UNSIGNED_INT, m.mesh_idx.data());
+  gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
+  gl.Disable(GL_TEXTURE_2D);
+
+  // Everything else: triangles projected per vertex through the mirror.
+  const Eigen::Matrix3d Rt = R.transpose();
+  auto project = [&](const Eigen::Vector3d& wp, float* out) {
+    const double dx = wp.x() - pose.x, dy = wp.y() - pose.y;
+    const Eigen::Vector3d q = Rt * Eigen::Vector3d(c * dx + s * dy, -s * dx + c * dy, wp.z() - h);
+    const double rho = std::hypot(q.x(), q.y());
+    const double e = std::atan2(q.z(), std::max(rho, 1e-9)), b = std::atan2(q.y(), q.x());
+    const double r = mirror.radius(e);
+    out[0] = static_cast<float>((centre.x() - r * std::sin(b)) * m.ss);
+    out[1] = static_cast<float>((centre.y() - r * std::cos(b)) * m.ss);
+    out[2] = static_cast<float>(-std::min(999.0, q.norm()));
+  };
+  std::vector<Tri> tris;
+  auto emit_all = [&](const std::vector<Tri>& list, bool ground_level) {
+    m.pos.clear();
+    m.col.clear();
+    for (const Tri& t : list) {
+      const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
+      const float illum = static_cast<float>(illumination_at(world.lighting, mid) / kRadianceScale);
+      for (const auto& v : t.p) {
+        float xyz[3];
+        project(v, xyz);
+        m.pos.insert(m.pos.end(), xyz, xyz + 3);
+        if (labels) {
+          const float l = t.label / 255.0f;
+          m.col.insert(m.col.end(), {l, l, l, 1.0f});
+        } else {
+          m.col.insert(m.col.end(), {std::min(1.0f, t.albedo[0] * illum), std::min(1.0f, t.albedo[1] * illum),
+                                     std::min(1.0f, t.albedo[2] * illum), 1.0f});
+        }
+      }
+    }
+    if (ground_level) {
+      gl.Disable(GL_DEPTH_TEST);
+    } else {
+      gl.Enable(GL_DEPTH_TEST);
+      gl.DepthMask(GL_TRUE);
+      gl.DepthFunc(GL_LESS);
+    }
+    gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
+    gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
+    gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(m.pos.size() / 3));
+  };
+  // Floor patches lie on the carpet: drawn over the floor, under everything standing on it.
+  for (const auto& fp : world.floor_patches) {
+    const Eigen::Vector3f alb = fp.reflectance.cast<float>();
+    const std::uint8_t lab = alb.maxCoeff() > 0.5f ? std::uint8_t{kLabelLine} : std::uint8_t{kLabelObstacle};
+    const double ca = std::cos(fp.angle), sa = std::sin(fp.angle);
+    auto corner = [&](double sx, double sy) {
+      return Eigen::Vector3d(fp.centre.x() + ca * sx * fp.half_size.x() - sa * sy * fp.half_size.y(),
+                             fp.centre.y() + sa * sx * fp.half_size.x() + ca * sy * fp.half_size.y(), 0.0);
+    };
+    add_quad(tris, corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1), alb, lab, 0.05);
+  }
+  if (!tris.empty()) emit_all(tris, true);
+  tris = m.static_tris;
+  for (const auto& r : world.robots)
+    if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5);
+  if (world.has_ball)
+    add_sphere(tris, Eigen::Vector3d(world.ball.position.x(), world.ball.position.y(), world.ball.radius), world.ball.radius, kBall, kLabelBall);
+  emit_all(tris, false);
+
+  // The robot's own body in the image centre (its brightness follows the light on the robot).
+  gl.Disable(GL_DEPTH_TEST);
+  const float body_illum = static_cast<float>(illumination_at(world.lighting, pose.translation()) / kRadianceScale);
+  m.pos.clear();
+  m.col.clear();
+  const int n = 64;
+  const double rb = mirror.body_radius() * m.ss;
+  for (int k = 0; k < n; ++k) {
+    const double a0 = kTwoPi * k / n, a1 = kTwoPi * (k + 1) / n;
+    const float cx = static_cast<float>(centre.x() * m.ss), cy = static_cast<float>(centre.y() * m.ss);
+    m.pos.insert(m.pos.end(), {cx, cy, 0.0f, static_cast<float>(cx + rb * std::cos(a0)), static_cast<float>(cy + rb * std::sin(a0)), 0.0f,
+                               static_cast<float>(cx + rb * std::cos(a1)), static_cast<float>(cy + rb * std::sin(a1)), 0.0f});
+    for (int v = 0; v < 3; ++v) {
+      if (labels) {
+        const float l = static_cast<float>(kLabelBody) / 255.0f;
+        m.col.insert(m.col.end(), {l, l, l, 1.0f});
+      } else {
+        m.col.insert(m.col.end(), {std::min(1.0f, kBody[0] * body_illum), std::min(1.0f, kBody[1] * body_illum),
+                                   std::min(1.0f, kBody[2] * body_illum), 1.0f});
+      }
+    }
+  }
+  gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
+  gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
+  gl.DrawArrays(GL_TRIANGLES, 0, n * 3);
+  gl.DisableClientState(GL_COLOR_ARRAY);
+  gl.DisableClientState(GL_VERTEX_ARRAY);
+  gl.Finish();
+}
+
+}  // namespace
+
+Image PanoramicCamera::render(const WorldState& world, int robot_id, const CameraSettings& requested, Rng& rng) {
+  PanoramicCameraImpl& m = *impl_;
+  const RobotState* me = world.robot(robot_id);
+  if (!me) throw RuntimeFailure("render: no robot with id " + std::to_string(robot_id));
+  const CameraSettings st = clamp(requested);
+  if (m.noise.empty()) {
+    m.noise.resize(1u << 20);
+    for (auto& x : m.noise) x = static_cast<float>(rng.normal());
+  }
+  const double roll = cfg_.mirror_tilt + (cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0);
+  const double pitch = cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0;
+  const std::uint64_t off = rng.next_u64(), stride = (rng.next_u64() | 1u);
+
+  m.ctx->make_current();
+  m.ctx->bind_framebuffer(m.W, m.H);
+  draw_scene(m, cfg_, mirror_, centre(), world, *me, camera_rotation(roll, pitch), false);
+  m.ctx->read_rgba(m.readback);
+
+  // Photometry: mean value per GL level (sum of ss*ss samples), then noise and saturation.
+  const int samples = m.ss * m.ss;
+  const int levels = 255 * samples + 1;
+  const double gainf = st.gain / 18.0;
+  const double per_unit = kRadianceScale / 255.0 / samples * kResponse * st.exposure_ms * st.gain;
+  std::vector<float> mean(levels), sigma(levels);
+  for (int l = 0; l < levels; ++l) {
+    mean[l] = static_cast<float>(l * per_unit);
+    const double v = std::min(255.0, static_cast<double>(mean[l]));
+    sigma[l] = static_cast<float>(std::sqrt(cfg_.read_noise * cfg_.read_noise * gainf * gainf + cfg_.shot_noise * cfg_.shot_noise * v * gainf));
+  }
+  Image img;
+  img.width = cfg_.width;
+  img.height = cfg_.height;
+  img.rgb.resize(static_cast<std::size_t>(img.width) * img.height * 3);
+  const std::size_t mask = m.noise.size() - 1;
+  std::size_t k = off & mask;
+  const std::size_t step = stride & mask;
+  const Eigen::Vector2d c = centre();
+  const double rim = mirror_.rim();
+  std::fill(img.rgb.begin(), img.rgb.end(), std::uint8_t{0});  // outside the mirror: black
+  for (int v = 0; v < img.height; ++v) {
+    // The span of this row inside the mirror rim.
+    const double dv = v + 0.5 - c.y();
+    if (std::fabs(dv) >= rim) continue;
+    const double half = std::sqrt(rim * rim - dv * dv);
+    const int u0 = std::max(0, static_cast<int>(std::ceil(c.x() - half - 0.5)));
+    const int u1 = std::min(img.width - 1, static_cast<int>(std::floor(c.x() + half - 0.5)));
+    std::uint8_t* out = img.row(v);
+    const unsigned char* rows[2];
+    for (int sy = 0; sy < m.ss; ++sy) rows[sy] = &m.readback[static_cast<std::size_t>(m.H - 1 - (v * m.ss + sy)) * m.W * 4];  // GL rows bottom-up
+    for (int u = u0; u <= u1; ++u) {
+      for (int ch = 0; ch < 3; ++ch) {
+        int sum = 0;
+        for (int sy = 0; sy < m.ss; ++sy)
+          for (int sx = 0; sx < m.ss; ++sx) sum += rows[sy][(u * m.ss + sx) * 4 + ch];
+        const float val = mean[sum] + sigma[sum] * m.noise[k];
+        k = (k + step) & mask;
+        out[3 * u + ch] = static_cast<std::uint8_t>(val <= 0.0f ? 0.0f : (val >= 255.0f ? 255.0f : val + 0.5f));
+      }
+    }
+  }
+  return img;
+}
+
+Image PanoramicCamera::render_labels(const WorldState& world, int robot_id) {
+  PanoramicCameraImpl& m = *impl_;
+  const RobotState* me = world.robot(robot_id);
+  if (!me) throw RuntimeFailure("render_labels: no robot with id " + std::to_string(robot_id));
+  m.ctx->make_current();
+  m.ctx->bind_framebuffer(m.W, m.H);
+  draw_scene(m, cfg_, mirror_, centre(), world, *me, camera_rotation(cfg_.mirror_tilt, 0.0), true);
+  m.ctx->read_rgba(m.readback);
+  Image img;
+  img.width = cfg_.width;
+  img.height = cfg_.height;
+  img.rgb.resize(static_cast<std::size_t>(img.width) * img.height * 3);
+  const Eigen::Vector2d c = centre();
+  const double rim2 = mirror_.rim() * mirror_.rim();
+  for (int v = 0; v < img.height; ++v) {
+    std::uint8_t* out = img.row(v);
+    const double dv = v + 0.5 - c.y();
+    // The sample nearest the output pixel centre of the supersampled grid.
+    const int gy = m.H - 1 - (v * m.ss + m.ss / 2);
+    for (int u = 0; u < img.width; ++u) {
+      const double du = u + 0.5 - c.x();
+      const std::uint8_t l = du * du + dv * dv > rim2 ? std::uint8_t{kLabelUnknown} : m.readback[(static_cast<std::size_t>(gy) * m.W + u * m.ss + m.ss / 2) * 4];
+      out[3 * u] = out[3 * u + 1] = out[3 * u + 2] = l;
+    }
+  }
+  return img;
+}
+
+}  // namespace omniloc::sim

@@ -1,0 +1,182 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/field.hpp"
+#include "sim/render/panoramic_camera.hpp"
+
+using namespace omniloc;
+using namespace omniloc::sim;
+
+namespace {
+CameraConfig quiet() {
+  CameraConfig c;
+  c.vibration_std = 0;
+  c.read_noise = 0;
+  c.shot_noise = 0;
+  return c;
+}
+WorldState one_robot(const Pose2& p) {
+  WorldState w;
+  RobotState r;
+  r.id = 0;
+  r.pose = p;
+  w.robots.push_back(r);
+  w.has_ball = false;
+  return w;
+}
+}  // namespace
+
+class CameraTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { cam_ = new PanoramicCamera(quiet(), Field::preset("msl2012")); }
+  static void TearDownTestSuite() {
+    delete cam_;
+    cam_ = nullptr;
+  }
+  static PanoramicCamera* cam_;
+};
+PanoramicCamera* CameraTest::cam_ = nullptr;
+
+TEST_F(CameraTest, ProjectionRoundTripsThroughTheFloor) {
+  for (double d : {0.5, 1.0, 2.0, 4.0, 6.0, 7.9})
+    for (double b : {0.0, 0.7, 2.0, -2.5}) {
+      const Eigen::Vector3d p(d * std::cos(b), d * std::sin(b), 0.0);
+      const auto px = cam_->project(p);
+      ASSERT_TRUE(px) << d << " " << b;
+      const auto back = cam_->floor_point(px->x(), px->y());
+      ASSERT_TRUE(back);
+      EXPECT_NEAR((*back - p.head<2>()).norm(), 0.0, 1e-3) << "distance " << d;
+    }
+  // Forward is up in the image, left is left.
+  const auto ahead = cam_->project({2.0, 0.0, 0.0});
+  const auto left = cam_->project({0.0, 2.0, 0.0});
+  EXPECT_LT(ahead->y(), cam_->centre().y() - 50);
+  EXPECT_NEAR(ahead->x(), cam_->centre().x(), 1e-6);
+  EXPECT_LT(left->x(), cam_->centre().x() - 50);
+  // The isometric part: image radius linear in floor distance between 1 m and 8 m.
+  const double r2 = (*cam_->project({2.0, 0, 0}) - cam_->centre()).norm();
+  const double r4 = (*cam_->project({4.0, 0, 0}) - cam_->centre()).norm();
+  const double r6 = (*cam_->project({6.0, 0, 0}) - cam_->centre()).norm();
+  EXPECT_NEAR(r6 - r4, r4 - r2, 0.05);
+}
+
+TEST_F(CameraTest, SameStateGivesIdenticalPixels) {
+  const WorldState w = one_robot(Pose2(1.0, -2.0, 0.4));
+  Rng a(5), b(5);
+  const Image i1 = cam_->render(w, 0, {}, a);
+  const Image i2 = cam_->render(w, 0, {}, b);
+  EXPECT_EQ(i1.rgb, i2.rgb);
+}
+
+TEST_F(CameraTest, LinesAreWhiteAndARobotHidesThem) {
+  // Observer at (0, -2) facing +x: the centre line x = 0 runs through the robot's left and right.
+  WorldState w = one_robot(Pose2(-1.0, -2.0, 0.0));
+  const Eigen::Vector3d on_line(1.0, 0.0, 0.0);  // robot frame: 1 m ahead lies on x = 0
+  const auto px = cam_->project(on_line);
+  ASSERT_TRUE(px);
+  Image lab = cam_->render_labels(w, 0);
+  auto label_at = [&](const Image& im, const Eigen::Vector2d& p) { return im.row(static_cast<int>(p.y()))[3 * static_cast<int>(p.x())]; };
+  EXPECT_EQ(label_at(lab, *px), kLabelLine);
+  Rng rng(1);
+  const Image col = cam_->render(w, 0, {}, rng);
+  const std::uint8_t* c = col.row(static_cast<int>(px->y())) + 3 * static_cast<int>(px->x());
+  EXPECT_GT(c[0], 150);  // white
+  // Another robot between camera and line hides it.
+  RobotState other;
+  other.id = 1;
+  other.pose = Pose2(-0.45, -2.0, 0.0);
+  w.robots.push_back(other);
+  lab = cam_->render_labels(w, 0);
+  EXPECT_EQ(label_at(lab, *px), kLabelObstacle);
+}
+
+TEST_F(CameraTest, FarLineStaysContinuous) {
+  // The goal line x = 9 seen from (3, 0) facing +x: 6 m away. Walk along it in the label image.
+  const WorldState w = one_robot(Pose2(3.0, 0.0, 0.0));
+  const Image lab = cam_->render_labels(w, 0);
+  int gaps = 0;
+  for (double y = -5.5; y <= 5.5; y += 0.1) {
+    if (std::fabs(y) < 1.3) continue;  // the goal posts and net stand on the line there
+    const auto px = cam_->project({6.0, y, 0.0});
+    ASSERT_TRUE(px);
+    bool found = false;
+    for (int dv = -2; dv <= 2 && !found; ++dv)
+      for (int du = -2; du <= 2 && !found; ++du)
+        found = lab.row(static_cast<int>(px->y()) + dv)[3 * (static_cast<int>(px->x()) + du)] == kLabelLine;
+    gaps += !found;
+  }
+  EXPECT_EQ(gaps, 0);
+}
+
+TEST_F(CameraTest, ExposureSaturatesAndNoiseGrowsWithGain) {
+  const WorldState w = one_robot(Pose2(0.0, -3.0, 0.0));
+  Rng rng(2);
+  const Image normal = cam_->render(w, 0, {18.0, 18.0}, rng);
+  const Image bright = cam_->render(w, 0, {60.0, 60.0}, rng);
+  std::size_t sat_n = 0, sat_b = 0;
+  for (std::size_t i = 0; i < normal.rgb.size(); ++i) {
+    sat_n += normal.rgb[i] == 255;
+    sat_b += bright.rgb[i] == 255;
+  }
+  EXPECT_LT(sat_n, normal.rgb.size() / 200);  // well exposed: almost nothing clipped
+  EXPECT_GT(sat_b, normal.rgb.size() / 5);    // over-exposed: the carpet's green clips too
+  EXPECT_NEAR(PanoramicCamera::response(0.85, 1.0, {18, 18}), 200.0, 1e-9);
+
+  CameraConfig noisy = quiet();
+  noisy.read_noise = 2.0;
+  noisy.shot_noise = 0.5;
+  PanoramicCamera cam(noisy, Field::preset("msl2012"));
+  auto noise_std = [&](double gain) {
+    Rng r1(3), r2(4);
+    const Image a = cam.render(w, 0, {324.0 / gain, gain}, r1), b = cam.render(w, 0, {324.0 / gain, gain}, r2);
+    double s2 = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) s2 += std::pow(double(a.rgb[i]) - double(b.rgb[i]), 2);
+    return std::sqrt(s2 / a.rgb.size() / 2.0);
+  };
+  const double low = noise_std(6.0), high = noise_std(54.0);  // same brightness, different gain
+  EXPECT_GT(low, 0.5);
+  EXPECT_GT(high, 2.0 * low);
+}
+
+TEST(CameraConfig, BadInputIsNamed) {
+  auto path_of = [](const char* s) {
+    try {
+      CameraConfig::from_json(Json::parse(s), "/camera");
+    } catch (const ConfigError& e) {
+      return e.path();
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_EQ(path_of(R"({"mirror": "parabolic"})"), "/camera/mirror");
+  EXPECT_EQ(path_of(R"({"width": 0})"), "/camera/width");
+  EXPECT_EQ(path_of(R"({"height": -640})"), "/camera/height");
+  EXPECT_EQ(path_of(R"({"exposure": 0})"), "/camera/exposure");
+  EXPECT_EQ(path_of(R"({"exposure": -3})"), "/camera/exposure");
+  EXPECT_EQ(path_of(R"({"backend": "vulkan"})"), "/camera/backend");
+  EXPECT_EQ(path_of(R"({"mirror": "hyperbolic", "quality": "high"})"), "(accepted)");
+  try {
+    make_gl_context("directx");
+    FAIL();
+  } catch (const RuntimeFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("directx"), std::string::npos);
+  }
+}
+
+TEST(CameraBackends, EglSurfacelessRendersTheSameScene) {
+  CameraConfig c = quiet();
+  c.backend = "egl";
+  std::unique_ptr<PanoramicCamera> egl;
+  try {
+    egl = std::make_unique<PanoramicCamera>(c, Field::preset("msl2012"));
+  } catch (const RuntimeFailure& e) {
+    GTEST_SKIP() << "EGL surfaceless unavailable here: " << e.what();
+  }
+  PanoramicCamera osm(quiet(), Field::preset("msl2012"));
+  const WorldState w = one_robot(Pose2(2.0, 1.0, -0.5));
+  const Image a = egl->render_labels(w, 0), b = osm.render_labels(w, 0);
+  std::size_t diff = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) diff += a.rgb[i] != b.rgb[i];
+  EXPECT_LT(diff, a.rgb.size() / 1000);
+}
