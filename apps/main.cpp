@@ -1,5 +1,6 @@
 // omniloc command line: validate, run, list, experiment (and more as capabilities land).
 // Exit codes: 0 success, 1 runtime failure, 2 bad input (scenario, arguments) — nothing written.
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -13,6 +14,8 @@
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
+#include "harness/vision_setup.hpp"
+#include "sim/render/camera_config.hpp"
 #include "sim/motion.hpp"
 
 using namespace omniloc;
@@ -24,8 +27,13 @@ const char* kUsage = R"(usage: omniloc <command> [options]
 commands:
   run FILE [--seed N] [-o DIR] [--frames DIR] [--frames-every N] [--quiet]
                          run a scenario; results in results/runs/<scenario>/<seed>/
-  render FILE --t SECONDS [--robot ID] [--seed N] [--labels] -o frame.png
+  render FILE --t SECONDS [--robot ID] [--seed N] [--labels | --points] -o frame.png
                          the panorama robot ID (default: the first localized) sees at time t
+  calibrate FILE [-o map.json] [--seed N]
+                         model-free mirror calibration with the scenario's camera; prints the
+                         map's error against the true mirror by distance
+  colour-calibrate FILE [-o table.lut] [--seed N]
+                         learn the colour look-up table from labelled renders of the scenario's field
   validate FILE          check a scenario file (exit 2 with the JSON path of the first problem)
   list                   field presets, motion scripts, localizers, noise profiles, experiments
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
@@ -157,7 +165,37 @@ int cmd_render(const Args& a) {
   }
   const int robot = opt(a, "--robot").empty() ? s.localized_robots().front() : std::atoi(opt(a, "--robot").c_str());
   const std::uint64_t seed = opt(a, "--seed").empty() ? s.seed : parse_seed(opt(a, "--seed"));
-  harness::render_to_png(s, t, robot, seed, flag(a, "--labels"), out);
+  harness::render_to_png(s, t, robot, seed, flag(a, "--labels"), out, flag(a, "--points"));
+  std::cout << "wrote " << out << "\n";
+  return 0;
+}
+
+int cmd_calibrate(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("calibrate takes one scenario file");
+  const auto s = harness::load_scenario(a.positional[0]);
+  const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
+  const std::uint64_t seed = opt(a, "--seed").empty() ? 1 : parse_seed(opt(a, "--seed"));
+  Json report;
+  auto r = harness::calibrate_camera(cfg, seed, &report);
+  const std::string out = opt(a, "-o", "results/cache/calibration_" + harness::camera_tag(cfg) + ".json");
+  r.map.save(out);
+  std::printf("directions used %d, rejected %d\n%10s %12s %12s %12s\n", r.directions_used, r.directions_rejected, "distance m", "mean err cm",
+              "p95 err cm", "max err cm");
+  for (const auto& row : report["error_by_distance"])
+    std::printf("%10.1f %12.2f %12.2f %12.2f\n", row["distance_m"].get<double>(), 100 * row["mean_error_m"].get<double>(),
+                100 * row["p95_error_m"].get<double>(), 100 * row["max_error_m"].get<double>());
+  std::cout << "wrote " << out << "\n";
+  return 0;
+}
+
+int cmd_colour_calibrate(const Args& a) {
+  if (a.positional.size() != 1) throw UsageError("colour-calibrate takes one scenario file");
+  const auto s = harness::load_scenario(a.positional[0]);
+  const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
+  const std::uint64_t seed = opt(a, "--seed").empty() ? 1 : parse_seed(opt(a, "--seed"));
+  const ColourTable t = harness::colour_calibrate(cfg, s.field, seed);
+  const std::string out = opt(a, "-o", "results/cache/colour_" + harness::camera_tag(cfg) + "_" + s.field.fingerprint() + ".lut");
+  t.save(out);
   std::cout << "wrote " << out << "\n";
   return 0;
 }
@@ -201,7 +239,9 @@ int main(int argc, char** argv) {
     if (cmd == "validate") return cmd_validate(parse(argc, argv, 2, {}, {}));
     if (cmd == "run") return cmd_run(parse(argc, argv, 2, {"--seed", "-o", "--frames", "--frames-every"}, {"--quiet"}));
     if (cmd == "list") return cmd_list();
-    if (cmd == "render") return cmd_render(parse(argc, argv, 2, {"--t", "--robot", "--seed", "-o"}, {"--labels"}));
+    if (cmd == "calibrate") return cmd_calibrate(parse(argc, argv, 2, {"-o", "--seed"}, {}));
+    if (cmd == "colour-calibrate") return cmd_colour_calibrate(parse(argc, argv, 2, {"-o", "--seed"}, {}));
+    if (cmd == "render") return cmd_render(parse(argc, argv, 2, {"--t", "--robot", "--seed", "-o"}, {"--labels", "--points"}));
     if (cmd == "sweep")
       return cmd_sweep(parse(argc, argv, 2, {"-j", "--shard", "-o", "--stop-after"}, {"--resume", "--aggregate-only"}));
     if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o"}, {"--quick"}));

@@ -1,5 +1,6 @@
 #include "harness/localizer_registry.hpp"
 
+#include "localization/matching.hpp"
 #include "localization/odometry_only.hpp"
 
 namespace omniloc::harness {
@@ -8,6 +9,10 @@ const std::vector<LocalizerInfo>& localizers() {
   static const std::vector<LocalizerInfo> list = {
       {"odometry_only", "dead reckoning from the true start pose (odometry drift baseline)", true, false,
        [](JsonReader&, const LocalizerContext&) { return std::make_unique<OdometryOnlyLocalizer>(); }},
+      {"matching", "matching-optimisation tracking (RPROP on the distance map) fused with odometry by a Kalman filter (paper 002)", true, true,
+       [](JsonReader& r, const LocalizerContext& ctx) {
+         return std::make_unique<MatchingLocalizer>(*ctx.field, MatchingParams::from_json(r), ctx.cache_dir);
+       }},
   };
   return list;
 }

@@ -8,6 +8,8 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "harness/camera_perception.hpp"
+#include "harness/vision_setup.hpp"
 #include "sim/motion.hpp"
 #include "sim/render/panoramic_camera.hpp"
 #include "sim/world.hpp"
@@ -49,7 +51,7 @@ void write_png(const Image& img, const std::string& path) {
   write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
 }
 
-void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed, bool labels, const std::string& png_path) {
+void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed, bool labels, const std::string& png_path, bool points) {
   if (!s.robot(robot_id)) throw ConfigError("--robot", std::to_string(robot_id), "the id of a robot in the scenario");
   if (t < 0 || t > s.duration) throw ConfigError("--t", std::to_string(t), "a time within the scenario's duration");
   const sim::CameraConfig cfg = sim::CameraConfig::from_json(s.camera, "/camera");
@@ -59,6 +61,15 @@ void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed
   Image img = labels ? cam.render_labels(ws, robot_id) : cam.render(ws, robot_id, cfg.initial, rng);
   if (labels)  // spread the class ids over the grey range so the picture is readable
     for (auto& v : img.rgb) v = static_cast<std::uint8_t>(std::min(255, v * 21));
+  if (points && !labels) {
+    const VisionConfig vc = VisionConfig::from_json(s.vision, "/vision");
+    const CalibrationMap map = calibration_for(cfg, vc.calibration, seed);
+    const ColourTable table = colour_table_for(cfg, s.field, vc.colour_table, seed);
+    const LineDetector det(vc.scan, map, table);
+    const ScanResult r = det.detect(img);
+    cv::Mat m(img.height, img.width, CV_8UC3, img.rgb.data());
+    for (const auto& p : r.pixels) cv::circle(m, cv::Point(static_cast<int>(p.x()), static_cast<int>(p.y())), 3, cv::Scalar(255, 0, 0), 1);
+  }
   write_png(img, png_path);
 }
 

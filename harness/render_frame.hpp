@@ -14,7 +14,9 @@ namespace omniloc::harness {
 sim::WorldState world_at(const Scenario& s, double t, std::uint64_t seed);
 
 /// Renders robot `robot_id` at time t (labels: the class image instead of colours). Writes a PNG.
-void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed, bool labels, const std::string& png_path);
+/// `points`: overlay the line points the vision front end finds (red) on the colour image.
+void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed, bool labels, const std::string& png_path,
+                   bool points = false);
 
 /// Writes an RGB image as PNG (atomically).
 void write_png(const Image& img, const std::string& path);

@@ -11,6 +11,7 @@
 #include "harness/localizer_registry.hpp"
 #include "harness/perception.hpp"
 #include "harness/recovery.hpp"
+#include "harness/render_frame.hpp"
 #include "harness/run_directory.hpp"
 #include "sim/motion.hpp"
 #include "sim/sensors.hpp"
@@ -106,7 +107,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
     tr.localizer->reset(info.needs_start_pose ? std::optional<Pose2>(rc.spec.start) : std::nullopt);
     tracked.push_back(std::move(tr));
   }
-  auto perception = make_perception(sc, info.needs_vision);
+  auto perception = make_perception(sc, info.needs_vision || !opt.frames_dir.empty(), seed);
 
   std::string events_log;
   auto log_event = [&](const Json& e) { events_log += e.dump() + "\n"; };
@@ -172,6 +173,11 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
       if (tr.has_heading) heading = tr.heading->read(ws.t, truth.pose.theta).heading;
 
       PerceptionOutput po = perception->observe(ws, tr.id, ws.t, cond);
+      if (!opt.frames_dir.empty() && po.image && k % opt.frames_every == 0) {
+        char name[64];
+        std::snprintf(name, sizeof name, "/r%d_%06lld.png", tr.id, k);
+        write_png(*po.image, opt.frames_dir + name);
+      }
       for (const auto& w : po.warnings) log_event(Json{{"t", ws.t}, {"type", "warning"}, {"robot", tr.id}, {"message", w}});
       if (po.stop_robot != tr.paused) log_event(Json{{"t", ws.t}, {"type", po.stop_robot ? "pause" : "resume"}, {"robot", tr.id}});
       tr.paused = po.stop_robot;

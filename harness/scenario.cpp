@@ -5,7 +5,9 @@
 #include <fstream>
 #include <set>
 
+#include "harness/camera_perception.hpp"
 #include "harness/localizer_registry.hpp"
+#include "sim/render/camera_config.hpp"
 #include "sim/motion.hpp"
 
 namespace omniloc::harness {
@@ -249,6 +251,18 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   if (const Json* cam = r.raw("camera")) {
     if (!cam->is_object()) throw ConfigError("/camera", json_brief(*cam), "an object");
     for (auto it = cam->begin(); it != cam->end(); ++it) s.camera[it.key()] = it.value();
+  }
+  {
+    Json eff;
+    sim::CameraConfig::from_json(s.camera, "/camera", &eff);  // validate now, record the effective values
+    s.effective["camera"] = eff;
+  }
+  const Json* vis = r.raw("vision");
+  s.vision = vis ? *vis : Json::object();
+  {
+    Json eff;
+    VisionConfig::from_json(s.vision, "/vision", &eff);
+    s.effective["vision"] = eff;
   }
   r.finish();
   validate_deep(s);

@@ -69,6 +69,7 @@ struct Scenario {
   std::vector<Eigen::Vector2d> sun_velocity;  ///< m/s per sun patch (sun moving slowly)
   Json localizer;            ///< {"type": ..., params}
   Json camera;               ///< camera configuration (profile defaults merged)
+  Json vision;               ///< vision front-end configuration (calibration, colour table, scan lines)
   Json effective;            ///< every value read, defaults filled in: saved as config.json
 
   const RobotConfig* robot(int id) const;

@@ -1,15 +1,18 @@
 #pragma once
-// The model-free image -> robot-frame ground map of paper 002 (after Voigtlaender et al.): built
-// from calibration images by omniloc calibrate, saved to a file, loaded by the pipeline. The
+// The model-free image -> robot-frame floor map of paper 002 (after Voigtlaender et al.): built
+// from calibration images by `omniloc calibrate`, saved to a file, loaded by the pipeline. The
 // localization side knows the camera only through this map, never through the simulator's mirror.
 //
-// Frames: image pixels (u right, v down, origin top-left corner of the image, pixel centres at
-// integer + 0.5); robot frame (metres, x forward, y left) on the floor plane.
+// Frames: image pixels (u right, v down, pixel centres at integer + 0.5); robot frame (metres,
+// x forward, y left) on the floor. Calibration directions are robot-frame bearings; the image angle
+// of a bearing b is atan2(-sin b, -cos b) (forward up, left left), the camera mounting convention.
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "core/messages.hpp"
 
 namespace omniloc {
 
@@ -19,34 +22,57 @@ class CalibrationMap {
 
   int image_width() const { return width_; }
   int image_height() const { return height_; }
-  /// Image centre (the mirror axis) found by calibration, pixels.
-  Eigen::Vector2d centre() const { return centre_; }
-  /// Largest image radius (pixels) for which the map is defined; beyond it pixels see no floor.
-  double max_radius() const { return max_radius_; }
-  /// Ground distance (metres) for an image radius at a given image angle; nullopt outside the map.
-  std::optional<double> ground_distance(double radius_px, double image_angle) const;
-  /// Robot-frame floor point seen at pixel (u, v); nullopt where the map is undefined.
+  Eigen::Vector2d centre() const { return centre_; }  ///< mirror axis in the image, pixels
+  double min_radius() const { return min_radius_; }   ///< first calibrated radius (inside: robot body), pixels
+  double max_radius() const { return max_radius_; }   ///< last calibrated radius, pixels
+  /// Floor distance (metres) at image radius r along robot bearing b; nullopt outside the map.
+  std::optional<double> ground_distance(double radius_px, double bearing) const;
+  /// Robot-frame floor point seen at pixel (u, v); nullopt outside the map. Uses the dense table.
   std::optional<Eigen::Vector2d> to_robot(double u, double v) const;
-  /// Inverse: image radius (pixels) at which a floor point at `distance` metres and robot-frame
-  /// bearing appears; nullopt beyond the calibrated range. Used to size line-width windows.
+  /// Image radius (pixels) at which a floor point at `distance` metres and `bearing` appears.
   std::optional<double> radius_for_distance(double distance, double bearing) const;
 
-  /// Tables: for each of `directions` image angles (evenly spaced from 0), the increasing image radii
-  /// of the calibration marks and their ground distances (metres). Interpolated by Lagrange
-  /// polynomials along the radius and linearly... see calibration_map.cpp for the exact scheme.
-  void set_tables(int width, int height, Eigen::Vector2d centre, double robot_heading_offset,
-                  std::vector<std::vector<double>> radii_px, std::vector<std::vector<double>> distances_m);
+  /// Tables: for each of the directions (robot bearings evenly spaced from 0, anticlockwise), the
+  /// increasing image radii of the calibration edges and their floor distances (metres). Radial:
+  /// 4-point Lagrange interpolation in each direction; rotary: 4-point Lagrange across directions.
+  void set_tables(int width, int height, Eigen::Vector2d centre, std::vector<std::vector<double>> radii_px,
+                  std::vector<std::vector<double>> distances_m);
+  /// Fingerprint of the camera/scene it was made for (checked on load when given).
+  std::string tag;
 
-  /// Text/JSON file round trip. load() throws omniloc::ConfigError naming the file on a bad or missing file.
   void save(const std::string& path) const;
-  static CalibrationMap load(const std::string& path);
+  /// Throws ConfigError naming the file on a missing or malformed file, or (when `expected_tag` is
+  /// not empty) a map made for another camera, or of another image size.
+  static CalibrationMap load(const std::string& path, const std::string& expected_tag = "", int width = 0, int height = 0);
 
  private:
+  double radial(std::size_t dir, double r) const;
+  void build_lut();
   int width_ = 0, height_ = 0;
   Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
-  double heading_offset_ = 0.0;  ///< image angle of the robot's forward axis, radians
-  double max_radius_ = 0.0;
+  double min_radius_ = 0.0, max_radius_ = 0.0;
   std::vector<std::vector<double>> radii_, distances_;
+  std::vector<float> lut_;  // x, y per pixel; NaN outside
 };
+
+/// One calibration image: the patch lies along robot bearing `bearing` (radians).
+struct CalibrationView {
+  Image image;
+  double bearing = 0.0;
+};
+
+struct CalibrationResult {
+  CalibrationMap map;
+  int directions_used = 0;
+  int directions_rejected = 0;
+};
+
+/// Finds the patch edges (cv::Canny on the grey image, refined to the grey-profile gradient peak
+/// along the ray) in each view and builds the map. `edge_distances`: the patch's known edge
+/// distances (core/calibration_patch.hpp); `centre`: the mirror axis (the image centre for a
+/// centred camera); `body_radius`: pixels to skip around the centre. Throws RuntimeFailure when
+/// fewer than 8 directions give all edges.
+CalibrationResult calibrate_from_images(const std::vector<CalibrationView>& views, const std::vector<double>& edge_distances,
+                                        const Eigen::Vector2d& centre, double body_radius);
 
 }  // namespace omniloc

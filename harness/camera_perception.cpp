@@ -1,0 +1,59 @@
+#include "harness/camera_perception.hpp"
+
+#include <chrono>
+
+#include "harness/vision_setup.hpp"
+
+namespace omniloc::harness {
+
+VisionConfig VisionConfig::from_json(const Json& j, const std::string& path, Json* effective) {
+  JsonReader r(j, path, effective);
+  r.allow("comment");
+  VisionConfig v;
+  v.calibration = r.string("calibration", std::string("auto"));
+  v.colour_table = r.string("colour_table", std::string("auto"));
+  if (auto s = r.object("scan_lines")) {
+    v.scan = ScanLineParams::from_json(*s);
+    s->finish();
+  }
+  r.finish();
+  return v;
+}
+
+CameraPerception::CameraPerception(const Scenario& s, std::uint64_t seed) : seed_(seed) {
+  const sim::CameraConfig cfg = sim::CameraConfig::from_json(s.camera, "/camera");
+  const VisionConfig vc = VisionConfig::from_json(s.vision, "/vision");
+  camera_ = std::make_unique<sim::PanoramicCamera>(cfg, s.field);
+  map_ = calibration_for(cfg, vc.calibration, seed);
+  table_ = colour_table_for(cfg, s.field, vc.colour_table, seed);
+  detector_ = std::make_unique<LineDetector>(vc.scan, map_, table_);
+}
+
+PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) {
+  using Clock = std::chrono::steady_clock;
+  PerceptionOutput out;
+  auto it = rngs_.find(robot_id);
+  if (it == rngs_.end()) it = rngs_.emplace(robot_id, Rng::stream(seed_, "camera/" + std::to_string(robot_id))).first;
+  auto st = settings_.find(robot_id);
+  if (st == settings_.end()) st = settings_.emplace(robot_id, camera_->config().initial).first;
+  out.settings = st->second;
+  const auto t0 = Clock::now();
+  auto img = std::make_shared<Image>();
+  if (cond.covered) {
+    img->width = camera_->config().width;
+    img->height = camera_->config().height;
+    img->rgb.assign(static_cast<std::size_t>(img->width) * img->height * 3, 0);
+  } else {
+    *img = camera_->render(world, robot_id, st->second, it->second);
+    sim::paint_sectors(*img, camera_->centre(), cond.occlusion);
+  }
+  const auto t1 = Clock::now();
+  out.obs = detector_->observe(*img, t);
+  const auto t2 = Clock::now();
+  out.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  out.vision_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  out.image = img;
+  return out;
+}
+
+}  // namespace omniloc::harness

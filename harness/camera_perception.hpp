@@ -1,0 +1,41 @@
+#pragma once
+// The full robot-side path for one camera frame: the simulated camera renders the panorama (sim),
+// scripted occlusion is painted into it, and the vision front end (colour table, radial scan lines,
+// calibration map: localization/vision) turns pixels into robot-frame line points.
+#include <map>
+#include <memory>
+
+#include "harness/perception.hpp"
+#include "localization/vision/calibration_map.hpp"
+#include "localization/vision/colour_table.hpp"
+#include "localization/vision/scan_lines.hpp"
+#include "sim/render/panoramic_camera.hpp"
+
+namespace omniloc::harness {
+
+/// Scenario key "vision": where the calibration map and colour table come from, scan-line parameters.
+struct VisionConfig {
+  std::string calibration = "auto";   ///< a map file, or "auto" (cached calibration run)
+  std::string colour_table = "auto";  ///< a table file, or "auto"
+  ScanLineParams scan;
+  static VisionConfig from_json(const Json& j, const std::string& path, Json* effective = nullptr);
+};
+
+class CameraPerception : public Perception {
+ public:
+  CameraPerception(const Scenario& s, std::uint64_t seed);
+  PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) override;
+  const sim::PanoramicCamera& camera() const { return *camera_; }
+  const LineDetector& detector() const { return *detector_; }
+
+ private:
+  std::unique_ptr<sim::PanoramicCamera> camera_;
+  CalibrationMap map_;
+  ColourTable table_;
+  std::unique_ptr<LineDetector> detector_;
+  std::uint64_t seed_;
+  std::map<int, Rng> rngs_;
+  std::map<int, CameraSettings> settings_;
+};
+
+}  // namespace omniloc::harness

@@ -1,0 +1,156 @@
+#include "harness/vision_setup.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "core/angles.hpp"
+#include "core/calibration_patch.hpp"
+#include "core/error.hpp"
+#include "core/rng.hpp"
+#include "harness/metrics.hpp"
+#include "sim/render/panoramic_camera.hpp"
+
+namespace omniloc::harness {
+
+namespace {
+std::string fnv_hex(const std::string& s) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (char c : s) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 0x100000001b3ULL;
+  }
+  std::ostringstream os;
+  os << std::hex << h;
+  return os.str();
+}
+const char* kCache = "results/cache";
+}  // namespace
+
+std::string camera_tag(const sim::CameraConfig& cfg) {
+  Json j = cfg.to_json();
+  j.erase("backend");  // the same optics whichever GL back-end draws them
+  j.erase("quality");
+  return "cam-" + fnv_hex(j.dump());
+}
+
+CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t seed, Json* report) {
+  // An empty floor large enough for the 8 m patch; the robot stands at the origin and turns.
+  const Field floor = Field::from_json(Json{{"type", "plain"}, {"length", 22.0}, {"width", 14.0}, {"margin", 1.0}, {"wall_height", 0.0}}, "/calibration");
+  // The robot turns slowly on the spot while calibrating, so the camera does not vibrate; pixel
+  // noise stays.
+  sim::CameraConfig still = cfg;
+  still.vibration_std = 0.0;
+  sim::PanoramicCamera cam(still, floor);
+  sim::WorldState w;
+  w.has_ball = false;
+  sim::RobotState me;
+  me.id = 0;
+  w.robots.push_back(me);
+  const auto& edges = calibration_patch::kEdgeDistances;
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
+    sim::FloorPatch p;
+    p.centre = {0.5 * (edges[i] + edges[i + 1]), 0.0};
+    p.half_size = {0.5 * (edges[i + 1] - edges[i]), 0.5 * calibration_patch::kStripWidth};
+    p.reflectance = calibration_patch::stripe_is_white(static_cast<int>(i)) ? Eigen::Vector3d(0.85, 0.85, 0.85) : Eigen::Vector3d(0.03, 0.03, 0.03);
+    w.floor_patches.push_back(p);
+  }
+  Rng rng = Rng::stream(seed, "calibration");
+  std::vector<CalibrationView> views;
+  for (int k = 0; k < calibration_patch::kDirections; ++k) {
+    const double bearing = kTwoPi * k / calibration_patch::kDirections;
+    w.robots[0].pose = Pose2(0, 0, -bearing);  // the patch along world +x appears at this robot bearing
+    views.push_back({cam.render(w, 0, cfg.initial, rng), bearing});
+  }
+  // Model-free: the mirror axis is taken as the image centre (a camera mounted on axis); a mounting
+  // offset shows up as calibration error.
+  const Eigen::Vector2d centre(0.5 * cfg.width, 0.5 * cfg.height);
+  CalibrationResult res = calibrate_from_images(views, std::vector<double>(edges.begin(), edges.end()), centre, cam.body_radius_px() + 1.0);
+  res.map.tag = camera_tag(cfg);
+  if (report) {
+    // Error against the true mirror: project floor points at known distances, map them back.
+    Json rows = Json::array();
+    for (double d : {0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0}) {
+      std::vector<double> errs;
+      for (int k = 0; k < 72; ++k) {
+        const double b = kTwoPi * k / 72 + 0.01;
+        const auto px = cam.project({d * std::cos(b), d * std::sin(b), 0.0});
+        if (!px) continue;
+        const auto back = res.map.to_robot(px->x(), px->y());
+        if (back) errs.push_back((*back - Eigen::Vector2d(d * std::cos(b), d * std::sin(b))).norm());
+      }
+      double mean = 0, mx = 0;
+      for (double e : errs) {
+        mean += e / errs.size();
+        mx = std::max(mx, e);
+      }
+      rows.push_back({{"distance_m", d}, {"mean_error_m", mean}, {"p95_error_m", percentile(errs, 95)}, {"max_error_m", mx}, {"samples", errs.size()}});
+    }
+    *report = {{"directions_used", res.directions_used}, {"directions_rejected", res.directions_rejected}, {"error_by_distance", rows}};
+  }
+  return res;
+}
+
+ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, std::uint64_t seed, int frames) {
+  sim::PanoramicCamera cam(cfg, field);
+  Rng rng = Rng::stream(seed, "colour-calibration");
+  std::vector<Image> images, labels;
+  const double hx = 0.5 * field.length - 0.5, hy = 0.5 * field.width - 0.5;
+  for (int f = 0; f < frames; ++f) {
+    sim::WorldState w;
+    sim::RobotState me;
+    me.id = 0;
+    me.pose = Pose2(rng.uniform(-hx, hx), rng.uniform(-hy, hy), rng.uniform(-kPi, kPi));
+    w.robots.push_back(me);
+    for (int i = 1; i <= 3; ++i) {  // robots and the ball within a few metres, so their colours are seen up close
+      sim::RobotState r;
+      r.id = i;
+      const double a = rng.uniform(0, kTwoPi), d = rng.uniform(1.0, 4.0);
+      r.pose = Pose2(me.pose.x + d * std::cos(a), me.pose.y + d * std::sin(a), 0);
+      w.robots.push_back(r);
+    }
+    const double a = rng.uniform(0, kTwoPi), d = rng.uniform(0.6, 3.0);
+    w.ball.position = me.pose.translation() + d * Eigen::Vector2d(std::cos(a), std::sin(a));
+    images.push_back(cam.render(w, 0, cfg.initial, rng));
+    labels.push_back(cam.render_labels(w, 0));
+  }
+  ColourTable t;
+  t.learn(images, labels);
+  t.field = field.fingerprint();
+  return t;
+}
+
+CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed) {
+  const std::string tag = camera_tag(cfg);
+  if (path != "auto") return CalibrationMap::load(path, tag, cfg.width, cfg.height);
+  const std::string file = std::string(kCache) + "/calibration_" + tag + ".json";
+  if (std::filesystem::exists(file)) {
+    try {
+      return CalibrationMap::load(file, tag, cfg.width, cfg.height);
+    } catch (const ConfigError&) {
+      // A damaged cache entry is rebuilt below.
+    }
+  }
+  // The cached map must not depend on which run made it first: a fixed seed, not the run's.
+  (void)seed;
+  CalibrationResult r = calibrate_camera(cfg, 1);
+  r.map.save(file);
+  return r.map;
+}
+
+ColourTable colour_table_for(const sim::CameraConfig& cfg, const Field& field, const std::string& path, std::uint64_t seed) {
+  if (path != "auto") return ColourTable::load(path, field.fingerprint());
+  const std::string file = std::string(kCache) + "/colour_" + camera_tag(cfg) + "_" + field.fingerprint() + ".lut";
+  if (std::filesystem::exists(file)) {
+    try {
+      return ColourTable::load(file, field.fingerprint());
+    } catch (const ConfigError&) {
+    }
+  }
+  (void)seed;
+  ColourTable t = colour_calibrate(cfg, field, 1);
+  t.save(file);
+  return t;
+}
+
+}  // namespace omniloc::harness

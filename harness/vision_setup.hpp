@@ -1,0 +1,33 @@
+#pragma once
+// Off-line vision set-up, as a team does it before a match: the model-free mirror calibration
+// (`omniloc calibrate`) and the colour table (`omniloc colour-calibrate`), both produced by rendering
+// with the simulated camera and processing the images with the robot-side code. Results are cached in
+// results/cache/ under a hash of the camera configuration (and field), so runs share them.
+#include <cstdint>
+#include <string>
+
+#include "core/field.hpp"
+#include "localization/vision/calibration_map.hpp"
+#include "localization/vision/colour_table.hpp"
+#include "sim/render/camera_config.hpp"
+
+namespace omniloc::harness {
+
+/// Renders the calibration patch in 36 directions while the robot turns on an empty floor, finds
+/// the edges and builds the map. `report`: optional, gets the map's error against the true mirror by
+/// distance (a JSON object) for the docs.
+CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t seed, Json* report = nullptr);
+
+/// Renders labelled frames of the field under normal light (observer at seeded random poses with
+/// robots and the ball around it) and learns the table.
+ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, std::uint64_t seed, int frames = 12);
+
+/// Tag identifying a camera configuration (what a calibration map was made for).
+std::string camera_tag(const sim::CameraConfig& cfg);
+
+/// The map for `cfg`: from `path` when given ("auto" = cached, calibrating when missing).
+CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed);
+/// The colour table for `cfg` and `field`: from `path` when given ("auto" = cached or learned).
+ColourTable colour_table_for(const sim::CameraConfig& cfg, const Field& field, const std::string& path, std::uint64_t seed);
+
+}  // namespace omniloc::harness

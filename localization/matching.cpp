@@ -1,0 +1,176 @@
+#include "localization/matching.hpp"
+
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace omniloc {
+
+MatchingParams MatchingParams::from_json(JsonReader& r) {
+  MatchingParams p;
+  p.c = r.positive("c", p.c, 5.0);
+  p.step_xy = r.positive("step_xy", p.step_xy, 2.0);
+  p.step_theta = r.positive("step_theta", p.step_theta, 1.0);
+  p.grow = r.number("grow", p.grow, 1.0, 3.0);
+  p.shrink = r.number("shrink", p.shrink, 0.05, 1.0);
+  p.iterations = static_cast<int>(r.integer("iterations", p.iterations, 1, 1000));
+  p.iterations_few = static_cast<int>(r.integer("iterations_few", p.iterations_few, 1, 1000));
+  p.many_points = static_cast<int>(r.integer("many_points", p.many_points, 0, 10000));
+  p.min_points = static_cast<int>(r.integer("min_points", p.min_points, 1, 10000));
+  p.max_points = static_cast<int>(r.integer("max_points", p.max_points, 3, 100000));
+  p.heading_prior = r.number("heading_prior", p.heading_prior, 0.0, 1000.0);
+  p.point_sigma = r.positive("point_sigma", p.point_sigma, 2.0);
+  p.cell = r.number("cell", p.cell, 0.005, 0.5);
+  p.odo_trans_frac = r.number("odo_trans_frac", p.odo_trans_frac, 0.0, 2.0);
+  p.odo_rot_frac = r.number("odo_rot_frac", p.odo_rot_frac, 0.0, 2.0);
+  p.odo_rot_per_m = r.number("odo_rot_per_m", p.odo_rot_per_m, 0.0, 2.0);
+  p.odo_floor_xy = r.number("odo_floor_xy", p.odo_floor_xy, 0.0, 1.0);
+  p.odo_floor_theta = r.number("odo_floor_theta", p.odo_floor_theta, 0.0, 1.0);
+  return p;
+}
+
+std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& pts, int n) {
+  if (static_cast<int>(pts.size()) <= n) return pts;
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(n);
+  for (int i = 0; i < n; ++i) out.push_back(pts[static_cast<std::size_t>(i) * pts.size() / n]);
+  return out;
+}
+
+namespace {
+
+// Data term and its gradient over (x, y, theta).
+double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
+  const double cs = std::cos(q.z()), sn = std::sin(q.z()), c2 = c * c;
+  double e = 0;
+  if (grad) grad->setZero();
+  for (const auto& o : pts) {
+    const Eigen::Vector2d w(q.x() + cs * o.x() - sn * o.y(), q.y() + sn * o.x() + cs * o.y());
+    Eigen::Vector2d g;
+    const double d = map.distance(w, grad ? &g : nullptr);
+    const double den = c2 + d * d;
+    e += 1.0 - c2 / den;
+    if (grad) {
+      const double de = 2.0 * c2 * d / (den * den);
+      const Eigen::Vector2d dw_dth(-sn * o.x() - cs * o.y(), cs * o.x() - sn * o.y());
+      (*grad) += de * Eigen::Vector3d(g.x(), g.y(), g.dot(dw_dth));
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& pose, double c) {
+  if (pts.empty()) return 1.0;
+  return data_term(map, pts, {pose.x, pose.y, pose.theta}, c, nullptr) / pts.size();
+}
+
+MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& start, const MatchingParams& p,
+                        int iterations, std::optional<double> prior_theta) {
+  Eigen::Vector3d q(start.x, start.y, start.theta);
+  Eigen::Vector3d step(p.step_xy, p.step_xy, p.step_theta), prev = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d max_step(1.0, 1.0, 0.5), min_step(1e-6, 1e-6, 1e-6);
+  MatchResult r;
+  r.points = static_cast<int>(pts.size());
+  for (int it = 0; it < iterations; ++it) {
+    Eigen::Vector3d g;
+    data_term(map, pts, q, p.c, &g);
+    if (prior_theta && p.heading_prior > 0) g.z() += 2.0 * p.heading_prior * angle_diff(q.z(), *prior_theta);
+    for (int k = 0; k < 3; ++k) {
+      // iRPROP-: on a sign change shrink the step and skip this update.
+      if (g[k] * prev[k] > 0) step[k] = std::min(step[k] * p.grow, max_step[k]);
+      else if (g[k] * prev[k] < 0) {
+        step[k] = std::max(step[k] * p.shrink, min_step[k]);
+        g[k] = 0;
+      }
+      if (g[k] > 0) q[k] -= step[k];
+      else if (g[k] < 0) q[k] += step[k];
+      prev[k] = g[k];
+    }
+    ++r.iterations;
+    if (step.head<2>().maxCoeff() < 1e-4 && step.z() < 1e-4) break;
+  }
+  r.pose = Pose2(q.x(), q.y(), q.z());
+  r.error = pts.empty() ? 1.0 : data_term(map, pts, q, p.c, nullptr) / pts.size();
+  // Curvature of the data term by central differences of its gradient. Near the optimum
+  // e(d) ~ d^2 / c^2, so the Gauss-Newton information of points with noise sigma is H c^2 / (2 sigma^2).
+  Eigen::Matrix3d H;
+  const Eigen::Vector3d h(0.01, 0.01, 0.005);
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d qp = q, qm = q, gp, gm;
+    qp[k] += h[k];
+    qm[k] -= h[k];
+    data_term(map, pts, qp, p.c, &gp);
+    data_term(map, pts, qm, p.c, &gm);
+    H.col(k) = (gp - gm) / (2 * h[k]);
+  }
+  H = 0.5 * (H + H.transpose()).eval();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H * (p.c * p.c / (2 * p.point_sigma * p.point_sigma)));
+  Eigen::Vector3d ev = es.eigenvalues();
+  // A flat direction (all points on one line) gets a large variance instead of an infinite one.
+  for (int k = 0; k < 3; ++k) ev[k] = 1.0 / std::max(ev[k], 1.0);
+  r.covariance = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+  return r;
+}
+
+void PoseKalman::predict(const Pose2& d, const MatchingParams& p) {
+  const double th = x_.theta, c = std::cos(th), s = std::sin(th);
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 2) = -s * d.x - c * d.y;
+  F(1, 2) = c * d.x - s * d.y;
+  const double dist = std::hypot(d.x, d.y);
+  const double sxy = p.odo_trans_frac * dist + p.odo_floor_xy;
+  const double sth = p.odo_rot_frac * std::fabs(d.theta) + p.odo_rot_per_m * dist + p.odo_floor_theta;
+  Eigen::Matrix3d Q = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
+  x_ = x_.compose(d);
+  P_ = F * P_ * F.transpose() + Q;
+}
+
+void PoseKalman::update(const Pose2& z, const Eigen::Matrix3d& R) {
+  const Eigen::Matrix3d S = P_ + R;
+  const Eigen::Matrix3d K = P_ * S.inverse();
+  const Eigen::Vector3d innov(z.x - x_.x, z.y - x_.y, angle_diff(z.theta, x_.theta));
+  const Eigen::Vector3d dx = K * innov;
+  x_ = Pose2(x_.x + dx.x(), x_.y + dx.y(), x_.theta + dx.z());
+  P_ = (Eigen::Matrix3d::Identity() - K) * P_;
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+}
+
+MatchingLocalizer::MatchingLocalizer(const Field& field, const MatchingParams& p, const std::string& cache_dir)
+    : p_(p), map_(field, p.cell, cache_dir) {}
+
+void MatchingLocalizer::reset(const std::optional<Pose2>& start) {
+  started_ = start.has_value();
+  kf_.reset(start.value_or(Pose2()), Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.02 * 0.02).asDiagonal());
+}
+
+Estimate MatchingLocalizer::track(const Observations& obs, const Odometry& odometry) {
+  kf_.predict(odometry.delta, p_);
+  Estimate e;
+  const std::vector<Eigen::Vector2d> pts = subsample(obs.line_points, p_.max_points);
+  e.extra["points"] = static_cast<double>(pts.size());
+  if (!obs.camera_ok || static_cast<int>(pts.size()) < p_.min_points) {
+    e.mode = "coasting";  // no usable vision: odometry only, no jump
+    e.pose = kf_.pose();
+    e.covariance = kf_.covariance();
+    e.valid = started_;
+    e.match_error = 1.0;  // the worst possible mean error: nothing matched
+    return e;
+  }
+  const int iters = static_cast<int>(pts.size()) > p_.many_points ? p_.iterations : p_.iterations_few;
+  const MatchResult m = rprop_match(map_, pts, kf_.pose(), p_, iters, kf_.pose().theta);
+  kf_.update(m.pose, m.covariance);
+  e.pose = kf_.pose();
+  e.covariance = kf_.covariance();
+  e.valid = started_;
+  e.mode = "tracking";
+  e.match_error = m.error;
+  e.extra["iterations"] = m.iterations;
+  e.extra["match_sd_xy"] = std::sqrt(0.5 * (m.covariance(0, 0) + m.covariance(1, 1)));
+  return e;
+}
+
+Estimate MatchingLocalizer::update(const Observations& obs, const Odometry& odometry, std::optional<double>) { return track(obs, odometry); }
+
+}  // namespace omniloc

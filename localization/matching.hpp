@@ -1,0 +1,92 @@
+#pragma once
+// Matching-optimisation tracking (paper 002; Lauer, Lange, Riedmiller 2005 "Calculating the perfect
+// match"): minimise sum_i e(d(o_i)) with e(t) = 1 - c^2 / (c^2 + t^2) over the pose by RPROP, take the
+// uncertainty from the error's second derivatives, and fuse with odometry in a Kalman filter.
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/json_reader.hpp"
+#include "localization/field_map.hpp"
+#include "localization/localizer.hpp"
+
+namespace omniloc {
+
+struct MatchingParams {
+  double c = 0.25;               ///< m, error scale (Tribots: c = 250 mm)
+  double step_xy = 0.04;         ///< m, RPROP initial step (Tribots: 40 mm)
+  double step_theta = 0.1;       ///< rad, RPROP initial step (Tribots: 0.1)
+  double grow = 1.2, shrink = 0.5;  ///< RPROP step factors (Tribots)
+  int iterations = 10;           ///< with more than `many_points` points (Tribots: 10) ...
+  int iterations_few = 20;       ///< ... else (Tribots: 20)
+  int many_points = 20;
+  int min_points = 10;           ///< fewer: no match, coast on odometry (NuBot needs > 15, CAMBADA > 5)
+  int max_points = 200;          ///< evenly subsampled beyond this
+  double heading_prior = 2.5;    ///< weight of (theta - predicted theta)^2 (Tribots: 2.5)
+  double point_sigma = 0.05;     ///< m, line-point noise used to turn curvature into covariance
+  double cell = 0.05;            ///< m, distance-map cell (Tribots: 50 mm)
+  // Odometry process noise of the Kalman filter (per frame): std = fraction * motion + floor.
+  double odo_trans_frac = 0.05;  ///< of the distance travelled
+  double odo_rot_frac = 0.05;    ///< of the angle turned
+  double odo_rot_per_m = 0.02;   ///< rad per metre travelled
+  double odo_floor_xy = 0.002;   ///< m
+  double odo_floor_theta = 0.002;  ///< rad
+  static MatchingParams from_json(JsonReader& r);
+};
+
+struct MatchResult {
+  Pose2 pose;
+  double error = 0.0;  ///< mean e(d) over the points, in [0, 1)
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  int iterations = 0;
+  int points = 0;
+};
+
+/// Mean error of the points (robot frame) at `pose`.
+double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& pose, double c);
+
+/// RPROP from `start`. `prior_theta`: optional heading the heading_prior term pulls towards.
+MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& start, const MatchingParams& p,
+                        int iterations, std::optional<double> prior_theta = std::nullopt);
+
+/// (x, y, theta) Kalman filter: odometry prediction, pose measurement update.
+class PoseKalman {
+ public:
+  void reset(const Pose2& pose, const Eigen::Matrix3d& cov) {
+    x_ = pose;
+    P_ = cov;
+  }
+  void predict(const Pose2& delta, const MatchingParams& p);
+  void update(const Pose2& z, const Eigen::Matrix3d& R);
+  const Pose2& pose() const { return x_; }
+  const Eigen::Matrix3d& covariance() const { return P_; }
+
+ private:
+  Pose2 x_;
+  Eigen::Matrix3d P_ = Eigen::Matrix3d::Identity();
+};
+
+/// Localizer "matching": tracking from a given start pose.
+class MatchingLocalizer : public Localizer {
+ public:
+  MatchingLocalizer(const Field& field, const MatchingParams& p, const std::string& cache_dir);
+  std::string type() const override { return "matching"; }
+  void reset(const std::optional<Pose2>& start) override;
+  Estimate update(const Observations& obs, const Odometry& odometry, std::optional<double> heading) override;
+  /// Tracking step usable by other localizers (hybrid, grid_global).
+  Estimate track(const Observations& obs, const Odometry& odometry);
+  const FieldMap& map() const { return map_; }
+  PoseKalman& filter() { return kf_; }
+
+ private:
+  MatchingParams p_;
+  FieldMap map_;
+  PoseKalman kf_;
+  bool started_ = false;
+};
+
+/// Evenly subsamples to at most n points (deterministic).
+std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& pts, int n);
+
+}  // namespace omniloc

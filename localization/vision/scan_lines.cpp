@@ -1,0 +1,104 @@
+#include "localization/vision/scan_lines.hpp"
+
+#include <cmath>
+
+#include "core/angles.hpp"
+
+namespace omniloc {
+
+ScanLineParams ScanLineParams::from_json(JsonReader& r) {
+  ScanLineParams p;
+  p.rays = static_cast<int>(r.integer("rays", 72, 4, 720));
+  p.max_distance = r.positive("max_distance", 7.5, 20.0);
+  p.line_width = r.positive("line_width", 0.125, 1.0);
+  p.width_factor = r.number("width_factor", 3.0, 1.0, 20.0);
+  p.width_slack_px = r.number("width_slack_px", 2.0, 0.0, 20.0);
+  p.max_gap = static_cast<int>(r.integer("max_gap", 2, 0, 10));
+  p.dark_mean = r.number("dark_mean", 15.0, 0.0, 255.0);
+  return p;
+}
+
+LineDetector::LineDetector(const ScanLineParams& p, const CalibrationMap& map, const ColourTable& table) : p_(p), map_(map), table_(table) {
+  const Eigen::Vector2d c = map.centre();
+  for (int k = 0; k < p.rays; ++k) {
+    const double b = kTwoPi * k / p.rays;
+    const Eigen::Vector2d dir(-std::sin(b), -std::cos(b));
+    std::vector<Sample> ray;
+    int last_u = -1, last_v = -1;
+    for (double r = map.min_radius() + 1.0; r <= map.max_radius(); r += 0.5) {
+      const auto d = map.ground_distance(r, b);
+      if (!d) continue;
+      if (*d > p.max_distance) break;
+      const Eigen::Vector2d px = c + r * dir;
+      const int u = static_cast<int>(px.x()), v = static_cast<int>(px.y());
+      if (u == last_u && v == last_v) continue;
+      if (u < 0 || v < 0 || u >= map.image_width() || v >= map.image_height()) break;
+      last_u = u;
+      last_v = v;
+      const auto d1 = map.ground_distance(r + 0.5, b), d0 = map.ground_distance(r - 0.5, b);
+      const double m_per_px = (d1 && d0) ? std::max(1e-4, *d1 - *d0) : 0.01;
+      ray.push_back({u, v, r, p.line_width / m_per_px});
+    }
+    rays_.push_back(std::move(ray));
+  }
+}
+
+ScanResult LineDetector::detect(const Image& img) const {
+  ScanResult res;
+  double grey_sum = 0;
+  std::size_t grey_n = 0;
+  for (const auto& ray : rays_) {
+    int green_end = -1000;  // index of the last green sample
+    int white_start = -1;
+    for (int i = 0; i < static_cast<int>(ray.size()); ++i) {
+      const Sample& s = ray[i];
+      const std::uint8_t* px = img.row(s.v) + 3 * s.u;
+      grey_sum += px[0] + px[1] + px[2];
+      grey_n += 3;
+      const std::uint8_t c = table_.classify(px);
+      if (c == kObstacleBlack) {
+        ++res.rays_blocked;
+        break;
+      }
+      if (c == kFieldGreen) {
+        if (white_start >= 0) {
+          // End of a white run followed by green (within the allowed gap): a candidate line point.
+          int white_end = i - 1;
+          while (white_end > white_start && table_.classify(img.row(ray[white_end].v) + 3 * ray[white_end].u) != kLineWhite) --white_end;
+          if (i - white_end - 1 <= p_.max_gap) {
+            const double len = ray[white_end].r - ray[white_start].r + 0.5;
+            const Sample& mid = ray[(white_start + white_end) / 2];
+            if (len <= p_.width_factor * mid.expected_px + p_.width_slack_px) {
+              const double rmid = 0.5 * (ray[white_start].r + ray[white_end].r);
+              const Eigen::Vector2d dir = (Eigen::Vector2d(mid.u + 0.5, mid.v + 0.5) - map_.centre()).normalized();
+              const Eigen::Vector2d pix = map_.centre() + rmid * dir;
+              if (auto p = map_.to_robot(pix.x(), pix.y())) {
+                res.points.push_back(*p);
+                res.pixels.push_back(pix);
+              }
+            }
+          }
+          white_start = -1;
+        }
+        green_end = i;
+      } else if (c == kLineWhite) {
+        if (white_start < 0 && i - green_end - 1 <= p_.max_gap) white_start = i;
+      } else if (white_start < 0 && i - green_end > p_.max_gap + 1) {
+        green_end = -1000;  // a long stretch of something else: no transition from green
+      }
+    }
+  }
+  res.mean_grey = grey_n ? grey_sum / grey_n : 0.0;
+  return res;
+}
+
+Observations LineDetector::observe(const Image& img, double t) const {
+  Observations o;
+  o.t = t;
+  const ScanResult r = detect(img);
+  o.camera_ok = r.mean_grey >= p_.dark_mean;
+  if (o.camera_ok) o.line_points = r.points;
+  return o;
+}
+
+}  // namespace omniloc
