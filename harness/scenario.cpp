@@ -37,7 +37,7 @@ NoiseProfile NoiseProfile::named(const std::string& name, const std::string& pat
   NoiseProfile p;
   p.name = name;
   if (name == "ideal") {
-    p.camera = Json{{"vibration_std", 0.0}, {"read_noise", 0.0}, {"shot_noise", 0.0}};
+    p.camera = Json{{"vibration_deg", 0.0}, {"read_noise", 0.0}, {"shot_noise", 0.0}};
     return p;
   }
   if (name == "robot") {

@@ -9,6 +9,7 @@ namespace omniloc {
 MatchingParams MatchingParams::from_json(JsonReader& r) {
   MatchingParams p;
   p.c = r.positive("c", p.c, 5.0);
+  p.c_start = r.positive("c_start", p.c, 10.0);
   p.step_xy = r.positive("step_xy", p.step_xy, 2.0);
   p.step_theta = r.positive("step_theta", p.step_theta, 1.0);
   p.grow = r.number("grow", p.grow, 1.0, 3.0);
@@ -73,9 +74,15 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
   const Eigen::Vector3d max_step(1.0, 1.0, 0.5), min_step(1e-6, 1e-6, 1e-6);
   MatchResult r;
   r.points = static_cast<int>(pts.size());
+  // Continuation: stages with c = c_start, c_start / 2, ... down to c.
+  int stages = 1;
+  if (p.c_start > p.c) stages = static_cast<int>(std::ceil(std::log2(p.c_start / p.c))) + 1;
+  const int per_stage = std::max(1, iterations / stages);
   for (int it = 0; it < iterations; ++it) {
+    const int stage = std::min(stages - 1, it / per_stage);
+    const double c = stages > 1 ? std::max(p.c, p.c_start * std::pow(0.5, stage)) : p.c;
     Eigen::Vector3d g;
-    data_term(map, pts, q, p.c, &g);
+    data_term(map, pts, q, c, &g);
     if (prior_theta && p.heading_prior > 0) g.z() += 2.0 * p.heading_prior * angle_diff(q.z(), *prior_theta);
     for (int k = 0; k < 3; ++k) {
       // iRPROP-: on a sign change shrink the step and skip this update.
@@ -89,7 +96,7 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
       prev[k] = g[k];
     }
     ++r.iterations;
-    if (step.head<2>().maxCoeff() < 1e-4 && step.z() < 1e-4) break;
+    if (stage == stages - 1 && step.head<2>().maxCoeff() < 1e-4 && step.z() < 1e-4) break;
   }
   r.pose = Pose2(q.x(), q.y(), q.z());
   r.error = pts.empty() ? 1.0 : data_term(map, pts, q, p.c, nullptr) / pts.size();

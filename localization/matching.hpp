@@ -15,6 +15,8 @@ namespace omniloc {
 
 struct MatchingParams {
   double c = 0.25;               ///< m, error scale (Tribots: c = 250 mm)
+  double c_start = 0.25;         ///< m; > c: continuation, c halves from c_start to c over the iterations
+                                 ///< (smooths the error early; for starts far from the pose)
   double step_xy = 0.04;         ///< m, RPROP initial step (Tribots: 40 mm)
   double step_theta = 0.1;       ///< rad, RPROP initial step (Tribots: 0.1)
   double grow = 1.2, shrink = 0.5;  ///< RPROP step factors (Tribots)
