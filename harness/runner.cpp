@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <cstdio>
 #include <map>
 #include <ostream>
@@ -108,6 +109,9 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
     tracked.push_back(std::move(tr));
   }
   auto perception = make_perception(sc, info.needs_vision || !opt.frames_dir.empty(), seed);
+  // Camera latency: the image shows the world as it was `latency` seconds before the frame time.
+  const double latency = sc.camera.value("latency_ms", 0.0) * 1e-3;
+  std::deque<sim::WorldState> history;
 
   std::string events_log;
   auto log_event = [&](const Json& e) { events_log += e.dump() + "\n"; };
@@ -153,6 +157,10 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
         world.command(rc.spec.id, paused ? sim::DriveCommand{} : scripts[rc.spec.id]->command(ws, rc.spec.id, world.time()));
       }
       world.step();
+      if (latency > 0) {
+        history.push_back(world.state());
+        while (history.size() > 1 && history[1].t <= world.time() - latency - 1e-9) history.pop_front();
+      }
       for (auto& tr : tracked) {
         tr.odometry->accumulate(world.wheel_motion(tr.id));
         tr.heading->advance(dt);
@@ -172,7 +180,17 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
       std::optional<double> heading;
       if (tr.has_heading) heading = tr.heading->read(ws.t, truth.pose.theta).heading;
 
-      PerceptionOutput po = perception->observe(ws, tr.id, ws.t, cond);
+      // What the camera saw: the newest state at least `latency` old (lighting as now).
+      const sim::WorldState* seen = &ws;
+      sim::WorldState past;
+      if (latency > 0 && !history.empty() && history.front().t <= ws.t - latency + 1e-9) {
+        past = history.front();
+        for (const auto& h : history)
+          if (h.t <= ws.t - latency + 1e-9) past = h;
+        past.lighting = ws.lighting;
+        seen = &past;
+      }
+      PerceptionOutput po = perception->observe(*seen, tr.id, ws.t, cond);
       if (!opt.frames_dir.empty() && po.image && k % opt.frames_every == 0) {
         char name[64];
         std::snprintf(name, sizeof name, "/r%d_%06lld.png", tr.id, k);

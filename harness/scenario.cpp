@@ -37,7 +37,7 @@ NoiseProfile NoiseProfile::named(const std::string& name, const std::string& pat
   NoiseProfile p;
   p.name = name;
   if (name == "ideal") {
-    p.camera = Json{{"vibration_deg", 0.0}, {"read_noise", 0.0}, {"shot_noise", 0.0}};
+    p.camera = Json{{"vibration_deg", 0.0}, {"read_noise", 0.0}, {"shot_noise", 0.0}, {"latency_ms", 0.0}};
     return p;
   }
   if (name == "robot") {
@@ -46,7 +46,9 @@ NoiseProfile NoiseProfile::named(const std::string& name, const std::string& pat
     // an MTi-class heading: 1 deg white noise, bias random walk 0.1 deg/sqrt(s).
     p.odometry = {0.015, 0.035, 0.01, 0.01};
     p.heading = {deg2rad(1.0), deg2rad(0.1), 0.0, 0.0, 0.0};
-    p.camera = Json::object();  // the camera's own defaults are the robot profile
+    // The camera's own defaults (vibration, pixel noise) plus one frame of latency at 30 Hz: the
+    // image is exposed and transferred before the odometry it is fused with.
+    p.camera = Json{{"latency_ms", 33.0}};
     return p;
   }
   throw ConfigError(path, "\"" + name + "\"", "a noise profile: \"ideal\" or \"robot\"");

@@ -31,6 +31,7 @@ std::string camera_tag(const sim::CameraConfig& cfg) {
   Json j = cfg.to_json();
   j.erase("backend");  // the same optics whichever GL back-end draws them
   j.erase("quality");
+  j.erase("latency_ms");  // latency changes when images arrive, not what the optics map
   return "cam-" + fnv_hex(j.dump());
 }
 

@@ -22,6 +22,7 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
   c.centre_offset_px = {off[0], off[1]};
   c.mirror_tilt = deg2rad(r.number("mirror_tilt_deg", 0.0, -5.0, 5.0));
   c.vibration_std = deg2rad(r.number("vibration_deg", 0.3, 0.0, 5.0));
+  c.latency = 1e-3 * r.number("latency_ms", 0.0, 0.0, 500.0);
   c.read_noise = r.number("read_noise", 1.5, 0.0, 50.0);
   c.shot_noise = r.number("shot_noise", 0.35, 0.0, 10.0);
   c.backend = r.string("backend", std::string("osmesa"), gl_backends());
@@ -45,7 +46,7 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
 Json CameraConfig::to_json() const {
   return Json{{"width", width}, {"height", height}, {"mount_height", mount_height}, {"mirror", mirror}, {"rim_fraction", rim_fraction},
               {"centre_offset_px", {centre_offset_px.x(), centre_offset_px.y()}}, {"mirror_tilt_deg", rad2deg(mirror_tilt)},
-              {"vibration_deg", rad2deg(vibration_std)}, {"read_noise", read_noise}, {"shot_noise", shot_noise}, {"backend", backend},
+              {"vibration_deg", rad2deg(vibration_std)}, {"latency_ms", 1e3 * latency}, {"read_noise", read_noise}, {"shot_noise", shot_noise}, {"backend", backend},
               {"quality", quality}, {"exposure", initial.exposure_ms}, {"gain", initial.gain}, {"exposure_min", exposure_min},
               {"exposure_max", exposure_max}, {"gain_min", gain_min}, {"gain_max", gain_max}};
 }

@@ -17,6 +17,7 @@ struct CameraConfig {
   double rim_fraction = 0.49;           ///< mirror rim radius as a fraction of min(width, height)
   Eigen::Vector2d centre_offset_px{0.0, 0.0};  ///< mirror axis offset from the image centre, pixels
   double mirror_tilt = 0.0;             ///< fixed mirror tilt about the robot's x axis, radians
+  double latency = 0.0;                 ///< seconds between exposure and the odometry it is paired with
   double vibration_std = 0.0052;        ///< per-frame roll/pitch std, radians (0.3 deg: a robot on carpet)
   double read_noise = 1.5;              ///< DN at gain 18
   double shot_noise = 0.35;             ///< DN^(1/2): shot-noise std = shot_noise * sqrt(value * gain / 18)
