@@ -47,7 +47,12 @@ void write_png(const Image& img, const std::string& path) {
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
   std::vector<uchar> buf;
-  if (!cv::imencode(".png", bgr, buf)) throw RuntimeFailure("cannot encode PNG for " + path);
+  // The encoder follows the extension (.png by default; .jpg for small pictures in docs).
+  const auto dot = path.find_last_of('.');
+  std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
+  if (ext != ".jpg" && ext != ".jpeg") ext = ".png";
+  if (!cv::imencode(ext, bgr, buf, ext == ".png" ? std::vector<int>{} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 88}))
+    throw RuntimeFailure("cannot encode " + ext + " for " + path);
   write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
 }
 

@@ -270,6 +270,18 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
     rj["robot"] = tr.id;
     rj["frames_total"] = tr.frames;
     rj["valid_fraction"] = tr.frames ? static_cast<double>(tr.valid) / tr.frames : 0.0;
+    {
+      // Vision statistics: line points per frame and frames without a usable match.
+      double pts = 0;
+      std::size_t coasting = 0, min_pts = tr.rows.empty() ? 0 : SIZE_MAX;
+      for (const auto& r : tr.rows) {
+        pts += static_cast<double>(r.points);
+        min_pts = std::min(min_pts, r.points);
+        coasting += r.mode == "coasting";
+      }
+      rj["line_points"] = {{"mean", tr.rows.empty() ? 0.0 : pts / tr.rows.size()}, {"min", min_pts}};
+      rj["coasting_frames"] = coasting;
+    }
     // Kidnap episodes of this robot: from each kidnap's uncovering to the next kidnap or the end.
     std::vector<Episode> episodes;
     for (const auto& e : sc.events)
