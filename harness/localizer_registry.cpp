@@ -1,6 +1,8 @@
 #include "harness/localizer_registry.hpp"
 
+#include "localization/hybrid.hpp"
 #include "localization/matching.hpp"
+#include "localization/mcl.hpp"
 #include "localization/odometry_only.hpp"
 
 namespace omniloc::harness {
@@ -12,6 +14,14 @@ const std::vector<LocalizerInfo>& localizers() {
       {"matching", "matching-optimisation tracking (RPROP on the distance map) fused with odometry by a Kalman filter (paper 002)", true, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<MatchingLocalizer>(*ctx.field, MatchingParams::from_json(r), ctx.cache_dir);
+       }},
+      {"mcl", "Monte Carlo localization, 600 particles, compass headings, distance-map sensor model (paper 002)", false, true,
+       [](JsonReader& r, const LocalizerContext& ctx) {
+         return std::make_unique<McLLocalizer>(*ctx.field, McLParams::from_json(r), ctx.seed, ctx.cache_dir);
+       }},
+      {"hybrid", "MCL until converged, then matching tracking; wrong-localisation detection restarts MCL (paper 002)", false, true,
+       [](JsonReader& r, const LocalizerContext& ctx) {
+         return std::make_unique<HybridLocalizer>(*ctx.field, HybridParams::from_json(r), ctx.seed, ctx.cache_dir);
        }},
   };
   return list;
