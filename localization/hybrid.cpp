@@ -17,7 +17,8 @@ HybridParams HybridParams::from_json(JsonReader& r) {
   p.deviation_threshold = r.positive("deviation_threshold", p.deviation_threshold, 10.0);
   p.heading_threshold = r.positive("heading_threshold", p.heading_threshold, 3.2);
   p.consecutive = static_cast<int>(r.integer("consecutive", p.consecutive, 1, 1000));
-  p.rule = r.string("rule", p.rule, {"and", "or"});
+  p.heading_only_frames = static_cast<int>(r.integer("heading_only_frames", p.heading_only_frames, 0, 100000));
+  p.deviation_only_frames = static_cast<int>(r.integer("deviation_only_frames", p.deviation_only_frames, 0, 100000));
   return p;
 }
 
@@ -64,13 +65,16 @@ Estimate HybridLocalizer::update(const Observations& obs, const Odometry& odo, s
       dev /= static_cast<double>(pts.size());
       const bool bad_dev = dev > p_.deviation_threshold;
       const bool bad_head = heading && std::fabs(angle_diff(e.pose.theta, *heading)) > p_.heading_threshold;
-      const bool suspicious = p_.rule == "and" ? (bad_dev && bad_head) : (bad_dev || bad_head);
-      suspicious_ = suspicious ? suspicious_ + 1 : 0;
+      suspicious_ = bad_dev && bad_head ? suspicious_ + 1 : 0;
+      bad_heading_ = bad_head ? bad_heading_ + 1 : 0;
+      bad_deviation_ = bad_dev ? bad_deviation_ + 1 : 0;
       e.extra["deviation_m"] = dev;
-      if (suspicious_ >= p_.consecutive) {
+      const bool restart = suspicious_ >= p_.consecutive || (p_.heading_only_frames > 0 && bad_heading_ >= p_.heading_only_frames) ||
+                           (p_.deviation_only_frames > 0 && bad_deviation_ >= p_.deviation_only_frames);
+      if (restart) {
         mcl_.reset(std::nullopt);
         tracking_ = false;
-        suspicious_ = 0;
+        suspicious_ = bad_heading_ = bad_deviation_ = 0;
         ++restarts_;
         e.valid = false;
         e.mode = "restart";

@@ -13,9 +13,12 @@ struct HybridParams {
   MatchingParams matching;
   double deviation_threshold = 0.25;  ///< m, mean point distance to the nearest line
   double heading_threshold = 0.35;    ///< rad, |tracked heading - compass|
-  int consecutive = 5;                ///< paper 002
-  /// "and" (paper 002: both conditions) or "or" (either; catches kidnaps that keep the heading).
-  std::string rule = "and";
+  int consecutive = 5;                ///< paper 002: both conditions for this many frames
+  /// Extension: the paper's AND misses a point-mirrored pose (the lines fit perfectly there, only the
+  /// compass disagrees, by pi) and a kidnap that keeps the heading. Either condition alone for this
+  /// many frames also restarts MCL (0 = off, the strict paper rule).
+  int heading_only_frames = 15;
+  int deviation_only_frames = 30;
   static HybridParams from_json(JsonReader& r);
 };
 
@@ -31,7 +34,7 @@ class HybridLocalizer : public Localizer {
   McLLocalizer mcl_;
   MatchingLocalizer tracker_;
   bool tracking_ = false;
-  int suspicious_ = 0;
+  int suspicious_ = 0, bad_heading_ = 0, bad_deviation_ = 0;
   int restarts_ = 0;
 };
 
