@@ -4,6 +4,7 @@
 #include "core/field.hpp"
 #include "core/rng.hpp"
 #include "localization/matching.hpp"
+#include "localization/mcl.hpp"
 
 using namespace omniloc;
 
@@ -48,3 +49,17 @@ static void BM_FieldMapLookup(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_FieldMapLookup);
+
+static void BM_McLUpdate(benchmark::State& state) {
+  const Field f = Field::preset("msl2012");
+  McLLocalizer mcl(f, McLParams{}, 1, "");
+  Rng rng(3);
+  const Pose2 truth(2.0, -1.0, 0.7);
+  Observations obs;
+  obs.line_points = points(f, truth, 200, rng);
+  Odometry odo;
+  odo.delta = Pose2(0.03, 0.0, 0.01);
+  mcl.reset(std::nullopt);
+  for (auto _ : state) benchmark::DoNotOptimize(mcl.update(obs, odo, truth.theta));
+}
+BENCHMARK(BM_McLUpdate)->Unit(benchmark::kMicrosecond);

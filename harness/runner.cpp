@@ -116,6 +116,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   std::string events_log;
   auto log_event = [&](const Json& e) { events_log += e.dump() + "\n"; };
   std::size_t next_event = 0;
+  Rng event_rng = Rng::stream(seed, "events");
 
   const long long n_frames = static_cast<long long>(std::floor(sc.duration * sc.camera_rate + 1e-9)) + 1;
   for (long long k = 0; k < n_frames; ++k) {
@@ -126,9 +127,13 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
         const EventConfig& e = sc.events[next_event++];
         Json ej{{"t", world.time()}, {"type", e.type}, {"robot", e.robot}};
         if (e.type == "teleport" || e.type == "kidnap") {
-          world.teleport(e.robot, e.pose);
+          Pose2 target = e.pose;
+          if (e.random_pose)  // anywhere inside the lines (0.5 m clear of them), any heading
+            target = Pose2(event_rng.uniform(-0.5 * sc.field.length + 0.5, 0.5 * sc.field.length - 0.5),
+                           event_rng.uniform(-0.5 * sc.field.width + 0.5, 0.5 * sc.field.width - 0.5), event_rng.uniform(-kPi, kPi));
+          world.teleport(e.robot, target);
           scripts[e.robot]->on_teleport();
-          ej["pose"] = {e.pose.x, e.pose.y, e.pose.theta};
+          ej["pose"] = {target.x, target.y, target.theta};
         }
         if (e.type == "cover" || e.type == "kidnap") {
           for (auto& tr : tracked)

@@ -198,8 +198,16 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
       e.robot = static_cast<int>(er.integer("robot", s.localized_robots().front(), 0, 99));
       if (!s.robot(e.robot)) throw ConfigError(ep + "/robot", std::to_string(e.robot), "the id of a robot in /robots");
       if (e.type == "teleport" || e.type == "kidnap") {
-        e.pose = read_pose(er, "pose");
-        check_on_floor(s.field, e.pose.translation(), s.robot(e.robot)->spec.radius, ep + "/pose", "a target with the whole robot");
+        const Json* pj = er.raw("pose", true);
+        if (pj->is_string()) {
+          if (pj->get<std::string>() != "random") throw ConfigError(ep + "/pose", json_brief(*pj), "[x, y, theta] or \"random\"");
+          e.random_pose = true;
+        } else {
+          if (!pj->is_array() || pj->size() != 3 || !(*pj)[0].is_number() || !(*pj)[1].is_number() || !(*pj)[2].is_number())
+            throw ConfigError(ep + "/pose", json_brief(*pj), "[x, y, theta] or \"random\"");
+          e.pose = Pose2((*pj)[0].get<double>(), (*pj)[1].get<double>(), (*pj)[2].get<double>());
+          check_on_floor(s.field, e.pose.translation(), s.robot(e.robot)->spec.radius, ep + "/pose", "a target with the whole robot");
+        }
       }
       if (e.type == "cover" || e.type == "kidnap" || e.type == "occlude")
         e.duration = er.positive("duration", e.type == "kidnap" ? 2.0 : 1.0, 3600.0);

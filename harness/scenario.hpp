@@ -42,6 +42,7 @@ struct EventConfig {
   std::string type;          ///< "teleport", "cover", "kidnap", "occlude", "lights"
   int robot = 0;
   Pose2 pose;                ///< teleport / kidnap target
+  bool random_pose = false;  ///< "pose": "random": drawn from the run's seed (stream "events") on the field
   double duration = 0.0;     ///< cover / kidnap / occlude: how long, seconds
   sim::OcclusionMask mask;   ///< occlude
   double level = 1.0;        ///< lights: new global illumination level
