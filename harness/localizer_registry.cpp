@@ -1,5 +1,6 @@
 #include "harness/localizer_registry.hpp"
 
+#include "localization/grid_global.hpp"
 #include "localization/hybrid.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
@@ -22,6 +23,10 @@ const std::vector<LocalizerInfo>& localizers() {
       {"hybrid", "MCL until converged, then matching tracking; wrong-localisation detection restarts MCL (paper 002)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<HybridLocalizer>(*ctx.field, HybridParams::from_json(r), ctx.seed, ctx.cache_dir);
+       }},
+      {"grid_global", "MTi-heading grid search (315 samples, best 5 refined by RPROP, up to 3 shifted passes), then matching tracking with MTi drift correction (paper 000)", false, true,
+       [](JsonReader& r, const LocalizerContext& ctx) {
+         return std::make_unique<GridGlobalLocalizer>(*ctx.field, GridGlobalParams::from_json(r), ctx.cache_dir);
        }},
   };
   return list;

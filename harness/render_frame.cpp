@@ -25,11 +25,12 @@ sim::WorldState world_at(const Scenario& s, double t, std::uint64_t seed) {
   }
   if (s.has_ball) world.set_ball(s.ball_position, s.ball_velocity);
   std::size_t next = 0;
+  Rng event_rng = Rng::stream(seed, "events");  // as in the run loop, so random targets agree
   while (world.time() < t - 1e-9) {
     while (next < s.events.size() && s.events[next].t <= world.time() + 1e-9) {
       const auto& e = s.events[next++];
       if (e.type == "teleport" || e.type == "kidnap") {
-        world.teleport(e.robot, e.pose);
+        world.teleport(e.robot, s.event_target(e, event_rng));
         scripts[e.robot]->on_teleport();
       }
     }

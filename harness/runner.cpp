@@ -127,10 +127,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
         const EventConfig& e = sc.events[next_event++];
         Json ej{{"t", world.time()}, {"type", e.type}, {"robot", e.robot}};
         if (e.type == "teleport" || e.type == "kidnap") {
-          Pose2 target = e.pose;
-          if (e.random_pose)  // anywhere inside the lines (0.5 m clear of them), any heading
-            target = Pose2(event_rng.uniform(-0.5 * sc.field.length + 0.5, 0.5 * sc.field.length - 0.5),
-                           event_rng.uniform(-0.5 * sc.field.width + 0.5, 0.5 * sc.field.width - 0.5), event_rng.uniform(-kPi, kPi));
+          const Pose2 target = sc.event_target(e, event_rng);
           world.teleport(e.robot, target);
           scripts[e.robot]->on_teleport();
           ej["pose"] = {target.x, target.y, target.theta};

@@ -54,6 +54,13 @@ NoiseProfile NoiseProfile::named(const std::string& name, const std::string& pat
   throw ConfigError(path, "\"" + name + "\"", "a noise profile: \"ideal\" or \"robot\"");
 }
 
+Pose2 Scenario::event_target(const EventConfig& e, Rng& rng) const {
+  if (!e.random_pose) return e.pose;
+  const double x = rng.uniform(-0.5 * field.length + 0.5, 0.5 * field.length - 0.5);
+  const double y = rng.uniform(-0.5 * field.width + 0.5, 0.5 * field.width - 0.5);
+  return Pose2(x, y, rng.uniform(-kPi, kPi));
+}
+
 sim::Lighting Scenario::lighting_at(double t) const {
   sim::Lighting l = lighting;
   for (std::size_t i = 0; i < l.sun.size(); ++i) l.sun[i].centre += sun_velocity[i] * t;

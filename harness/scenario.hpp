@@ -76,6 +76,9 @@ struct Scenario {
   const RobotConfig* robot(int id) const;
   /// Lighting at time t: lamp events applied with their transitions, sun patches moved.
   sim::Lighting lighting_at(double t) const;
+  /// Target of a teleport / kidnap event: its pose, or for "random" a pose inside the lines (0.5 m
+  /// clear of them, any heading) drawn from `rng` (the run's stream "events", in event order).
+  Pose2 event_target(const EventConfig& e, Rng& rng) const;
   std::vector<int> localized_robots() const;
 };
 

@@ -5,20 +5,16 @@
 // restarts MCL.
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
+#include "localization/wrong_localisation.hpp"
 
 namespace omniloc {
 
 struct HybridParams {
   McLParams mcl;
   MatchingParams matching;
-  double deviation_threshold = 0.25;  ///< m, mean point distance to the nearest line
-  double heading_threshold = 0.35;    ///< rad, |tracked heading - compass|
-  int consecutive = 5;                ///< paper 002: both conditions for this many frames
-  /// Extension: the paper's AND misses a point-mirrored pose (the lines fit perfectly there, only the
-  /// compass disagrees, by pi) and a kidnap that keeps the heading. Either condition alone for this
-  /// many frames also restarts MCL (0 = off, the strict paper rule).
-  int heading_only_frames = 15;
-  int deviation_only_frames = 30;
+  /// Paper 002: deviation AND heading for 5 frames; plus the single-condition windows (see
+  /// wrong_localisation.hpp), which catch the point-mirrored pose the AND misses.
+  DetectionParams detection;
   static HybridParams from_json(JsonReader& r);
 };
 
@@ -34,7 +30,7 @@ class HybridLocalizer : public Localizer {
   McLLocalizer mcl_;
   MatchingLocalizer tracker_;
   bool tracking_ = false;
-  int suspicious_ = 0, bad_heading_ = 0, bad_deviation_ = 0;
+  WrongLocalisationDetector detector_;
   int restarts_ = 0;
 };
 

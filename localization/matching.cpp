@@ -68,7 +68,7 @@ double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts,
 }
 
 MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& start, const MatchingParams& p,
-                        int iterations, std::optional<double> prior_theta) {
+                        int iterations, std::optional<double> prior_theta, std::vector<double>* trace) {
   Eigen::Vector3d q(start.x, start.y, start.theta);
   Eigen::Vector3d step(p.step_xy, p.step_xy, p.step_theta), prev = Eigen::Vector3d::Zero();
   const Eigen::Vector3d max_step(1.0, 1.0, 0.5), min_step(1e-6, 1e-6, 1e-6);
@@ -83,6 +83,7 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     const double c = stages > 1 ? std::max(p.c, p.c_start * std::pow(0.5, stage)) : p.c;
     Eigen::Vector3d g;
     data_term(map, pts, q, c, &g);
+    if (trace) trace->push_back(pts.empty() ? 1.0 : data_term(map, pts, q, p.c, nullptr) / pts.size());
     if (prior_theta && p.heading_prior > 0) g.z() += 2.0 * p.heading_prior * angle_diff(q.z(), *prior_theta);
     for (int k = 0; k < 3; ++k) {
       // iRPROP-: on a sign change shrink the step and skip this update.
@@ -100,6 +101,7 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
   }
   r.pose = Pose2(q.x(), q.y(), q.z());
   r.error = pts.empty() ? 1.0 : data_term(map, pts, q, p.c, nullptr) / pts.size();
+  if (trace) trace->push_back(r.error);
   // Curvature of the data term by central differences of its gradient. Near the optimum
   // e(d) ~ d^2 / c^2, so the Gauss-Newton information of points with noise sigma is H c^2 / (2 sigma^2).
   Eigen::Matrix3d H;

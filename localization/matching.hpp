@@ -49,8 +49,9 @@ struct MatchResult {
 double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& pose, double c);
 
 /// RPROP from `start`. `prior_theta`: optional heading the heading_prior term pulls towards.
+/// `trace`: if given, receives the mean error (at the final c) before each iteration and at the end.
 MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& start, const MatchingParams& p,
-                        int iterations, std::optional<double> prior_theta = std::nullopt);
+                        int iterations, std::optional<double> prior_theta = std::nullopt, std::vector<double>* trace = nullptr);
 
 /// (x, y, theta) Kalman filter: odometry prediction, pose measurement update.
 class PoseKalman {

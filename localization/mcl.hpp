@@ -41,12 +41,14 @@ class McLLocalizer : public Localizer {
   Estimate update(const Observations& obs, const Odometry& odometry, std::optional<double> heading) override;
   bool converged() const { return converged_; }
   const FieldMap& map() const { return map_; }
+  struct Particle {
+    Pose2 pose;        ///< world frame
+    double logw = 0.0; ///< log weight (unnormalised)
+  };
+  /// The current particle set (for pictures and tests).
+  const std::vector<Particle>& particles() const { return ps_; }
 
  private:
-  struct Particle {
-    Pose2 pose;
-    double logw = 0.0;
-  };
   void init_uniform(std::optional<double> heading);
   McLParams p_;
   Field field_;

@@ -1,0 +1,171 @@
+#include "localization/grid_global.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/angles.hpp"
+
+namespace omniloc {
+
+GridGlobalParams GridGlobalParams::from_json(JsonReader& r) {
+  GridGlobalParams p;
+  p.spacing = r.number("spacing", p.spacing, 0.1, 10.0);
+  p.outside = r.number("outside", p.outside, 0.0, 5.0);
+  p.shift = r.number("shift", p.shift, 0.0, 5.0);
+  p.passes = static_cast<int>(r.integer("passes", p.passes, 1, 20));
+  p.candidates = static_cast<int>(r.integer("candidates", p.candidates, 1, 100));
+  p.c_grid = r.positive("c_grid", p.c_grid, 20.0);
+  p.grid_points = static_cast<int>(r.integer("grid_points", p.grid_points, 3, 10000));
+  p.refine_iterations = static_cast<int>(r.integer("refine_iterations", p.refine_iterations, 1, 1000));
+  p.refine_c_start = r.positive("refine_c_start", p.refine_c_start, 20.0);
+  p.accept_error = r.positive("accept_error", p.accept_error, 1.0);
+  p.min_separation = r.number("min_separation", p.min_separation, 0.0, 20.0);
+  p.record_traces = r.boolean("record_traces", p.record_traces);
+  p.good_deviation = r.positive("good_deviation", p.good_deviation, 5.0);
+  p.drift_frames = static_cast<int>(r.integer("drift_frames", p.drift_frames, 1, 100000));
+  p.drift_gain = r.number("drift_gain", p.drift_gain, 0.0, 1.0);
+  if (auto m = r.object("matching")) {
+    p.matching = MatchingParams::from_json(*m);
+    m->finish();
+  }
+  p.detection = DetectionParams::from_json(r);
+  return p;
+}
+
+GridSearchRecord grid_search(const Field& field, const FieldMap& map, const std::vector<Eigen::Vector2d>& points, double heading,
+                             const GridGlobalParams& p) {
+  GridSearchRecord rec;
+  rec.heading = heading;
+  const auto grid_pts = subsample(points, p.grid_points);
+  const auto match_pts = subsample(points, p.matching.max_points);
+  const double x_lo = -0.5 * field.length - p.outside, y_lo = -0.5 * field.width - p.outside;
+  const int nx = static_cast<int>(std::floor((field.length + 2 * p.outside) / p.spacing + 1e-9)) + 1;
+  const int ny = static_cast<int>(std::floor((field.width + 2 * p.outside) / p.spacing + 1e-9)) + 1;
+  // The points rotated once into the world orientation: E_k then needs only a translation per sample.
+  const double c = std::cos(heading), s = std::sin(heading), c2 = p.c_grid * p.c_grid;
+  std::vector<Eigen::Vector2d> rotated;
+  rotated.reserve(grid_pts.size());
+  for (const auto& o : grid_pts) rotated.emplace_back(c * o.x() - s * o.y(), s * o.x() + c * o.y());
+  MatchingParams refine = p.matching;
+  refine.c_start = std::max(refine.c, p.refine_c_start);
+
+  for (int pass = 0; pass < p.passes; ++pass) {
+    const double off = pass * p.shift;
+    const std::size_t first = rec.samples.size();
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        GridSearchRecord::Sample smp{x_lo + i * p.spacing + off, y_lo + j * p.spacing + off, 0.0, pass};
+        double e = 0;
+        for (const auto& w : rotated) {
+          const double d = map.distance({smp.x + w.x(), smp.y + w.y()});
+          e += 1.0 - c2 / (c2 + d * d);
+        }
+        smp.error = rotated.empty() ? 1.0 : e / static_cast<double>(rotated.size());
+        rec.samples.push_back(smp);
+      }
+    // The best samples of this pass, distinct places (neighbours of one minimum would refine to the same pose).
+    std::vector<std::size_t> order(rec.samples.size() - first);
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = first + k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return rec.samples[a].error < rec.samples[b].error; });
+    std::vector<std::size_t> best;
+    for (std::size_t k : order) {
+      if (static_cast<int>(best.size()) >= p.candidates) break;
+      bool far = true;
+      for (std::size_t b : best) far = far && std::hypot(rec.samples[k].x - rec.samples[b].x, rec.samples[k].y - rec.samples[b].y) >= p.min_separation - 1e-9;
+      if (far) best.push_back(k);
+    }
+    for (std::size_t k : best) {
+      GridSearchRecord::Candidate cand;
+      cand.pass = pass;
+      cand.start = Pose2(rec.samples[k].x, rec.samples[k].y, heading);
+      const MatchResult m = rprop_match(map, match_pts, cand.start, refine, p.refine_iterations, heading, p.record_traces ? &cand.trace : nullptr);
+      cand.result = m.pose;
+      cand.error = m.error;
+      rec.candidates.push_back(std::move(cand));
+    }
+    rec.passes = pass + 1;
+    int chosen = -1;
+    for (std::size_t k = 0; k < rec.candidates.size(); ++k)
+      if (chosen < 0 || rec.candidates[k].error < rec.candidates[static_cast<std::size_t>(chosen)].error) chosen = static_cast<int>(k);
+    rec.chosen = chosen;
+    rec.accepted = chosen >= 0 && rec.candidates[static_cast<std::size_t>(chosen)].error < p.accept_error;
+    if (rec.accepted) break;
+  }
+  return rec;
+}
+
+GridGlobalLocalizer::GridGlobalLocalizer(const Field& field, const GridGlobalParams& p, const std::string& cache_dir)
+    : p_(p), field_(field), tracker_(field, p.matching, cache_dir), detector_(p.detection) {}
+
+void GridGlobalLocalizer::reset(const std::optional<Pose2>& start) {
+  tracking_ = false;
+  offset_ = 0.0;
+  good_frames_ = 0;
+  detector_.reset();
+  if (start) {
+    tracker_.reset(start);
+    tracking_ = true;
+  }
+}
+
+Estimate GridGlobalLocalizer::update(const Observations& obs, const Odometry& odo, std::optional<double> raw_heading) {
+  std::optional<double> heading;
+  if (raw_heading) heading = wrap_angle(*raw_heading + offset_);
+  Estimate e;
+  if (!tracking_) {
+    const auto pts = subsample(obs.line_points, p_.matching.max_points);
+    e.mode = "global";
+    e.valid = false;
+    if (obs.camera_ok && static_cast<int>(pts.size()) >= p_.matching.min_points) {
+      // Paper 000 needs the MTi; without a heading, search eight headings (eight times the work).
+      std::vector<double> headings;
+      if (heading) headings.push_back(*heading);
+      else
+        for (int k = 0; k < 8; ++k) headings.push_back(-kPi + k * kPi / 4);
+      std::optional<GridSearchRecord> best;
+      for (double h : headings) {
+        GridSearchRecord r = grid_search(field_, tracker_.map(), obs.line_points, h, p_);
+        if (!best || r.candidates[static_cast<std::size_t>(r.chosen)].error < best->candidates[static_cast<std::size_t>(best->chosen)].error)
+          best = std::move(r);
+      }
+      ++searches_;
+      const auto& ch = best->candidates[static_cast<std::size_t>(best->chosen)];
+      tracker_.reset(ch.result);
+      tracking_ = true;
+      detector_.reset();
+      good_frames_ = 0;
+      e.pose = ch.result;
+      e.valid = true;
+      e.mode = best->accepted ? "converged" : "converged_weak";
+      e.match_error = ch.error;
+      e.extra["global_passes"] = best->passes;
+      last_ = std::move(best);
+    }
+  } else {
+    e = tracker_.track(obs, odo);
+    if (e.mode == "tracking") {
+      const double dev = mean_deviation(tracker_.map(), subsample(obs.line_points, p_.matching.max_points), e.pose);
+      e.extra["deviation_m"] = dev;
+      // MTi drift correction by the vision heading (paper 000), only for small disagreements.
+      if (heading) {
+        const double diff = angle_diff(e.pose.theta, *heading);
+        good_frames_ = dev < p_.good_deviation && std::fabs(diff) < p_.detection.heading_threshold ? good_frames_ + 1 : 0;
+        if (good_frames_ >= p_.drift_frames) {
+          offset_ = wrap_angle(offset_ + p_.drift_gain * diff);
+          heading = wrap_angle(*raw_heading + offset_);
+        }
+      }
+      if (detector_.update(dev, e.pose, heading)) {
+        tracking_ = false;
+        ++restarts_;
+        e.valid = false;
+        e.mode = "restart";
+      }
+    }
+  }
+  e.extra["restarts"] = restarts_;
+  e.extra["heading_offset"] = offset_;
+  return e;
+}
+
+}  // namespace omniloc

@@ -1,0 +1,39 @@
+#include "localization/wrong_localisation.hpp"
+
+#include <cmath>
+
+#include "core/angles.hpp"
+
+namespace omniloc {
+
+DetectionParams DetectionParams::from_json(JsonReader& r) {
+  DetectionParams p;
+  p.deviation_threshold = r.positive("deviation_threshold", p.deviation_threshold, 10.0);
+  p.heading_threshold = r.positive("heading_threshold", p.heading_threshold, 3.2);
+  p.consecutive = static_cast<int>(r.integer("consecutive", p.consecutive, 1, 1000));
+  p.heading_only_frames = static_cast<int>(r.integer("heading_only_frames", p.heading_only_frames, 0, 100000));
+  p.deviation_only_frames = static_cast<int>(r.integer("deviation_only_frames", p.deviation_only_frames, 0, 100000));
+  return p;
+}
+
+double mean_deviation(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& pose) {
+  if (pts.empty()) return 0.0;
+  double dev = 0;
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  for (const auto& o : pts) dev += map.distance({pose.x + c * o.x() - s * o.y(), pose.y + s * o.x() + c * o.y()});
+  return dev / static_cast<double>(pts.size());
+}
+
+bool WrongLocalisationDetector::update(double deviation, const Pose2& pose, std::optional<double> heading) {
+  const bool bad_dev = deviation > p_.deviation_threshold;
+  const bool bad_head = heading && std::fabs(angle_diff(pose.theta, *heading)) > p_.heading_threshold;
+  both_ = bad_dev && bad_head ? both_ + 1 : 0;
+  heading_ = bad_head ? heading_ + 1 : 0;
+  deviation_ = bad_dev ? deviation_ + 1 : 0;
+  const bool fire = both_ >= p_.consecutive || (p_.heading_only_frames > 0 && heading_ >= p_.heading_only_frames) ||
+                    (p_.deviation_only_frames > 0 && deviation_ >= p_.deviation_only_frames);
+  if (fire) reset();
+  return fire;
+}
+
+}  // namespace omniloc
