@@ -204,10 +204,10 @@ Fix total_like(std::span<const BearingObs> obs) {
   // D = 0 when the three centres coincide: the robot on the circle through the landmarks. D is the
   // sum of the cross products of the centres; compared with the size of those products it falls
   // quadratically with the distance to the circle (each centre moves linearly towards the common
-  // one), so the relative threshold is kSingularTol^(4/3) ~ 1e-12: a band of ~1e-6 scale around the
-  // circle, well above the ~1e-16 rounding floor exactly on it.
+  // one). Threshold 1e-14: refused within ~1e-7 scale of the circle (~1e-6 m for landmarks 10 m
+  // apart), two decades above the ~1e-16 rounding floor exactly on it.
   const double dnorm = c12.norm() * c23.norm() + c23.norm() * c31.norm() + c31.norm() * c12.norm();
-  if (!(std::fabs(D) > 1e-12 * dnorm)) return no_fix(kOnCircle);
+  if (!(std::fabs(D) > 1e-14 * dnorm)) return no_fix(kOnCircle);
   const double invD = 1.0 / D;  // the single division
   const Eigen::Vector2d R(B2.x() + k31 * (c12.y() - c23.y()) * invD, B2.y() + k31 * (c23.x() - c12.x()) * invD);
   return finish_fix(obs, dirs, R, landmark_scale(obs));
