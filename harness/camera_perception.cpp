@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "harness/vision_setup.hpp"
+#include "localization/vision/entropy.hpp"
 
 namespace omniloc::harness {
 
@@ -16,6 +17,10 @@ VisionConfig VisionConfig::from_json(const Json& j, const std::string& path, Jso
     v.scan = ScanLineParams::from_json(*s);
     s->finish();
   }
+  if (auto e = r.object("exposure_control")) {
+    v.exposure = ExposureParams::from_json(*e);
+    e->finish();
+  }
   r.finish();
   return v;
 }
@@ -27,6 +32,11 @@ CameraPerception::CameraPerception(const Scenario& s, std::uint64_t seed) : seed
   map_ = calibration_for(cfg, vc.calibration, seed);
   table_ = colour_table_for(cfg, s.field, vc.colour_table, seed);
   detector_ = std::make_unique<LineDetector>(vc.scan, map_, table_);
+  exposure_ = vc.exposure;
+  exposure_.exposure_min = cfg.exposure_min;
+  exposure_.exposure_max = cfg.exposure_max;
+  exposure_.gain_min = cfg.gain_min;
+  exposure_.gain_max = cfg.gain_max;
 }
 
 PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) {
@@ -53,6 +63,18 @@ PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int rob
   out.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   out.vision_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   out.image = img;
+  // Entropy auto-adjustment (paper 002) on what the robot sees; never while the lens is covered.
+  if (exposure_.enabled && !cond.covered && out.obs.camera_ok) {
+    auto ct = controllers_.find(robot_id);
+    if (ct == controllers_.end()) ct = controllers_.emplace(robot_id, ExposureController(exposure_, st->second)).first;
+    const double body = centre_brightness(*img, map_.centre(), 0.8 * map_.min_radius());
+    if (ct->second.wants_entropy()) out.entropy = image_entropy(*img, map_.centre(), map_.max_radius());
+    ExposureDecision d = ct->second.update(t, body, out.entropy);
+    st->second = d.settings;  // takes effect on the next frame
+    out.stop_robot = d.searching;
+    out.warnings.insert(out.warnings.end(), d.warnings.begin(), d.warnings.end());
+    if (d.event) out.notes.push_back(*d.event);
+  }
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include "harness/perception.hpp"
 #include "localization/vision/calibration_map.hpp"
 #include "localization/vision/colour_table.hpp"
+#include "localization/vision/exposure_control.hpp"
 #include "localization/vision/scan_lines.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
@@ -18,6 +19,7 @@ struct VisionConfig {
   std::string calibration = "auto";   ///< a map file, or "auto" (cached calibration run)
   std::string colour_table = "auto";  ///< a table file, or "auto"
   ScanLineParams scan;
+  ExposureParams exposure;            ///< key "exposure_control" (camera ranges come from "camera")
   static VisionConfig from_json(const Json& j, const std::string& path, Json* effective = nullptr);
 };
 
@@ -36,6 +38,8 @@ class CameraPerception : public Perception {
   std::uint64_t seed_;
   std::map<int, Rng> rngs_;
   std::map<int, CameraSettings> settings_;
+  ExposureParams exposure_;
+  std::map<int, ExposureController> controllers_;
 };
 
 }  // namespace omniloc::harness

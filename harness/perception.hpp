@@ -28,6 +28,8 @@ struct PerceptionOutput {
   double vision_ms = 0.0;
   bool stop_robot = false;             ///< the robot must stand still (camera adjusting, paper 002)
   std::vector<std::string> warnings;   ///< written to events.jsonl
+  std::vector<std::string> notes;      ///< camera control events (exposure search), written to events.jsonl
+  double entropy = -1.0;               ///< image entropy (nats) when it was computed, else -1
 };
 
 class Perception {

@@ -199,6 +199,8 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
         write_png(*po.image, opt.frames_dir + name);
       }
       for (const auto& w : po.warnings) log_event(Json{{"t", ws.t}, {"type", "warning"}, {"robot", tr.id}, {"message", w}});
+      for (const auto& n : po.notes)
+        log_event(Json{{"t", ws.t}, {"type", "camera"}, {"robot", tr.id}, {"message", n}, {"exposure_ms", po.settings.exposure_ms}, {"gain", po.settings.gain}});
       if (po.stop_robot != tr.paused) log_event(Json{{"t", ws.t}, {"type", po.stop_robot ? "pause" : "resume"}, {"robot", tr.id}});
       tr.paused = po.stop_robot;
       const auto t0 = Clock::now();
@@ -206,8 +208,13 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
       const double loc_ms = ms_since(t0);
 
       ++tr.frames;
+      std::map<std::string, double> extra = est.extra;
+      if (po.image) {  // the camera settings the frame was taken with (exposure control, paper 002)
+        extra["exposure_ms"] = po.settings.exposure_ms;
+        extra["gain"] = po.settings.gain;
+      }
       FrameRow row{ws.t, tr.id, truth.pose, est.pose, est.valid, po.obs.camera_ok, world.in_contact(tr.id), est.mode,
-                   po.obs.line_points.size(), est.match_error, est.extra, po.render_ms, po.vision_ms, loc_ms};
+                   po.obs.line_points.size(), est.match_error, extra, po.render_ms, po.vision_ms, loc_ms};
       tr.rows.push_back(row);
       tr.gt_tum += tum_line(ws.t, truth.pose);
       tr.scored.push_back({ws.t, truth.pose, est.pose, est.valid});

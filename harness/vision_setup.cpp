@@ -32,6 +32,7 @@ std::string camera_tag(const sim::CameraConfig& cfg) {
   j.erase("backend");  // the same optics whichever GL back-end draws them
   j.erase("quality");
   j.erase("latency_ms");  // latency changes when images arrive, not what the optics map
+  j["photometry"] = sim::PanoramicCamera::kPhotometryVersion;
   return "cam-" + fnv_hex(j.dump());
 }
 
@@ -113,7 +114,12 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
     const double a = rng.uniform(0, kTwoPi), d = rng.uniform(0.6, 3.0);
     w.ball.position = me.pose.translation() + d * Eigen::Vector2d(std::cos(a), std::sin(a));
     images.push_back(cam.render(w, 0, cfg.initial, rng));
-    labels.push_back(cam.render_labels(w, 0));
+    Image lab = cam.render_labels(w, 0);
+    // White goals are the same white as the lines to a colour table: one "white" class (a real
+    // table has no way to tell them apart, and with clipped whites the two would split the cell).
+    for (std::size_t i = 0; i < lab.rgb.size(); ++i)
+      if (lab.rgb[i] == sim::kLabelGoal) lab.rgb[i] = sim::kLabelLine;
+    labels.push_back(std::move(lab));
   }
   ColourTable t;
   t.learn(images, labels);

@@ -26,10 +26,12 @@ const Eigen::Vector3f kBlack(0.03f, 0.03f, 0.03f);
 
 // GL colours carry albedo * illumination / kRadianceScale, so illumination up to 4x normal fits.
 constexpr float kRadianceScale = 4.0f;
-// Camera response: value (DN) = kResponse * albedo * illumination * exposure_ms * gain. Chosen so
-// that exposure = gain = 18 (paper 002's entropy peak under normal light) puts the white lines at
-// 200 DN and the carpet's green channel near 80 DN: well exposed, nothing clipped.
-constexpr double kResponse = 200.0 / (0.85 * 18.0 * 18.0);
+// Camera response: value (DN) = kResponse * albedo * illumination * exposure_ms * gain. The sensor's
+// sensitivity is set so that, under normal light, the image entropy along exposure = gain peaks at
+// 18 / 18 as paper 002 reports for its camera (measured with `omniloc experiment entropy_maps`):
+// the carpet's green channel then sits near 180 DN and the white lines clip, as on many robot cameras.
+// (v1 put the lines at 200 DN at 18 / 18; its entropy peak lay at 26-30.)
+constexpr double kResponse = 2.25 * 200.0 / (0.85 * 18.0 * 18.0);
 
 Eigen::Vector3f colour_of(const std::string& c) {
   if (c == "yellow") return {0.85f, 0.78f, 0.08f};

@@ -48,6 +48,9 @@ enum LabelClass : std::uint8_t {
 
 class PanoramicCamera {
  public:
+  /// Changes whenever the photometry (response, noise) changes: part of the cache key of the colour
+  /// tables and calibration maps learned from rendered images.
+  static constexpr int kPhotometryVersion = 2;
   /// Throws ConfigError for a bad configuration, RuntimeFailure when the GL back-end fails.
   PanoramicCamera(const CameraConfig& config, const Field& field);
   ~PanoramicCamera();

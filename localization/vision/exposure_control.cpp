@@ -1,0 +1,163 @@
+#include "localization/vision/exposure_control.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace omniloc {
+
+ExposureParams ExposureParams::from_json(JsonReader& r) {
+  ExposureParams p;
+  p.enabled = r.boolean("enabled", p.enabled);
+  p.a = r.positive("a", p.a, 100.0);
+  p.b = r.number("b", p.b, -100.0, 100.0);
+  p.change_threshold = r.positive("change_threshold", p.change_threshold, 255.0);
+  p.confirm_frames = static_cast<int>(r.integer("confirm_frames", p.confirm_frames, 1, 1000));
+  p.initial_step = r.positive("initial_step", p.initial_step, 100.0);
+  p.min_step = r.positive("min_step", p.min_step, 100.0);
+  p.max_steps = static_cast<int>(r.integer("max_steps", p.max_steps, 1, 1000));
+  p.settle_s = r.number("settle_s", p.settle_s, 0.0, 10.0);
+  p.search_at_start = r.boolean("search_at_start", p.search_at_start);
+  return p;
+}
+
+ExposureController::ExposureController(const ExposureParams& p, const CameraSettings& initial) : p_(p), cur_(initial) {}
+
+CameraSettings ExposureController::on_line(double g, std::vector<std::string>* warnings) const {
+  CameraSettings s;
+  const double g_clamped = std::clamp(g, p_.gain_min, p_.gain_max);
+  s.gain = g_clamped;
+  s.exposure_ms = p_.a * g_clamped + p_.b;
+  const double e_clamped = std::clamp(s.exposure_ms, p_.exposure_min, p_.exposure_max);
+  if (warnings && (g_clamped != g || e_clamped != s.exposure_ms)) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "exposure search left the camera's range (gain %.2f, exposure %.2f ms): clamped to gain %.2f, exposure %.2f ms", g,
+                  p_.a * g + p_.b, g_clamped, e_clamped);
+    warnings->push_back(buf);
+  }
+  s.exposure_ms = e_clamped;
+  return s;
+}
+
+void ExposureController::start(double t, double change, double entropy) {
+  state_ = State::Searching;
+  ++searches_;
+  steps_ = 0;
+  best_g_ = cur_.gain;
+  best_h_ = entropy;
+  step_ = p_.initial_step;
+  dir_ = change > 0 ? -1 : 1;  // brighter than saved: less exposure and gain first
+  tried_other_ = false;
+  path_.assign(1, {best_g_, best_h_});
+  settled_at_ = t;
+}
+
+void ExposureController::fail() {
+  if (!tried_other_) {
+    dir_ = -dir_;  // try the other side at the same step
+    tried_other_ = true;
+  } else {
+    step_ *= 0.5;  // bracketed: refine around the best, both sides again
+    tried_other_ = false;
+  }
+}
+
+void ExposureController::propose(double t, double g, ExposureDecision& d) {
+  std::vector<std::string> w;
+  const CameraSettings s = on_line(g, &w);
+  probe_g_ = s.gain;
+  cur_ = s;
+  ++steps_;
+  settled_at_ = t + p_.settle_s;
+  d.warnings.insert(d.warnings.end(), w.begin(), w.end());
+}
+
+ExposureDecision ExposureController::update(double t, double brightness, double entropy) {
+  ExposureDecision d;
+  const bool first = first_;
+  first_ = false;
+  if (!p_.enabled) {
+    d.settings = cur_;
+    return d;
+  }
+  if (state_ == State::Idle) {
+    if (first && p_.search_at_start) {
+      start(t, 0.0, entropy);
+      d.event = "search_start (first frame)";
+      propose(t, best_g_ + dir_ * step_, d);
+      d.settings = cur_;
+      d.searching = true;
+      return d;
+    } else if (saved_brightness_ < 0) {
+      saved_brightness_ = brightness;
+    } else {
+      const double change = brightness - saved_brightness_;
+      over_ = std::fabs(change) > p_.change_threshold ? over_ + 1 : 0;
+      if (over_ >= p_.confirm_frames) {
+        over_ = 0;
+        d.settings = cur_;
+        d.searching = true;
+        char buf[120];
+        std::snprintf(buf, sizeof buf, "search_start (body brightness %.1f, saved %.1f)", brightness, saved_brightness_);
+        d.event = buf;
+        // The entropy of this frame is not known yet (not computed while idle): the first probe is the
+        // current setting itself, measured on the next frame.
+        start(t, change, -1.0);
+        return d;
+      }
+      d.settings = cur_;
+      return d;
+    }
+    if (state_ == State::Idle) {
+      d.settings = cur_;
+      return d;
+    }
+  }
+  // Searching: frames taken before the last setting settled do not count.
+  d.searching = true;
+  if (t + 1e-9 < settled_at_) {
+    d.settings = cur_;
+    return d;
+  }
+  const double g = cur_.gain;
+  if (best_h_ < 0) {  // the starting setting, measured on this frame
+    best_h_ = entropy;
+    path_.assign(1, {g, entropy});
+  } else {
+    path_.push_back({g, entropy});
+    if (entropy > best_h_) {
+      best_h_ = entropy;
+      best_g_ = g;
+      tried_other_ = true;  // the other side is where we came from, known to be worse
+    } else {
+      fail();
+    }
+  }
+  // Probes that the camera's range clamps onto the best setting are failures without a frame.
+  while (step_ >= p_.min_step && on_line(best_g_ + dir_ * step_).gain == best_g_) {
+    d.warnings.push_back("exposure search reached the camera's range limit at gain " + std::to_string(best_g_));
+    fail();
+  }
+  if (step_ < p_.min_step || steps_ >= p_.max_steps) {
+    if (steps_ >= p_.max_steps) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "exposure search stopped after the maximum of %d settings", p_.max_steps);
+      d.warnings.push_back(buf);
+    }
+    cur_ = on_line(best_g_);
+    state_ = State::Idle;
+    saved_brightness_ = -1.0;  // re-measured on the next frame, taken with the final setting
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "search_end (gain %.2f, exposure %.2f ms, entropy %.3f, %d settings tried)", cur_.gain, cur_.exposure_ms, best_h_,
+                  steps_);
+    d.event = buf;
+    d.settings = cur_;
+    d.searching = false;
+    return d;
+  }
+  propose(t, best_g_ + dir_ * step_, d);
+  d.settings = cur_;
+  return d;
+}
+
+}  // namespace omniloc
