@@ -488,7 +488,9 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   RunDirectory dir(args.out_dir);
   std::ostringstream md;  // the markdown report, also printed
 
-  md << "# cooperative_001: paper 001 simulation\n\n"
+  md << "# cooperative_001: paper 001 simulation\n\n";
+  if (!c.description.empty()) md << c.description << "\n\n";
+  md
      << "Description file `" << file << "`; seed " << seed << (args.quick ? " (quick mode)" : "") << "; machine: " << machine_text() << ".\n"
      << sf("Field %.1f m x %.1f m, ", c.field_length, c.field_width) << c.robots.size() << " robots, ball "
      << sf("(%.0f, %.0f) -> (%.0f, %.0f) mm", 1000 * c.ball_start.x(), 1000 * c.ball_start.y(), 1000 * c.ball_end.x(), 1000 * c.ball_end.y())
@@ -654,9 +656,10 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   };
   const std::string d_mf = paired(2, 1), d_fp = paired(1, 0);
   const double dm = growth_json["mfbpf_minus_fbpf"]["mean"].get<double>(), dse = growth_json["mfbpf_minus_fbpf"]["se"].get<double>();
-  const std::string verdict = dm < -2.0 * dse   ? "reproduced: MFBPF is lower by more than two standard errors"
-                              : dm > 2.0 * dse ? "not reproduced: MFBPF is higher by more than two standard errors"
-                                               : "not reproduced: the difference is within two standard errors of zero";
+  const double z = dse > 0.0 ? dm / dse : 0.0;
+  const std::string verdict = z < -2.0  ? sf("reproduced: MFBPF is lower by %.3f (%.1f standard errors)", -dm, -z)
+                              : z < 0.0 ? sf("not established: MFBPF is lower by %.3f, only %.1f standard errors", -dm, -z)
+                                        : sf("not reproduced: MFBPF is not lower (MFBPF - FBPF = %+.3f, %.1f standard errors)", dm, z);
   md << "\nPaired differences (mean +- standard error): MFBPF - FBPF = " << d_mf << "; FBPF - PF = " << d_fp << ".\n"
      << "Paper's claim: "
      << (paper.contains("001_growth_model") && paper["001_growth_model"].contains("claim") ? paper["001_growth_model"]["claim"].get<std::string>()
