@@ -2,6 +2,7 @@
 // Exit codes: 0 success, 1 runtime failure, 2 bad input (scenario, arguments) — nothing written.
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -34,13 +35,15 @@ commands:
                          map's error against the true mirror by distance
   colour-calibrate FILE [-o table.lut] [--seed N]
                          learn the colour look-up table from labelled renders of the scenario's field
-  validate FILE          check a scenario file (exit 2 with the JSON path of the first problem)
+  validate FILE          check a scenario file or an experiment description (scenarios/experiments/);
+                         exit 2 with the JSON path of the first problem
   list                   field presets, motion scripts, localizers, noise profiles, experiments
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
-  experiment NAME [--seed N] [-o DIR] [--quick]
-                         run a named experiment (solver maps, cooperative simulation, ...)
+  experiment NAME [--seed N] [-o DIR] [--quick] [--config FILE]
+                         run a named experiment (solver maps, cooperative simulation, ...);
+                         --config: its description file instead of scenarios/experiments/NAME.json
 )";
 
 struct Args {
@@ -101,6 +104,19 @@ std::uint64_t parse_seed(const std::string& s) {
 
 int cmd_validate(const Args& a) {
   if (a.positional.size() != 1) throw UsageError("validate takes one scenario file");
+  // An experiment description (scenarios/experiments/*.json) names its experiment; the experiment checks it.
+  if (std::ifstream in(a.positional[0]); in) {
+    const Json j = Json::parse(in, nullptr, false);
+    if (j.is_object() && j.contains("experiment") && j["experiment"].is_string()) {
+      for (const auto& e : harness::experiments())
+        if (e.name == j["experiment"].get<std::string>() && e.validate) {
+          e.validate(a.positional[0]);
+          std::cout << a.positional[0] << ": ok (description of experiment \"" << e.name << "\")\n";
+          return 0;
+        }
+      throw ConfigError("/experiment", json_brief(j["experiment"]), "the name of an experiment that reads a description file (see omniloc list)");
+    }
+  }
   const auto s = harness::load_scenario(a.positional[0]);
   std::cout << a.positional[0] << ": ok (scenario \"" << s.name << "\", " << s.robots.size() << " robot(s), "
             << s.duration << " s, localizer " << s.localizer.value("type", "?") << ")\n";
@@ -222,6 +238,7 @@ int cmd_experiment(const Args& a) {
     if (!opt(a, "--seed").empty()) ea.seed = parse_seed(opt(a, "--seed"));
     ea.out_dir = opt(a, "-o", "results/experiments/" + e.name);
     ea.quick = flag(a, "--quick");
+    ea.config = opt(a, "--config");
     return e.run(ea, std::cout);
   }
   throw UsageError("unknown experiment \"" + a.positional[0] + "\" (see omniloc list)");
@@ -244,7 +261,7 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmd_render(parse(argc, argv, 2, {"--t", "--robot", "--seed", "-o"}, {"--labels", "--points"}));
     if (cmd == "sweep")
       return cmd_sweep(parse(argc, argv, 2, {"-j", "--shard", "-o", "--stop-after"}, {"--resume", "--aggregate-only"}));
-    if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o"}, {"--quick"}));
+    if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o", "--config"}, {"--quick"}));
     throw UsageError("unknown command \"" + cmd + "\"");
   } catch (const ConfigError& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -14,6 +14,7 @@ struct ExperimentArgs {
   std::uint64_t seed = 1;
   std::string out_dir;   ///< results/experiments/<name> by default
   bool quick = false;    ///< a smaller version for tests and the default job
+  std::string config;    ///< the experiment's description file; empty: the one shipped in scenarios/experiments/
 };
 
 struct ExperimentInfo {
@@ -22,6 +23,10 @@ struct ExperimentInfo {
   /// Runs the experiment, writes files under args.out_dir, prints a paper-format table to `out`.
   /// Returns 0 on success.
   std::function<int(const ExperimentArgs& args, std::ostream& out)> run;
+  /// Checks a description file of this experiment (throws ConfigError naming the JSON path); empty
+  /// when the experiment reads none. Files under scenarios/experiments/ name their experiment in
+  /// the key "experiment".
+  std::function<void(const std::string& file)> validate = {};
 };
 
 /// All experiments (harness/experiment_registry.cpp holds the list).

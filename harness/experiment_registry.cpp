@@ -1,4 +1,5 @@
 #include "harness/experiment.hpp"
+#include "harness/experiments/cooperative_001.hpp"
 #include "harness/experiments/entropy_maps.hpp"
 #include "harness/experiments/global_figures.hpp"
 
@@ -10,6 +11,10 @@ const std::vector<ExperimentInfo>& experiments() {
   static const std::vector<ExperimentInfo> list = {
       {"entropy_maps", "paper 002 figures 6, 10, 11: image entropy over (exposure, gain) under normal light and sun, the auto-adjust search path, frames before / after", run_entropy_maps},
       {"global_figures", "paper 000 figures 7 and 9 (grid-sample errors, RPROP traces) and an MCL particle-cloud sequence", run_global_figures},
+      {"cooperative_001",
+       "paper 001 simulation: Hough-space ball fix by 5 robots over a lossy network (equal vs 1/L weights, error vs robot count), "
+       "FBPF vs MFBPF growth model, trackers on the fixes (scenarios/experiments/cooperative_001.json)",
+       run_cooperative_001, validate_cooperative_001},
   };
   return list;
 }

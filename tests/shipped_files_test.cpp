@@ -1,9 +1,13 @@
-// Every scenario and sweep shipped in scenarios/ must validate (they are documentation too).
+// Every scenario, sweep and experiment description shipped in scenarios/ must validate (they are
+// documentation too).
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "core/error.hpp"
+#include "core/json_reader.hpp"
+#include "harness/experiment.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 
@@ -14,11 +18,25 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
   for (const auto& e : fs::recursive_directory_iterator(fs::path(OMNILOC_SOURCE_DIR) / "scenarios")) {
     if (e.path().extension() != ".json") continue;
     const bool sweep = e.path().parent_path().filename() == "sweeps";
+    const bool experiment = e.path().parent_path().filename() == "experiments";
     try {
-      if (sweep)
+      if (sweep) {
         omniloc::harness::load_sweep(e.path().string());
-      else
+      } else if (experiment) {
+        // An experiment's description file: validated by the experiment named in its "experiment" key.
+        std::ifstream in(e.path());
+        const omniloc::Json j = omniloc::Json::parse(in, nullptr, false);
+        const std::string name = j.is_object() && j.contains("experiment") && j["experiment"].is_string() ? j["experiment"].get<std::string>() : "";
+        bool found = false;
+        for (const auto& x : omniloc::harness::experiments())
+          if (x.name == name && x.validate) {
+            x.validate(e.path().string());
+            found = true;
+          }
+        if (!found) ADD_FAILURE() << e.path() << ": no experiment \"" << name << "\" that validates description files";
+      } else {
         omniloc::harness::load_scenario(e.path().string());
+      }
     } catch (const omniloc::ConfigError& err) {
       ADD_FAILURE() << e.path() << ": " << err.what();
     }
