@@ -231,6 +231,36 @@ TEST(LandmarkGroups, LocalizerNoiseFreeTracksTheRobot) {
   }
 }
 
+TEST(LandmarkGroups, MemoryRecognisesAGroupAfterAGap) {
+  // Frame 0: both groups seen; frame 1: the blue landmark hidden (no group); frame 2: seen again.
+  for (const bool remember : {false, true}) {
+    GroupLocalizerParams p;
+    p.remember_groups = remember;
+    GroupLocalizer loc(Pose2(0, 0, 0), p);
+    loc.update(sight(kSquare, Pose2(0, 0, 0), {0, 1, 2, 3}), PlausibleRegion::everywhere());
+    EXPECT_TRUE(loc.update(sight(kSquare, Pose2(0.1, 0, 0), {0, 2, 3}), PlausibleRegion::everywhere()).groups.empty());
+    const Pose2 truth(0.2, 0.1, 0.3);
+    const auto r = loc.update(sight(kSquare, truth, {3, 2, 1, 0}), PlausibleRegion::everywhere());
+    ASSERT_EQ(r.groups.size(), 2u);
+    for (const auto& g : r.groups) {
+      if (remember) {
+        EXPECT_LT(g.id, 2);  // the groups of frame 0, with their coordinates
+        EXPECT_GE(g.previous, 0);
+      } else {
+        EXPECT_GE(g.id, 2);  // paper 003: only the previous frame counts, so they are new again
+        EXPECT_EQ(g.previous, -1);
+      }
+    }
+    if (remember) {
+      ASSERT_EQ(r.fixes.size(), 2u);
+      EXPECT_NEAR(r.estimate.x, truth.x, 1e-9);
+      EXPECT_NEAR(r.estimate.y, truth.y, 1e-9);
+    } else {
+      EXPECT_TRUE(r.fixes.empty());
+    }
+  }
+}
+
 TEST(LandmarkMapsExperiment, QuickRunWritesItsFiles) {
   namespace fs = std::filesystem;
   const harness::ExperimentInfo* info = nullptr;
@@ -248,8 +278,9 @@ TEST(LandmarkMapsExperiment, QuickRunWritesItsFiles) {
   ASSERT_EQ(info->run(args, out), 0);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_LT(secs, 20.0);
-  for (const char* f : {"landmark_maps.json", "maps_004.csv", "table1_004.json", "table1_004.md", "sim_003.json", "sim_003_paper.png",
-                        "sim_003_distractor.png", "map_two_circle_004.png", "map_three_point_004.png", "map_circle_intersection_003.png",
+  for (const char* f : {"landmark_maps.json", "maps_004.csv", "table1_004.json", "table1_004.md", "sim_003.json",
+                        "sim_003_paper_consecutive.png", "sim_003_paper_memory.png", "sim_003_distractor_consecutive.png",
+                        "sim_003_distractor_memory.png", "map_two_circle_004.png", "map_three_point_004.png", "map_circle_intersection_003.png",
                         "map_total_like.png"})
     EXPECT_TRUE(fs::exists(dir / f) && fs::file_size(dir / f) > 0) << f;
 
@@ -271,7 +302,7 @@ TEST(LandmarkMapsExperiment, QuickRunWritesItsFiles) {
   }
   std::ifstream sj(dir / "sim_003.json");
   const Json sim = Json::parse(sj);
-  for (const char* c : {"paper", "distractor"}) {
+  for (const char* c : {"paper_consecutive", "paper_memory", "distractor_consecutive", "distractor_memory"}) {
     const auto& a = sim[c]["all_paths"];
     EXPECT_GT(a["group_fixes"].get<int>(), 0) << c;
     EXPECT_TRUE(std::isfinite(a["voting_mean_m"].get<double>())) << c;

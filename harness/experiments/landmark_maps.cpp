@@ -374,8 +374,9 @@ std::vector<SimFrame> make_sim_frames(std::uint64_t seed, int waypoints, bool di
   return frames;
 }
 
-landmarks::GroupLocalizerParams sim_params(bool voting) {
+landmarks::GroupLocalizerParams sim_params(bool voting, bool remember) {
   landmarks::GroupLocalizerParams p;
+  p.remember_groups = remember;
   p.match.max_distance_diff = 2.0;
   p.match.max_angle_diff = deg2rad(45.0);
   p.use_voting = voting;
@@ -383,9 +384,9 @@ landmarks::GroupLocalizerParams sim_params(bool voting) {
 }
 constexpr double kSimRegionMargin = 1.0;  // metres
 
-SimStats run_sim(const std::vector<SimFrame>& frames) {
+SimStats run_sim(const std::vector<SimFrame>& frames, bool remember) {
   SimStats st;
-  landmarks::GroupLocalizer vote(Pose2(0, 0, 0), sim_params(true)), plain(Pose2(0, 0, 0), sim_params(false));
+  landmarks::GroupLocalizer vote(Pose2(0, 0, 0), sim_params(true, remember)), plain(Pose2(0, 0, 0), sim_params(false, remember));
   for (const SimFrame& fr : frames) {
     const auto region = landmarks::PlausibleRegion::from_path(vote.estimate().translation(), fr.goal, kSimRegionMargin);
     const auto rv = vote.update(fr.sightings, region);
@@ -454,8 +455,8 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
   const Field004 field;
   const auto& S = solvers();
   const double sigma_map = deg2rad(0.5);
-  const double cell_m = args.quick ? 0.2 : 0.05;
-  const int map_trials = args.quick ? 10 : 200;
+  const double cell_m = args.quick ? 0.2 : 0.1;
+  const int map_trials = args.quick ? 10 : 400;
   const int table_trials = args.quick ? 200 : 5000;
   const std::vector<double> table_sigmas_deg = {0.5, 2.0};
   const int sim_waypoints = args.quick ? 4 : 20;
@@ -605,7 +606,8 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
   out << "\n(c) Paper 003 simulation: landmarks (+-4, +-4) m (the paper's (+-40, +-40) read as decimetres), range 8 m, distance error "
          "U(-1, 1) m, bearing noise N(0, 1 deg); "
       << sim_paths << " random paths of " << sim_waypoints << " waypoints (path 0 plotted)\n";
-  out << "condition   | frames | group fixes: mean m  max m  (>1 m) | no voting: mean m  max m | voting: mean m  max m | kept last | forced\n";
+  out << "condition              | frames | group fixes: mean m   max m  (>1 m) | no voting: mean m  max m | voting: mean m  max m | kept last | "
+         "forced | new groups\n";
   Json sim_json{{"landmarks_m", {{-4, -4, "red"}, {-4, 4, "blue"}, {4, -4, "yellow"}, {4, 4, "red"}}},
                 {"range_m", 8.0},
                 {"distance_error", "uniform [-1, 1] m"},
@@ -616,23 +618,26 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
                 {"paths", sim_paths},
                 {"waypoints_per_path", sim_waypoints}};
   for (const bool distractor : {false, true}) {
-    const char* cname = distractor ? "distractor" : "paper";
-    SimStats all;
-    Json per_path = Json::array();
+    std::array<SimStats, 2> all;  // [remember_groups]
+    std::array<Json, 2> per_path = {Json::array(), Json::array()};
     for (int k = 0; k < sim_paths; ++k) {
+      // The same frames (truth, noise, distractor) for both ways of recognising groups.
       const auto frames = make_sim_frames(derive_seed(args.seed, fmt("sim003/path%d", k)), sim_waypoints, distractor);
-      const SimStats st = run_sim(frames);
-      per_path.push_back(sim_summary(st));
-      all.err_vote.insert(all.err_vote.end(), st.err_vote.begin(), st.err_vote.end());
-      all.err_novote.insert(all.err_novote.end(), st.err_novote.begin(), st.err_novote.end());
-      all.fix_errors.insert(all.fix_errors.end(), st.fix_errors.begin(), st.fix_errors.end());
-      all.frames += st.frames;
-      all.kept += st.kept;
-      all.forced += st.forced;
-      all.new_groups_vote += st.new_groups_vote;
-      all.new_groups_novote += st.new_groups_novote;
-      if (k == 0) {
-        Series sv{"voting", {}, st.err_vote}, sn{"no voting (mean of fixes)", {}, st.err_novote}, sw{"worst group fix", {}, {}};
+      for (const bool remember : {false, true}) {
+        const std::string cname = fmt("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
+        const SimStats st = run_sim(frames, remember);
+        SimStats& a = all[remember ? 1 : 0];
+        per_path[remember ? 1 : 0].push_back(sim_summary(st));
+        a.err_vote.insert(a.err_vote.end(), st.err_vote.begin(), st.err_vote.end());
+        a.err_novote.insert(a.err_novote.end(), st.err_novote.begin(), st.err_novote.end());
+        a.fix_errors.insert(a.fix_errors.end(), st.fix_errors.begin(), st.fix_errors.end());
+        a.frames += st.frames;
+        a.kept += st.kept;
+        a.forced += st.forced;
+        a.new_groups_vote += st.new_groups_vote;
+        a.new_groups_novote += st.new_groups_novote;
+        if (k != 0) continue;
+        Series sv{"voting", {}, st.err_vote}, sn{"no voting", {}, st.err_novote}, sw{"worst group fix", {}, {}};
         for (std::size_t i = 0; i < st.err_vote.size(); ++i) {
           sv.x.push_back(static_cast<double>(i));
           sn.x.push_back(static_cast<double>(i));
@@ -641,21 +646,25 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
             sw.y.push_back(st.worst_fix[i]);
           }
         }
-        dir.write(fmt("sim_003_%s.png", cname),
-                  png_bytes(line_plot({sw, sn, sv}, fmt("Paper 003 simulation (%s), path 0: position error", cname), "frame", "error m")));
+        dir.write("sim_003_" + cname + ".png",
+                  png_bytes(line_plot({sw, sn, sv}, "Paper 003 simulation, " + cname + ", path 0: position error", "frame", "error m")));
         Json series{{"truth", Json::array()}, {"err_vote_m", st.err_vote}, {"err_novote_m", st.err_novote}, {"worst_fix_m", Json::array()}};
         for (const auto& fr : frames) series["truth"].push_back({fr.truth.x, fr.truth.y, fr.truth.theta});
         for (double w : st.worst_fix) series["worst_fix_m"].push_back(num_or_null(w));
-        sim_json[std::string(cname) + "_path0"] = series;
+        sim_json[cname + "_path0"] = series;
       }
     }
-    const Json sum = sim_summary(all);
-    sim_json[cname] = {{"all_paths", sum}, {"per_path", per_path}};
-    out << fmt("%-11s | %6d | %10.3f %6.3f (%4ld) | %9.3f %6.3f | %7.3f %6.3f | %9d | %6d\n", cname, all.frames, mean_of(all.fix_errors),
-               max_of(all.fix_errors), static_cast<long>(sum["fixes_over_1m"].get<long>()), mean_of(all.err_novote), max_of(all.err_novote),
-               mean_of(all.err_vote), max_of(all.err_vote), all.kept, all.forced);
+    for (const bool remember : {false, true}) {
+      const std::string cname = fmt("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
+      const SimStats& a = all[remember ? 1 : 0];
+      const Json sum = sim_summary(a);
+      sim_json[cname] = {{"all_paths", sum}, {"per_path", per_path[remember ? 1 : 0]}};
+      out << fmt("%-22s | %6d | %10.3f %7.3f (%5ld) | %9.3f %6.3f | %7.3f %6.3f | %9d | %6d | %d\n", cname.c_str(), a.frames,
+                 mean_of(a.fix_errors), max_of(a.fix_errors), static_cast<long>(sum["fixes_over_1m"].get<long>()), mean_of(a.err_novote),
+                 max_of(a.err_novote), mean_of(a.err_vote), max_of(a.err_vote), a.kept, a.forced, a.new_groups_vote);
+    }
   }
-  dir.write("sim_003.json", sim_json.dump(1) + "\n");
+  dir.write("sim_003.json", sim_json.dump() + "\n");  // per-frame series: compact
 
   Json top{{"seed", args.seed},
            {"quick", args.quick},
@@ -663,7 +672,8 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
                           {"posts_cm", posts_cm_json(field)}, {"yellow_goal_x_cm", 0.0}, {"blue_goal_x_cm", 100 * field.length}}},
            {"maps", {{"cell_cm", 100 * cell_m}, {"cols", m.cols}, {"rows", m.rows}, {"trials_per_cell", map_trials},
                      {"bearing_sigma_deg", m.sigma_deg}, {"cap_cm", cap_cm}, {"solvers", maps_json}}},
-           {"files", {"maps_004.csv", "table1_004.json", "table1_004.md", "sim_003.json", "sim_003_paper.png", "sim_003_distractor.png"}}};
+           {"files", {"maps_004.csv", "table1_004.json", "table1_004.md", "sim_003.json", "sim_003_paper_consecutive.png", "sim_003_paper_memory.png",
+                      "sim_003_distractor_consecutive.png", "sim_003_distractor_memory.png"}}};
   dir.write("landmark_maps.json", top.dump(1) + "\n");
   dir.commit();
   out << "\nwritten: " << dir.final_dir() << "/{landmark_maps.json, maps_004.csv, map_*.png, table1_004.{json,md}, sim_003.json, sim_003_*.png}\n";

@@ -146,8 +146,8 @@ GroupFrameResult GroupLocalizer::update(std::span<const LandmarkSighting> sighti
   GroupFrameResult out;
   const std::vector<LandmarkGroup> groups = form_groups(sightings);
   std::vector<LandmarkGroup> prev;
-  prev.reserve(previous_.size());
-  for (const auto& t : previous_) prev.push_back(t.group);
+  prev.reserve(candidates_.size());
+  for (const auto& t : candidates_) prev.push_back(t.group);
   const std::vector<int> match = match_groups(prev, groups, params_.match);
 
   out.groups.resize(groups.size());
@@ -156,7 +156,7 @@ GroupFrameResult GroupLocalizer::update(std::span<const LandmarkSighting> sighti
     t.group = groups[i];
     t.previous = match[i];
     if (match[i] < 0) continue;
-    const TrackedGroup& p = previous_[static_cast<std::size_t>(match[i])];
+    const TrackedGroup& p = candidates_[static_cast<std::size_t>(match[i])];
     t.world = p.world;
     t.id = p.id;
     t.fix = group_fix(t.group, sightings, t.world);
@@ -175,12 +175,23 @@ GroupFrameResult GroupLocalizer::update(std::span<const LandmarkSighting> sighti
   out.estimate = estimate_;
 
   // New groups: global coordinates from the robot position just decided and this frame's sightings.
+  std::vector<TrackedGroup> new_memory;
   for (TrackedGroup& t : out.groups) {
     if (t.previous >= 0) continue;
     for (std::size_t k = 0; k < 3; ++k) t.world[k] = estimate_.transform(sightings[t.group.member[k]].relative());
     t.id = next_id_++;
+    if (params_.remember_groups) {
+      // Remembered with the feature of its global coordinates (equal to the sighted one: a rigid motion).
+      TrackedGroup m = t;
+      m.group.feature = group_feature(t.world[0], t.world[1], t.world[2]);
+      m.fix = Fix();
+      new_memory.push_back(std::move(m));
+    }
   }
-  previous_ = out.groups;
+  if (params_.remember_groups)
+    candidates_.insert(candidates_.end(), new_memory.begin(), new_memory.end());
+  else
+    candidates_ = out.groups;
   return out;
 }
 

@@ -163,6 +163,13 @@ struct GroupLocalizerParams {
   /// false: no voting and no plausibility check; the estimate is the mean of the frame's fixes (the
   /// last estimate when there are none). For comparing with and without paper 003's voting.
   bool use_voting = true;
+  /// false (paper 003): a group is recognised only when it matches a group of the previous frame, so a
+  /// group seen again after a gap (out of range, a missed match) gets new global coordinates from the
+  /// current estimate, and estimate errors accumulate with every such restart.
+  /// true (our extension): every group ever given coordinates is remembered and the current groups are
+  /// matched against all of them (feature from the stored coordinates: the same rigid configuration),
+  /// so a group seen again keeps the coordinates it got when first seen.
+  bool remember_groups = false;
 };
 
 /// A group of the current frame with its global landmark coordinates.
@@ -170,7 +177,8 @@ struct TrackedGroup {
   LandmarkGroup group;
   std::array<Eigen::Vector2d, 3> world{};  ///< metres, global frame: landmarks 1, 2, 3
   int id = -1;                             ///< the same across matched frames; new groups get new ids
-  int previous = -1;                       ///< index in the previous frame's groups, -1 when new
+  int previous = -1;                       ///< index of the group matched (in the previous frame's groups, or
+                                           ///< in the memory with remember_groups), -1 when new
   Fix fix;                                 ///< this frame's fix (only for matched groups; !ok otherwise)
 };
 
@@ -181,7 +189,8 @@ struct GroupFrameResult {
   Pose2 estimate;            ///< the robot position after this frame
 };
 
-/// The whole of paper 003's scheme, frame by frame: form groups, match them with the previous frame,
+/// The whole of paper 003's scheme, frame by frame: form groups, match them with the previous frame
+/// (or with every group seen so far, remember_groups),
 /// fix each matched group from its carried global coordinates and this frame's bearings, vote (or
 /// average), then give unmatched (new) groups global coordinates from the new estimate and this
 /// frame's sightings (distance and bearing). A group seen for the first time gives no fix. The global
@@ -196,7 +205,7 @@ class GroupLocalizer {
   GroupLocalizerParams params_;
   FixVoter voter_;
   Pose2 estimate_;
-  std::vector<TrackedGroup> previous_;
+  std::vector<TrackedGroup> candidates_;  ///< the previous frame's groups, or every group seen (remember_groups)
   int next_id_ = 0;
 };
 
