@@ -2,6 +2,7 @@
 #include "harness/experiments/cooperative_001.hpp"
 #include "harness/experiments/entropy_maps.hpp"
 #include "harness/experiments/global_figures.hpp"
+#include "harness/experiments/landmark_maps.hpp"
 
 // Add an experiment: include its header and append one line to the list below.
 
@@ -15,6 +16,7 @@ const std::vector<ExperimentInfo>& experiments() {
        "paper 001 simulation: Hough-space ball fix by 5 robots over a lossy network (equal vs 1/L weights, error vs robot count), "
        "FBPF vs MFBPF growth model, trackers on the fixes (scenarios/experiments/cooperative_001.json)",
        run_cooperative_001, validate_cooperative_001},
+      {"landmark_maps", "paper 004 solver error maps and table 1, paper 003 landmark groups with voting (simulation)", run_landmark_maps},
   };
   return list;
 }

@@ -20,6 +20,7 @@ Image constant(int w, int h, std::uint8_t v) {
 ExposureParams enabled() {
   ExposureParams p;
   p.enabled = true;
+  p.search_at_start = false;  // the tests below script the lighting change themselves
   return p;
 }
 
@@ -150,4 +151,15 @@ TEST(ExposureControl, DisabledNeverChangesTheSettings) {
     EXPECT_FALSE(d.searching);
     EXPECT_DOUBLE_EQ(d.settings.gain, 18.0);
   }
+}
+
+TEST(ExposureControl, SearchesOnceAtStartByDefault) {
+  ExposureParams p;
+  p.enabled = true;  // search_at_start defaults to true: the robot adjusts once when it starts
+  ExposureController c(p, CameraSettings{18.0, 18.0});
+  const int end = drive(c, [](double g) { return 10.0 - 0.01 * (g - 12.0) * (g - 12.0); }, [](double) { return 200.0; }, 300);
+  ASSERT_GE(end, 0);
+  EXPECT_NEAR(c.current().gain, 12.0, 0.5);
+  EXPECT_EQ(c.searches(), 1);
+  for (int k = end + 1; k < end + 200; ++k) EXPECT_FALSE(c.update(k / 30.0, 200.0, -1.0).searching);  // steady afterwards
 }

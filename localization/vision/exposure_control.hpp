@@ -27,7 +27,7 @@ struct ExposureParams {
   double min_step = 0.5;            ///< search ends when the step falls below this
   int max_steps = 24;               ///< hard bound on settings tried per search (reported when hit)
   double settle_s = 0.04;           ///< s a new setting needs before its frame counts (paper: ~40 ms)
-  bool search_at_start = false;     ///< also search on the first frame
+  bool search_at_start = true;      ///< also search on the first frame (the robot adjusts once when it starts)
   static ExposureParams from_json(JsonReader& r);
 };
 
