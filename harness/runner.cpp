@@ -290,6 +290,19 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
       }
       rj["line_points"] = {{"mean", tr.rows.empty() ? 0.0 : pts / tr.rows.size()}, {"min", min_pts}};
       rj["coasting_frames"] = coasting;
+      // Failures stated, not averaged away: how often the localizer gave up its pose, and how many
+      // valid frames were wrong (over 0.5 m or 0.35 rad) or point-mirrored (compass turned round).
+      std::size_t restarts = 0, wrong = 0, mirrored = 0;
+      for (const auto& r : tr.rows) {
+        restarts += r.mode == "restart";
+        if (!r.valid) continue;
+        const double ep = std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y), et = std::fabs(angle_diff(r.est.theta, r.truth.theta));
+        wrong += ep > 0.5 || et > 0.35;
+        mirrored += std::hypot(r.est.x + r.truth.x, r.est.y + r.truth.y) < 0.5 && std::fabs(angle_diff(r.est.theta, r.truth.theta + kPi)) < 0.35 && ep > 0.5;
+      }
+      rj["relocalisations"] = restarts;
+      rj["wrong_frames"] = wrong;
+      rj["mirrored_frames"] = mirrored;
     }
     // Kidnap episodes of this robot: from each kidnap's uncovering to the next kidnap or the end.
     std::vector<Episode> episodes;

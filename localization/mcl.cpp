@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <unordered_set>
 
 #include "localization/matching.hpp"
 
@@ -25,6 +27,12 @@ McLParams McLParams::from_json(JsonReader& r) {
   p.alpha_slow = r.number("alpha_slow", p.alpha_slow, 0.0, 1.0);
   p.alpha_fast = r.number("alpha_fast", p.alpha_fast, 0.0, 1.0);
   p.cell = r.number("cell", p.cell, 0.005, 0.5);
+  p.kld = r.boolean("kld", p.kld);
+  p.kld_epsilon = r.positive("kld_epsilon", p.kld_epsilon, 1.0);
+  p.kld_z = r.positive("kld_z", p.kld_z, 10.0);
+  p.kld_bin_xy = r.positive("kld_bin_xy", p.kld_bin_xy, 10.0);
+  p.kld_bin_theta = r.positive("kld_bin_theta", p.kld_bin_theta, 3.2);
+  p.kld_min_particles = static_cast<int>(r.integer("kld_min_particles", p.kld_min_particles, 1, 100000));
   return p;
 }
 
@@ -52,6 +60,33 @@ void McLLocalizer::init_uniform(std::optional<double> heading) {
     ps_.push_back({Pose2(rng_.uniform(-hx, hx), rng_.uniform(-hy, hy), th), 0.0});
   }
   initialised_ = true;
+}
+
+std::vector<McLLocalizer::Particle> McLLocalizer::kld_resample(const std::vector<double>& w, double sum) {
+  // Fox 2003: draw one particle at a time (with replacement, by weight) and count the histogram bins
+  // they fall in; stop once n >= (k - 1) / (2 eps) * (1 - 2 / (9 (k - 1)) + sqrt(2 / (9 (k - 1))) z)^3.
+  std::vector<double> cum(w.size());
+  double acc = 0;
+  for (std::size_t i = 0; i < w.size(); ++i) cum[i] = (acc += w[i]);
+  std::vector<Particle> next;
+  std::unordered_set<std::uint64_t> bins;
+  const int max_n = p_.particles;
+  for (int m = 0; m < max_n; ++m) {
+    const double u = rng_.uniform(0, sum);
+    const std::size_t i = std::min(w.size() - 1, static_cast<std::size_t>(std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()));
+    const Pose2& q = ps_[i].pose;
+    next.push_back({q, 0.0});
+    const auto bx = static_cast<std::int64_t>(std::floor(q.x / p_.kld_bin_xy)), by = static_cast<std::int64_t>(std::floor(q.y / p_.kld_bin_xy));
+    const auto bt = static_cast<std::int64_t>(std::floor(wrap_angle(q.theta) / p_.kld_bin_theta));
+    bins.insert((static_cast<std::uint64_t>(bx & 0xFFFFF) << 40) | (static_cast<std::uint64_t>(by & 0xFFFFF) << 20) | static_cast<std::uint64_t>(bt & 0xFFFFF));
+    const double k = static_cast<double>(bins.size());
+    if (k > 1 && static_cast<int>(next.size()) >= p_.kld_min_particles) {
+      const double a = 2.0 / (9.0 * (k - 1));
+      const double bound = (k - 1) / (2 * p_.kld_epsilon) * std::pow(1 - a + std::sqrt(a) * p_.kld_z, 3);
+      if (static_cast<double>(next.size()) >= bound) break;
+    }
+  }
+  return next;
 }
 
 Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std::optional<double> heading) {
@@ -98,6 +133,9 @@ Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std:
       w_fast_ += p_.alpha_fast * (mean_lik - w_fast_);
       inject = w_slow_ > 0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
     }
+    if (p_.kld) {
+      ps_ = kld_resample(w, sum);
+    } else {
     // Low-variance resampling.
     std::vector<Particle> next;
     next.reserve(ps_.size());
@@ -116,6 +154,7 @@ Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std:
       next.push_back({ps_[i].pose, 0.0});
     }
     ps_ = std::move(next);
+    }
   }
   // Estimate: mean position and circular mean heading; spread decides convergence.
   double mx = 0, my = 0, sc = 0, ss = 0;

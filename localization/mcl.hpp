@@ -29,6 +29,16 @@ struct McLParams {
   double converged_std = 0.15;    ///< m: position spread below this = converged
   double converged_theta_std = 0.1;  ///< rad
   double alpha_slow = 0.0, alpha_fast = 0.0;  ///< augmented MCL (0 = off)
+  // KLD-adaptive sample size (Fox 2003; ROS amcl's pf_err / pf_z), off by default: particles are drawn
+  // until their number bounds the KL distance between the sample and the true posterior by
+  // kld_epsilon with probability given by kld_z (upper standard-normal quantile), histogram bins of
+  // kld_bin_xy x kld_bin_xy x kld_bin_theta, between kld_min_particles and `particles`.
+  bool kld = false;
+  double kld_epsilon = 0.05;      ///< amcl pf_err
+  double kld_z = 2.326;           ///< amcl pf_z = 0.99
+  double kld_bin_xy = 0.5;        ///< m (amcl: 0.5 m)
+  double kld_bin_theta = 0.1745;  ///< rad (amcl: 10 degrees)
+  int kld_min_particles = 100;
   double cell = 0.05;
   static McLParams from_json(JsonReader& r);
 };
@@ -50,6 +60,7 @@ class McLLocalizer : public Localizer {
 
  private:
   void init_uniform(std::optional<double> heading);
+  std::vector<Particle> kld_resample(const std::vector<double>& w, double sum);
   McLParams p_;
   Field field_;
   FieldMap map_;

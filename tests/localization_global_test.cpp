@@ -172,3 +172,25 @@ TEST(WrongLocalisation, AndRuleNeedsBothConditionsSingleWindowsNeedOne) {
   WrongLocalisationDetector s(strict);
   for (int k = 0; k < 100; ++k) EXPECT_FALSE(s.update(0.01, pose, kPi));  // misses the mirror, as the paper's AND does
 }
+
+TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
+  const Field f = Field::preset("msl2012");
+  Rng world(31);
+  McLParams p;
+  p.kld = true;
+  McLLocalizer mcl(f, p, 7, "");
+  mcl.reset(std::nullopt);
+  const Pose2 truth(2.5, -1.5, 1.0);
+  Estimate e;
+  double first_n = 0;
+  for (int k = 0; k < 40; ++k) {
+    e = mcl.update(see(f, truth, world), Odometry{}, truth.theta + world.normal(0, 0.02));
+    if (k == 0) first_n = e.extra.at("particles");
+  }
+  EXPECT_TRUE(mcl.converged());
+  EXPECT_LT(std::hypot(e.pose.x - truth.x, e.pose.y - truth.y), 0.5);
+  // Spread over the field the bound needs (nearly) all 600; concentrated, a few hundred at most.
+  EXPECT_GE(first_n, 300.0);
+  EXPECT_LE(e.extra.at("particles"), 300.0);
+  EXPECT_GE(e.extra.at("particles"), p.kld_min_particles);
+}

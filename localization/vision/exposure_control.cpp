@@ -13,7 +13,8 @@ ExposureParams ExposureParams::from_json(JsonReader& r) {
   p.b = r.number("b", p.b, -100.0, 100.0);
   p.change_threshold = r.positive("change_threshold", p.change_threshold, 255.0);
   p.confirm_frames = static_cast<int>(r.integer("confirm_frames", p.confirm_frames, 1, 1000));
-  p.initial_step = r.positive("initial_step", p.initial_step, 100.0);
+  p.coarse_ratio = r.number("coarse_ratio", p.coarse_ratio, 1.01, 4.0);
+  p.patience = static_cast<int>(r.integer("patience", p.patience, 1, 20));
   p.min_step = r.positive("min_step", p.min_step, 100.0);
   p.max_steps = static_cast<int>(r.integer("max_steps", p.max_steps, 1, 1000));
   p.settle_s = r.number("settle_s", p.settle_s, 0.0, 10.0);
@@ -45,9 +46,13 @@ void ExposureController::start(double t, double change, double entropy) {
   steps_ = 0;
   best_g_ = cur_.gain;
   best_h_ = entropy;
-  step_ = p_.initial_step;
+  step_ = p_.min_step;
   dir_ = change > 0 ? -1 : 1;  // brighter than saved: less exposure and gain first
   tried_other_ = false;
+  coarse_ = true;
+  flipped_ = improved_ = false;
+  fails_ = 0;
+  last_g_ = best_g_;
   path_.assign(1, {best_g_, best_h_});
   settled_at_ = t;
 }
@@ -65,7 +70,6 @@ void ExposureController::fail() {
 void ExposureController::propose(double t, double g, ExposureDecision& d) {
   std::vector<std::string> w;
   const CameraSettings s = on_line(g, &w);
-  probe_g_ = s.gain;
   cur_ = s;
   ++steps_;
   settled_at_ = t + p_.settle_s;
@@ -84,7 +88,7 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     if (first && p_.search_at_start) {
       start(t, 0.0, entropy);
       d.event = "search_start (first frame)";
-      propose(t, best_g_ + dir_ * step_, d);
+      propose(t, next_probe(), d);
       d.settings = cur_;
       d.searching = true;
       return d;
@@ -125,18 +129,35 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     path_.assign(1, {g, entropy});
   } else {
     path_.push_back({g, entropy});
-    if (entropy > best_h_) {
+    const bool better = entropy > best_h_;
+    if (better) {
       best_h_ = entropy;
       best_g_ = g;
+    }
+    if (coarse_) {
+      // Coarse phase: geometric steps in one direction; a plateau or a local dip (clipping makes the
+      // curve step-shaped) is crossed by allowing `patience` worse probes before giving up.
+      if (better) {
+        improved_ = true;
+        fails_ = 0;
+      } else {
+        ++fails_;
+      }
+      last_g_ = g;
+      if (fails_ >= p_.patience) end_coarse_direction();
+    } else if (better) {
       tried_other_ = true;  // the other side is where we came from, known to be worse
     } else {
       fail();
     }
   }
-  // Probes that the camera's range clamps onto the best setting are failures without a frame.
-  while (step_ >= p_.min_step && on_line(best_g_ + dir_ * step_).gain == best_g_) {
-    d.warnings.push_back("exposure search reached the camera's range limit at gain " + std::to_string(best_g_));
-    fail();
+  // Probes that the camera's range clamps onto a measured setting are skipped (with a warning).
+  for (int guard = 0; guard < 8 && (coarse_ || step_ >= p_.min_step); ++guard) {
+    const double next = on_line(next_probe()).gain;
+    if (next != (coarse_ ? last_g_ : best_g_)) break;
+    d.warnings.push_back("exposure search reached the camera's range limit at gain " + std::to_string(next));
+    if (coarse_) end_coarse_direction();
+    else fail();
   }
   if (step_ < p_.min_step || steps_ >= p_.max_steps) {
     if (steps_ >= p_.max_steps) {
@@ -155,9 +176,28 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     d.searching = false;
     return d;
   }
-  propose(t, best_g_ + dir_ * step_, d);
+  propose(t, next_probe(), d);
   d.settings = cur_;
   return d;
+}
+
+double ExposureController::next_probe() const {
+  if (coarse_) return dir_ > 0 ? last_g_ * p_.coarse_ratio : last_g_ / p_.coarse_ratio;
+  return best_g_ + dir_ * step_;
+}
+
+void ExposureController::end_coarse_direction() {
+  fails_ = 0;
+  if (!improved_ && !flipped_) {  // nothing better this way: search the other way from the start
+    flipped_ = true;
+    dir_ = -dir_;
+    last_g_ = best_g_;
+    return;
+  }
+  // Fine phase around the best: steps of half a coarse step, both sides, halving.
+  coarse_ = false;
+  step_ = std::max(p_.min_step, 0.5 * best_g_ * (p_.coarse_ratio - 1.0));
+  tried_other_ = false;
 }
 
 }  // namespace omniloc

@@ -23,8 +23,9 @@ struct ExposureParams {
   double gain_min = 1.0, gain_max = 60.0;
   double change_threshold = 12.0;   ///< grey levels of body brightness against the saved value
   int confirm_frames = 2;           ///< that many frames in a row before a search (noise, passing shadows)
-  double initial_step = 4.0;        ///< gain units
-  double min_step = 0.5;            ///< search ends when the step falls below this
+  double coarse_ratio = 1.25;       ///< coarse phase: each probe multiplies (or divides) the gain by this
+  int patience = 2;                 ///< coarse phase: worse probes in a row before a direction is given up
+  double min_step = 0.5;            ///< fine phase (additive, halving) ends below this step, gain units
   int max_steps = 24;               ///< hard bound on settings tried per search (reported when hit)
   double settle_s = 0.04;           ///< s a new setting needs before its frame counts (paper: ~40 ms)
   bool search_at_start = true;      ///< also search on the first frame (the robot adjusts once when it starts)
@@ -60,15 +61,20 @@ class ExposureController {
   void start(double t, double brightness_change, double entropy);
   void propose(double t, double g, ExposureDecision& d);
   void fail();
+  double next_probe() const;
+  void end_coarse_direction();
   ExposureParams p_;
   CameraSettings cur_;
   State state_ = State::Idle;
   bool first_ = true;
   double saved_brightness_ = -1.0;
   int over_ = 0, searches_ = 0, steps_ = 0;
-  double best_g_ = 0, best_h_ = 0, step_ = 0, probe_g_ = 0, settled_at_ = 0;
+  double best_g_ = 0, best_h_ = 0, step_ = 0, settled_at_ = 0;
   int dir_ = 1;
   bool tried_other_ = false;
+  bool coarse_ = true, flipped_ = false, improved_ = false;
+  int fails_ = 0;
+  double last_g_ = 0;
   std::vector<std::pair<double, double>> path_;
 };
 
