@@ -98,6 +98,9 @@ TEST_F(BlobsTest, ArenaFieldHasTheFourCubesOfPaper003) {
   EXPECT_DOUBLE_EQ(arena_->width, 8.0);
   EXPECT_TRUE(arena_->has_coloured_objects());
   EXPECT_FALSE(Field::preset("msl2012").has_coloured_objects());
+  // Fields without coloured objects keep their fingerprint (the committed caches are named by it).
+  EXPECT_EQ(Field::preset("msl2012").fingerprint(), "2a43db978ea6658f");
+  EXPECT_NE(arena_->fingerprint(), Field::preset("msl2012").fingerprint());
   const Field msl2007 = Field::preset("msl2007");
   ASSERT_EQ(msl2007.goals.size(), 2u);
   EXPECT_TRUE(msl2007.has_coloured_objects());
@@ -118,6 +121,7 @@ TEST_F(BlobsTest, OneBlobPerCubeWithBearingAndDistance) {
                                        [&](const Landmark& l) { return landmark_colour_class(l.colour) == c; });
     EXPECT_EQ(n_blobs, n_cubes) << colour_class_name(c);
   }
+  double worst_deg = 0, worst_rel = 0;
   for (const auto& l : arena_->landmarks) {
     const double truth = bearing_to(kPose, l.position);
     const Blob* best = nullptr;
@@ -131,7 +135,10 @@ TEST_F(BlobsTest, OneBlobPerCubeWithBearingAndDistance) {
     EXPECT_LT(std::fabs(best->distance - d_truth) / d_truth, 0.10) << l.id << ": " << best->distance << " m against " << d_truth;
     EXPECT_GT(best->area_px, 25);
     EXPECT_FALSE(best->left_occluded || best->right_occluded) << l.id;
+    worst_deg = std::max(worst_deg, std::fabs(rad2deg(angle_diff(best->bearing, truth))));
+    worst_rel = std::max(worst_rel, std::fabs(best->distance - d_truth) / d_truth);
   }
+  std::printf("cubes: worst bearing error %.3f deg, worst distance error %.1f %%\n", worst_deg, 100 * worst_rel);
 }
 
 TEST_F(BlobsTest, NoisyCameraStillFindsTheCubes) {

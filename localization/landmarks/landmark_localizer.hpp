@@ -27,7 +27,8 @@
 // A frame without a fix is reported honestly: valid = false, mode "no_fix" and the reason code in
 // extra["no_fix_reason"] (see NoFixReason), the running count in extra["no_fix_total"]. With
 // odometry_prediction on, such a frame instead reports the last pose moved by odometry (mode
-// "odometry", valid) for up to max_prediction_time seconds after the last fix.
+// "odometry", valid) for up to max_prediction_time seconds after the last fix. The compass / MTi
+// heading is not used (papers 004 and 003 have none); the camera's latency is not compensated.
 #include <optional>
 #include <string>
 #include <vector>

@@ -1,6 +1,7 @@
 #include "localization/vision/blobs.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -27,7 +28,7 @@ std::vector<ColourClass> to_classes(const std::vector<std::string>& names) {
 // Per-region accumulators.
 struct Region {
   double ref = 0.0;                 // reference bearing (centroid), radians
-  double dmin = 0.0, dmax = 0.0;    // extent relative to ref, radians (pixel edges included)
+  double dmin = 0.0, dmax = 0.0;    // extent relative to ref, radians
   float rmin = std::numeric_limits<float>::max(), rmax = 0.0f;
   int imin = -1;                    // pixel index of the nearest pixel
 };
@@ -41,6 +42,7 @@ BlobParams BlobParams::from_json(JsonReader& r) {
   p.min_area_px = static_cast<int>(r.integer("min_area_px", 25, 1, 1000000));
   p.outer_radius_px = r.number("outer_radius_px", 0.0, 0.0, 100000.0);
   p.dark_mean = r.number("dark_mean", 15.0, 0.0, 255.0);
+  p.edge_extend_px = r.number("edge_extend_px", 0.0, 0.0, 10.0);
   p.edge_band_px = static_cast<int>(r.integer("edge_band_px", 3, 1, 50));
   p.occluded_fraction = r.number("occluded_fraction", 0.3, 0.0, 1.0);
   p.edge_contact_deg = r.number("edge_contact_deg", 1.5, 0.0, 45.0);
@@ -85,13 +87,34 @@ std::vector<Blob> BlobDetector::detect(const Image& img) const {
   if (img.width != w_ || img.height != h_ || img.rgb.size() < 3 * inside_.size()) return out;
   if (mean_grey(img) < p_.dark_mean) return out;
 
-  // Classify the annulus once; everything outside it stays kUnknown.
+  // Classify the annulus once (everything outside it stays kUnknown), noting each wanted colour's
+  // bounding box so connected components run on that box only (cubes are small).
   cv::Mat cls(h_, w_, CV_8U, cv::Scalar(0));
+  std::array<bool, 256> wanted{};
+  for (const ColourClass c : p_.colours) wanted[c] = true;
+  std::array<int, 256> bx0, by0, bx1, by1;
+  bx0.fill(w_);
+  by0.fill(h_);
+  bx1.fill(-1);
+  by1.fill(-1);
   {
     std::uint8_t* dst = cls.ptr<std::uint8_t>(0);
     const std::uint8_t* src = img.rgb.data();
-    for (std::size_t i = 0; i < inside_.size(); ++i)
-      if (inside_[i]) dst[i] = table_.classify(src + 3 * i);
+    for (int v = 0; v < h_; ++v) {
+      const std::size_t row = static_cast<std::size_t>(v) * w_;
+      for (int u = 0; u < w_; ++u) {
+        const std::size_t i = row + u;
+        if (!inside_[i]) continue;
+        const std::uint8_t c = table_.classify(src + 3 * i);
+        dst[i] = c;
+        if (wanted[c]) {
+          bx0[c] = std::min(bx0[c], u);
+          bx1[c] = std::max(bx1[c], u);
+          by0[c] = std::min(by0[c], v);
+          by1[c] = std::max(by1[c], v);
+        }
+      }
+    }
   }
   const Eigen::Vector2d c = map_.centre();
   auto class_at = [&](double r, double b) -> int {
@@ -126,25 +149,29 @@ std::vector<Blob> BlobDetector::detect(const Image& img) const {
 
   cv::Mat mask, labels, stats, centroids;
   for (const ColourClass colour : p_.colours) {
-    cv::compare(cls, cv::Scalar(colour), mask, cv::CMP_EQ);
+    if (bx1[colour] < 0) continue;  // no pixel of this colour
+    const cv::Rect roi(bx0[colour], by0[colour], bx1[colour] - bx0[colour] + 1, by1[colour] - by0[colour] + 1);
+    cv::compare(cls(roi), cv::Scalar(colour), mask, cv::CMP_EQ);
     const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
     const bool edges = std::find(p_.edge_colours.begin(), p_.edge_colours.end(), colour) != p_.edge_colours.end();
     for (int k = 1; k < n; ++k) {
       const int area = stats.at<int>(k, cv::CC_STAT_AREA);
       if (area < p_.min_area_px) continue;
+      // Image coordinates = ROI coordinates + (ox, oy).
+      const int ox = roi.x, oy = roi.y;
       const int x0 = stats.at<int>(k, cv::CC_STAT_LEFT), y0 = stats.at<int>(k, cv::CC_STAT_TOP);
       const int x1 = x0 + stats.at<int>(k, cv::CC_STAT_WIDTH), y1 = y0 + stats.at<int>(k, cv::CC_STAT_HEIGHT);
       Region g;
-      g.ref = std::atan2(-(centroids.at<double>(k, 0) + 0.5 - c.x()), -(centroids.at<double>(k, 1) + 0.5 - c.y()));
+      g.ref = std::atan2(-(centroids.at<double>(k, 0) + ox + 0.5 - c.x()), -(centroids.at<double>(k, 1) + oy + 0.5 - c.y()));
       g.dmin = std::numeric_limits<double>::max();
       g.dmax = std::numeric_limits<double>::lowest();
       for (int v = y0; v < y1; ++v) {
         const int* lab = labels.ptr<int>(v);
         for (int u = x0; u < x1; ++u) {
           if (lab[u] != k) continue;
-          const std::size_t i = static_cast<std::size_t>(v) * w_ + u;
+          const std::size_t i = static_cast<std::size_t>(v + oy) * w_ + (u + ox);
           const double d = wrap_angle(bearing_[i] - g.ref);
-          const double half = 0.5 / radius_[i];  // half a pixel, in radians at this radius
+          const double half = p_.edge_extend_px / radius_[i];  // pixels to radians at this radius
           g.dmin = std::min(g.dmin, d - half);
           g.dmax = std::max(g.dmax, d + half);
           if (radius_[i] < g.rmin) {
@@ -174,7 +201,7 @@ std::vector<Blob> BlobDetector::detect(const Image& img) const {
         const int* lab = labels.ptr<int>(v);
         for (int u = x0; u < x1; ++u) {
           if (lab[u] != k) continue;
-          const std::size_t i = static_cast<std::size_t>(v) * w_ + u;
+          const std::size_t i = static_cast<std::size_t>(v + oy) * w_ + (u + ox);
           const double d = wrap_angle(bearing_[i] - g.ref);
           if (d >= g.dmax - band && radius_[i] < rl) {
             rl = radius_[i];

@@ -40,6 +40,11 @@ struct BlobParams {
   /// measured (far goals sit near the mirror rim) but distances are not.
   double outer_radius_px = 0.0;
   double dark_mean = 15.0;       ///< mean grey of the annulus below this: camera covered, no blobs
+  /// The angular extent runs between the outermost region pixels' centres, widened by this many
+  /// pixels on each side. 0 by measurement: mixed pixels along an edge mostly classify as the
+  /// object's colour, so the outermost centres already lie on the edge (0.5 gave 0.1-0.13 degrees
+  /// too wide an extent on the rendered goals and cubes, ~0.5 px).
+  double edge_extend_px = 0.0;
   int edge_band_px = 3;          ///< pixels beyond an edge checked for an occluder
   double occluded_fraction = 0.3;  ///< fraction of those pixels that must be black (or off-image)
   double edge_contact_deg = 1.5;   ///< an edge's distance: nearest region pixel within this angle of it
