@@ -338,3 +338,45 @@ TEST(BlobsGoalTest, GoalEdgesAndPoseOnTheLegacyField) {
     EXPECT_LT(std::fabs(angle_diff(e.pose.theta, pose.theta)), 0.05);
   }
 }
+
+// Between fixes: odometry moves the last pose; reported only when asked for, and only for
+// max_prediction_time seconds.
+TEST(LandmarkLocalizerTest, OdometryPredictionBetweenFixes) {
+  const Field field = Field::preset("arena_10x8");
+  const Pose2 truth(-1.0, 1.5, -0.7);
+  std::vector<Blob> blobs;
+  for (const auto& l : field.landmarks) {
+    Blob b;
+    b.colour = landmark_colour_class(l.colour);
+    b.bearing = bearing_to(truth, l.position);
+    b.area_px = 200;
+    blobs.push_back(b);
+  }
+  LandmarkLocalizerParams p;
+  p.odometry_prediction = true;
+  p.max_prediction_time = 0.25;
+  LandmarkLocalizer loc(field, p);
+  loc.reset(std::nullopt);
+  Observations obs;
+  obs.blobs = blobs;
+  const Estimate fix = loc.update(obs, Odometry{}, std::nullopt);
+  ASSERT_TRUE(fix.valid);
+  EXPECT_LT((fix.pose.translation() - truth.translation()).norm(), 1e-6);
+  Odometry odo;
+  odo.delta = Pose2(0.1, 0.0, 0.0);
+  obs.blobs.clear();
+  for (int k = 1; k <= 3; ++k) {
+    obs.t = 0.1 * k;
+    const Estimate e = loc.update(obs, odo, std::nullopt);
+    const Pose2 expect = truth.compose(Pose2(0.1 * k, 0.0, 0.0));
+    EXPECT_LT((e.pose.translation() - expect.translation()).norm(), 1e-6) << k;
+    EXPECT_EQ(e.extra.at("no_fix_reason"), static_cast<double>(NoFixReason::kTooFewLandmarks));
+    if (k <= 2) {
+      EXPECT_TRUE(e.valid) << k;
+      EXPECT_EQ(e.mode, "odometry");
+    } else {
+      EXPECT_FALSE(e.valid) << "0.3 s after the fix, beyond max_prediction_time";
+      EXPECT_EQ(e.mode, "no_fix");
+    }
+  }
+}
