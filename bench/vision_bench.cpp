@@ -4,6 +4,7 @@
 
 #include "core/field.hpp"
 #include "harness/vision_setup.hpp"
+#include "localization/vision/blobs.hpp"
 #include "localization/vision/scan_lines.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
@@ -31,3 +32,29 @@ static void BM_LinePointExtraction(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(points);
 }
 BENCHMARK(BM_LinePointExtraction)->Unit(benchmark::kMicrosecond);
+
+// Blob detection on a frame of paper 003's cube arena (four cubes in view): classify the annulus,
+// connected components per colour (yellow, blue, red), bearings / edges / contact distances.
+static void BM_BlobDetection(benchmark::State& state) {
+  sim::CameraConfig cfg;
+  const Field field = Field::preset("arena_10x8");
+  sim::PanoramicCamera cam(cfg, field);
+  const CalibrationMap map = harness::calibrate_camera(cfg, 1).map;
+  const ColourTable table = harness::colour_calibrate(cfg, field, 1, 6);
+  const BlobDetector det(BlobParams{}, map, table);
+  sim::WorldState w;
+  w.has_ball = false;
+  sim::RobotState me;
+  me.pose = Pose2(1.0, 0.5, 0.4);
+  w.robots.push_back(me);
+  Rng rng(1);
+  const Image img = cam.render(w, 0, cfg.initial, rng);
+  std::size_t blobs = 0;
+  for (auto _ : state) {
+    const std::vector<Blob> b = det.detect(img);
+    blobs = b.size();
+    benchmark::DoNotOptimize(b.data());
+  }
+  state.counters["blobs"] = static_cast<double>(blobs);
+}
+BENCHMARK(BM_BlobDetection)->Unit(benchmark::kMicrosecond);

@@ -52,6 +52,13 @@ bool Field::inside_floor(const Eigen::Vector2d& p, double clearance) const {
   return std::fabs(p.x()) <= half_floor_x() - clearance && std::fabs(p.y()) <= half_floor_y() - clearance;
 }
 
+bool Field::has_coloured_objects() const {
+  if (!landmarks.empty()) return true;
+  for (const auto& g : goals)
+    if (g.colour != "white") return true;
+  return false;
+}
+
 std::string Field::fingerprint() const {
   std::ostringstream os;
   os.precision(9);
@@ -59,6 +66,12 @@ std::string Field::fingerprint() const {
   for (const auto& s : segments) os << "|s" << s.a.x() << ',' << s.a.y() << ',' << s.b.x() << ',' << s.b.y();
   for (const auto& a : arcs) os << "|a" << a.centre.x() << ',' << a.centre.y() << ',' << a.radius << ',' << a.start << ',' << a.sweep;
   for (const auto& s : spots) os << "|p" << s.centre.x() << ',' << s.centre.y() << ',' << s.radius;
+  // Coloured objects change what a colour table must learn and what landmark localizers use. Only
+  // they are hashed (white goals are not), so fields without them keep their fingerprints.
+  for (const auto& g : goals)
+    if (g.colour != "white") os << "|g" << g.goal_line_x << ',' << g.width << ',' << g.depth << ',' << g.height << ',' << g.post_width << ',' << g.colour;
+  for (const auto& l : landmarks)
+    os << "|l" << l.id << ',' << l.colour << ',' << l.shape << ',' << l.position.x() << ',' << l.position.y() << ',' << l.size << ',' << l.height;
   // FNV-1a to keep file names short.
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (char c : os.str()) {

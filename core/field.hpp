@@ -72,6 +72,9 @@ class Field {
   double half_floor_x() const { return 0.5 * length + margin; }
   double half_floor_y() const { return 0.5 * width + margin; }
   bool inside_floor(const Eigen::Vector2d& p, double clearance = 0.0) const;
+  /// True when the field has coloured goals (legacy field) or coloured landmarks: what blob
+  /// detection and landmark localizers work with.
+  bool has_coloured_objects() const;
   /// Stable fingerprint of the geometry: caches (distance maps, colour tables) are tagged with it.
   std::string fingerprint() const;
 

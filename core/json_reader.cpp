@@ -136,6 +136,35 @@ bool JsonReader::boolean(const std::string& key, std::optional<bool> def) {
   return v->get<bool>();
 }
 
+std::vector<std::string> JsonReader::strings(const std::string& key, std::optional<std::vector<std::string>> def,
+                                             const std::vector<std::string>& allowed) {
+  const Json* v = fetch(key, !def.has_value());
+  auto expected = [&] {
+    if (allowed.empty()) return std::string("an array of strings");
+    std::string e = "an array of strings, each one of ";
+    for (std::size_t i = 0; i < allowed.size(); ++i) e += (i ? ", \"" : "\"") + allowed[i] + "\"";
+    return e;
+  };
+  if (!v) {
+    record(key, *def);
+    return *def;
+  }
+  if (!v->is_array()) throw ConfigError(child_path(key), json_brief(*v), expected());
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < v->size(); ++i) {
+    const Json& e = (*v)[i];
+    bool ok = e.is_string();
+    if (ok && !allowed.empty()) {
+      ok = false;
+      for (const auto& a : allowed) ok = ok || a == e.get<std::string>();
+    }
+    if (!ok) throw ConfigError(json_child(child_path(key), i), json_brief(e), expected());
+    out.push_back(e.get<std::string>());
+  }
+  record(key, out);
+  return out;
+}
+
 std::string JsonReader::string(const std::string& key, std::optional<std::string> def,
                                const std::vector<std::string>& allowed) {
   const Json* v = fetch(key, !def.has_value());

@@ -46,6 +46,9 @@ class JsonReader {
   bool boolean(const std::string& key, std::optional<bool> def);
   std::string string(const std::string& key, std::optional<std::string> def,
                      const std::vector<std::string>& allowed = {});
+  /// Array of strings (any length), each one of `allowed` when that is not empty.
+  std::vector<std::string> strings(const std::string& key, std::optional<std::vector<std::string>> def,
+                                   const std::vector<std::string>& allowed = {});
   /// Fixed-length array of numbers.
   std::vector<double> numbers(const std::string& key, std::optional<std::vector<double>> def,
                               std::size_t length);

@@ -1,5 +1,6 @@
 #include "harness/camera_perception.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "harness/vision_setup.hpp"
@@ -21,6 +22,12 @@ VisionConfig VisionConfig::from_json(const Json& j, const std::string& path, Jso
     v.exposure = ExposureParams::from_json(*e);
     e->finish();
   }
+  if (auto b = r.object("blobs")) {
+    v.blobs_detect = b->string("detect", std::string("auto"), {"auto", "on", "off"});
+    v.blob_edge_colours_given = b->has("edge_colours");
+    v.blobs = BlobParams::from_json(*b);
+    b->finish();
+  }
   r.finish();
   return v;
 }
@@ -37,6 +44,16 @@ CameraPerception::CameraPerception(const Scenario& s, std::uint64_t seed) : seed
   exposure_.exposure_max = cfg.exposure_max;
   exposure_.gain_min = cfg.gain_min;
   exposure_.gain_max = cfg.gain_max;
+  if (vc.detect_blobs(s.field)) {
+    BlobParams bp = vc.blobs;
+    if (!vc.blob_edge_colours_given)
+      for (const auto& g : s.field.goals) {
+        const ColourClass c = landmark_colour_class(g.colour);
+        if (c != kUnknown && std::find(bp.edge_colours.begin(), bp.edge_colours.end(), c) == bp.edge_colours.end())
+          bp.edge_colours.push_back(c);
+      }
+    blob_detector_ = std::make_unique<BlobDetector>(bp, map_, table_);
+  }
 }
 
 PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) {
@@ -59,6 +76,7 @@ PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int rob
   }
   const auto t1 = Clock::now();
   out.obs = detector_->observe(*img, t);
+  if (blob_detector_ && out.obs.camera_ok) out.obs.blobs = blob_detector_->detect(*img);
   const auto t2 = Clock::now();
   out.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   out.vision_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();

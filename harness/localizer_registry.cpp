@@ -2,6 +2,7 @@
 
 #include "localization/grid_global.hpp"
 #include "localization/hybrid.hpp"
+#include "localization/landmarks/landmark_localizer.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
 #include "localization/odometry_only.hpp"
@@ -28,6 +29,8 @@ const std::vector<LocalizerInfo>& localizers() {
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<GridGlobalLocalizer>(*ctx.field, GridGlobalParams::from_json(r), ctx.cache_dir);
        }},
+      {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
+       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); }},
   };
   return list;
 }

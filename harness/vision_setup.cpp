@@ -1,5 +1,6 @@
 #include "harness/vision_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -120,6 +121,30 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
     for (std::size_t i = 0; i < lab.rgb.size(); ++i)
       if (lab.rgb[i] == sim::kLabelGoal) lab.rgb[i] = sim::kLabelLine;
     labels.push_back(std::move(lab));
+  }
+  // Coloured goals and landmarks: random poses may see them only far away and small, so one more
+  // frame per object from 1-4 m, as a team would hold each landmark up to the camera. Fields
+  // without coloured objects learn from exactly the frames above.
+  std::vector<Eigen::Vector2d> targets;
+  for (const auto& l : field.landmarks) targets.push_back(l.position);
+  for (const auto& g : field.goals)
+    if (g.colour != "white") targets.push_back({g.goal_line_x, 0.0});
+  const double fx = field.half_floor_x() - 0.4, fy = field.half_floor_y() - 0.4;
+  for (const auto& target : targets) {
+    sim::WorldState w;
+    w.has_ball = false;
+    sim::RobotState me;
+    me.id = 0;
+    Eigen::Vector2d p = target;
+    for (int attempt = 0; attempt < 50; ++attempt) {
+      const double a = rng.uniform(0, kTwoPi), d = rng.uniform(1.0, 4.0);
+      p = target + d * Eigen::Vector2d(std::cos(a), std::sin(a));
+      if (std::fabs(p.x()) <= fx && std::fabs(p.y()) <= fy && std::fabs(p.x()) <= 0.5 * field.length) break;
+    }
+    me.pose = Pose2(std::clamp(p.x(), -fx, fx), std::clamp(p.y(), -fy, fy), rng.uniform(-kPi, kPi));
+    w.robots.push_back(me);
+    images.push_back(cam.render(w, 0, cfg.initial, rng));
+    labels.push_back(cam.render_labels(w, 0));
   }
   ColourTable t;
   t.learn(images, labels);

@@ -12,8 +12,37 @@
 
 #include "core/messages.hpp"
 #include "core/pose2.hpp"
+#include "localization/vision/colour_table.hpp"
 
 namespace omniloc {
+
+/// A coloured region (cube, post, goal) found by blob detection (localization/vision/blobs.hpp),
+/// or one edge of such a region.
+///
+/// Frames and units: bearings are robot-frame directions in radians, anticlockwise from the robot's
+/// forward (x) axis, wrapped to (-pi, pi]; distances are metres on the floor from the robot centre
+/// (through the calibration map). "Left" is anticlockwise: seen from the robot, the left edge of a
+/// region is the one at the larger bearing.
+struct Blob {
+  enum class Kind : std::uint8_t {
+    kRegion,     ///< the whole region; bearing = middle of its angular extent
+    kLeftEdge,   ///< its anticlockwise edge (emitted for goal colours only); bearing = the edge
+    kRightEdge,  ///< its clockwise edge (goal colours only)
+  };
+  ColourClass colour = kUnknown;  ///< kYellow, kBlue, kRed (colour_table.hpp)
+  Kind kind = Kind::kRegion;
+  double bearing = 0.0;        ///< radians, see above
+  double left_bearing = 0.0;   ///< radians: the region's anticlockwise edge (same for all kinds)
+  double right_bearing = 0.0;  ///< radians: the region's clockwise edge
+  /// Metres from the robot centre to the region's ground contact nearest the robot (for an edge:
+  /// nearest along that edge); valid only when has_distance (beyond the calibrated range it is not).
+  double distance = 0.0;
+  bool has_distance = false;
+  int area_px = 0;             ///< pixels in the region
+  /// True when the region touches an obstacle (black) pixel or the image border across an edge:
+  /// it may be cut off there, so that edge (and the middle bearing) may be wrong.
+  bool left_occluded = false, right_occluded = false;
+};
 
 /// What the vision front end extracted from one image.
 struct Observations {
@@ -21,6 +50,9 @@ struct Observations {
   bool camera_ok = true; ///< false when the image was unusable (covered, black, missing)
   /// White line points in the robot frame, metres (x forward, y left).
   std::vector<Eigen::Vector2d> line_points;
+  /// Coloured blobs (regions and goal edges); empty unless blob detection ran (the scenario's
+  /// "vision": {"blobs": ...}, by default whenever the field has coloured goals or landmarks).
+  std::vector<Blob> blobs;
 };
 
 /// A localizer's answer for one frame.

@@ -14,6 +14,27 @@
 
 namespace omniloc {
 
+std::string colour_class_name(std::uint8_t c) {
+  switch (c) {
+    case kFieldGreen: return "green";
+    case kLineWhite: return "white";
+    case kBallOrange: return "orange";
+    case kObstacleBlack: return "black";
+    case kOwnBody: return "body";
+    case kYellow: return "yellow";
+    case kBlue: return "blue";
+    case kRed: return "red";
+    default: return "unknown";
+  }
+}
+
+ColourClass landmark_colour_class(const std::string& name) {
+  if (name == "yellow") return kYellow;
+  if (name == "blue") return kBlue;
+  if (name == "red") return kRed;
+  return kUnknown;
+}
+
 ColourTable::ColourTable(int bits) : bits_(bits), lut_(std::size_t{1} << (3 * bits), kUnknown) {}
 
 void ColourTable::learn(const std::vector<Image>& images, const std::vector<Image>& labels, int min_count, int fill_radius) {

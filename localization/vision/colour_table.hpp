@@ -26,6 +26,13 @@ enum ColourClass : std::uint8_t {
   kNumClasses = 12,
 };
 
+/// Name of a colour class as used in field files ("yellow", "blue", "red", "green" for the carpet,
+/// "white", "orange", "black", ...); "unknown" for anything else.
+std::string colour_class_name(std::uint8_t c);
+/// The class of a landmark/goal colour name ("yellow", "blue", "red"); kUnknown for colours the
+/// table has no class for (e.g. "magenta", "cyan", "white").
+ColourClass landmark_colour_class(const std::string& name);
+
 class ColourTable {
  public:
   explicit ColourTable(int bits = 6);
