@@ -34,7 +34,7 @@ struct GridGlobalParams {
   // drift_frames frames, the offset between the vision heading and the MTi is learned with drift_gain
   // per frame. Corrections larger than detection.heading_threshold are not learned: that is a wrong
   // pose (or a turned-round compass), not drift, and is left to the detector.
-  double good_deviation = 0.08;  ///< m
+  double good_deviation = 0.15;  ///< m (median deviation; camera vibration puts far points a decimetre off)
   int drift_frames = 10;
   double drift_gain = 0.1;
   MatchingParams matching;

@@ -17,7 +17,7 @@
 namespace omniloc {
 
 struct DetectionParams {
-  double deviation_threshold = 0.25;  ///< m, mean point distance to the nearest line
+  double deviation_threshold = 0.25;  ///< m, median point distance to the nearest line
   double heading_threshold = 0.35;    ///< rad, |tracked heading - compass|
   int consecutive = 5;                ///< papers 000 / 002: both conditions for this many frames
   int heading_only_frames = 15;       ///< extension (0 = off, the strict paper rule)
@@ -26,7 +26,8 @@ struct DetectionParams {
   static DetectionParams from_json(JsonReader& r);
 };
 
-/// Mean distance (metres) of the points (robot frame) from the nearest marking at `pose` (world).
+/// Median distance (metres) of the points (robot frame) from the nearest marking at `pose` (world):
+/// the papers' "mean deviation", made robust to the far points' vibration error.
 double mean_deviation(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& pose);
 
 class WrongLocalisationDetector {

@@ -14,6 +14,10 @@ namespace {
 Json kidnap_000(double duration) {
   Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/kidnap_000.json"));
   j["duration"] = duration;
+  Json kept = Json::array();
+  for (const auto& e : j["events"])
+    if (e["t"].get<double>() + e["duration"].get<double>() < duration) kept.push_back(e);
+  j["events"] = kept;
   return j;
 }
 Json run(const Json& j, const std::string& name) {

@@ -82,6 +82,7 @@ int run_entropy_maps(const ExperimentArgs& args, std::ostream& out) {
     // The controller on this scene: settled under normal light at 18 / 18, then this case's light.
     ExposureParams ep = vc.exposure;
     ep.enabled = true;
+    ep.search_at_start = false;  // settled under normal light first; the change of light triggers the search
     ep.exposure_min = cfg.exposure_min, ep.exposure_max = cfg.exposure_max, ep.gain_min = cfg.gain_min, ep.gain_max = cfg.gain_max;
     ExposureController ctl(ep, cfg.initial);
     const sim::Lighting target = ws.lighting;
