@@ -64,13 +64,17 @@ Pose2 Scenario::event_target(const EventConfig& e, Rng& rng) const {
 sim::Lighting Scenario::lighting_at(double t) const {
   sim::Lighting l = lighting;
   for (std::size_t i = 0; i < l.sun.size(); ++i) l.sun[i].centre += sun_velocity[i] * t;
-  double level = lighting.level;
+  // Events in time order; each moves its target (the global level, or each listed lamp's state)
+  // linearly from where the earlier events left it to the new value over its transition.
   for (const auto& e : events) {
     if (e.type != "lights" || e.t > t) continue;
     const double f = e.transition > 0 ? std::min(1.0, (t - e.t) / e.transition) : 1.0;
-    level = level + f * (e.level - level);
+    if (e.lamps.empty()) {
+      l.level += f * (e.level - l.level);
+    } else {
+      for (int k : e.lamps) l.lamps[static_cast<std::size_t>(k)].state += f * (e.level - l.lamps[static_cast<std::size_t>(k)].state);
+    }
   }
-  l.level = level;
   return l;
 }
 
@@ -228,6 +232,15 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
       if (e.type == "lights") {
         e.level = er.number("level", std::nullopt, 0.0, 20.0);
         e.transition = er.number("transition", 0.5, 0.0, 600.0);
+        if (const Json* lamps = er.raw("lamps")) {  // indices checked against /lighting/lamps below
+          if (!lamps->is_array() || lamps->empty()) throw ConfigError(ep + "/lamps", json_brief(*lamps), "a non-empty array of lamp indices");
+          for (std::size_t k = 0; k < lamps->size(); ++k) {
+            const Json& v = (*lamps)[k];
+            if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 10000)
+              throw ConfigError(json_child(ep + "/lamps", k), json_brief(v), "a lamp index (an integer >= 0)");
+            e.lamps.push_back(v.get<int>());
+          }
+        }
       }
       er.finish();
       s.events.push_back(e);
@@ -237,27 +250,78 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
 
   if (const Json* occ = r.raw("occlusion")) s.occlusion = sim::OcclusionMask::from_json(*occ, "/occlusion");
   if (auto l = r.object("lighting")) {
+    l->allow("comment");
     s.lighting.level = l->number("level", 1.0, 0.0, 20.0);
     if (const Json* sun = l->raw("sun")) {
       const std::string sp = l->child_path("sun");
       if (!sun->is_array()) throw ConfigError(sp, json_brief(*sun), "an array of sun patches");
       for (std::size_t i = 0; i < sun->size(); ++i) {
         JsonReader pr((*sun)[i], json_child(sp, i));
+        pr.allow("comment");
         sim::SunPatch p;
+        const bool wall = pr.string("surface", std::string("floor"), {"floor", "wall"}) == "wall";
+        p.surface = wall ? sim::SunPatch::Surface::kWall : sim::SunPatch::Surface::kFloor;
         const auto c = pr.numbers("centre", std::nullopt, 2);
-        const auto h = pr.numbers("half_size", std::vector<double>{1.0, 0.5}, 2);
         const auto v = pr.numbers("velocity", std::vector<double>{0.0, 0.0}, 2);
         p.centre = {c[0], c[1]};
-        p.half_size = {h[0], h[1]};
-        if (h[0] <= 0 || h[1] <= 0) throw ConfigError(json_child(sp, i) + "/half_size", json_brief((*sun)[i]["half_size"]), "two positive half sizes (metres)");
+        if (wall) {
+          // A window's light on the hall wall nearest to `centre`: half_width along the wall, height [z0, z1] up it.
+          p.half_size = {pr.positive("half_width", 1.0, 100.0), 0.0};
+          const auto z = pr.numbers("height", std::vector<double>{0.2, 0.8}, 2);
+          if (!(z[0] >= 0 && z[1] > z[0]))
+            throw ConfigError(json_child(sp, i) + "/height", json_brief((*sun)[i]["height"]), "[z0, z1] with 0 <= z0 < z1 (metres)");
+          p.z_min = z[0];
+          p.z_max = z[1];
+        } else {
+          const auto h = pr.numbers("half_size", std::vector<double>{1.0, 0.5}, 2);
+          if (h[0] <= 0 || h[1] <= 0) throw ConfigError(json_child(sp, i) + "/half_size", json_brief((*sun)[i]["half_size"]), "two positive half sizes (metres)");
+          p.half_size = {h[0], h[1]};
+        }
         p.strength = pr.number("strength", 3.0, 0.0, 50.0);
         pr.finish();
         s.lighting.sun.push_back(p);
         s.sun_velocity.emplace_back(v[0], v[1]);
       }
     }
+    // Lamps: an explicit list, or a regular grid of banks over the floor inside the walls.
+    if (const Json* lamps = l->raw("lamps")) {
+      const std::string lp = l->child_path("lamps");
+      if (!lamps->is_array() || lamps->empty()) throw ConfigError(lp, json_brief(*lamps), "a non-empty array of lamps {\"centre\": [x, y], \"spread\": m}");
+      for (std::size_t i = 0; i < lamps->size(); ++i) {
+        JsonReader lr((*lamps)[i], json_child(lp, i));
+        lr.allow("comment");
+        sim::Lamp lamp;
+        const auto c = lr.numbers("centre", std::nullopt, 2);
+        lamp.centre = {c[0], c[1]};
+        lamp.spread = lr.positive("spread", 3.0, 100.0);
+        lamp.state = lr.number("state", 1.0, 0.0, 20.0);
+        lr.finish();
+        s.lighting.lamps.push_back(lamp);
+      }
+    }
+    s.lighting.diffuse = l->number("lamp_diffuse", 0.3, 0.0, 1.0);
+    if (auto g = l->object("lamp_grid")) {
+      if (!s.lighting.lamps.empty()) throw ConfigError(g->path(), "an object", "either /lighting/lamps or /lighting/lamp_grid, not both");
+      const int nx = static_cast<int>(g->integer("nx", 4, 1, 50)), ny = static_cast<int>(g->integer("ny", 3, 1, 50));
+      const double spread = g->positive("spread", 3.0, 100.0);
+      g->finish();
+      // Banks at the centres of an nx x ny partition of the floor, numbered row by row from (-x, -y).
+      const double hx = s.field.half_floor_x(), hy = s.field.half_floor_y();
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          sim::Lamp lamp;
+          lamp.centre = {-hx + (i + 0.5) * 2 * hx / nx, -hy + (j + 0.5) * 2 * hy / ny};
+          lamp.spread = spread;
+          s.lighting.lamps.push_back(lamp);
+        }
+    }
     l->finish();
   }
+  for (const auto& e : s.events)
+    for (std::size_t k = 0; k < e.lamps.size(); ++k)
+      if (static_cast<std::size_t>(e.lamps[k]) >= s.lighting.lamps.size())
+        throw ConfigError(json_child(e.path + "/lamps", k), std::to_string(e.lamps[k]),
+                          "the index of a lamp in /lighting/lamps (" + std::to_string(s.lighting.lamps.size()) + " lamps)");
 
   const Json* loc = r.raw("localizer");
   s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};

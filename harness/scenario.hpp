@@ -45,8 +45,9 @@ struct EventConfig {
   bool random_pose = false;  ///< "pose": "random": drawn from the run's seed (stream "events") on the field
   double duration = 0.0;     ///< cover / kidnap / occlude: how long, seconds
   sim::OcclusionMask mask;   ///< occlude
-  double level = 1.0;        ///< lights: new global illumination level
+  double level = 1.0;        ///< lights: new global illumination level, or with `lamps` those lamps' new state (0 off, 1 on)
   double transition = 0.0;   ///< lights: seconds to reach it (lamps warming up / dimming)
+  std::vector<int> lamps;    ///< lights: indices into /lighting/lamps switched; empty = the global level
   std::string path;          ///< JSON path, for messages
 };
 

@@ -26,14 +26,40 @@ struct BallState {
 };
 
 /// Illumination of the scene (issue: lighting). 1.0 = the normal artificial light of the hall.
+/// Light is white: the camera's auto white balance is assumed to have removed the lamps' and the
+/// sun's colour temperature, so light changes a surface's brightness and (through clipping and noise)
+/// its saturation, never its hue.
 struct SunPatch {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();  ///< world frame, metres, on the carpet
-  Eigen::Vector2d half_size = {1.0, 0.5};            ///< metres
+  enum class Surface { kFloor, kWall };
+  /// kFloor: a beam through a window: everything whose (x, y) lies in the rectangle (carpet, robots,
+  /// ball standing in it) gets `strength` more light. kWall: a lit rectangle on the hall wall nearest
+  /// to `centre`, `half_size.x()` along the wall and from z_min to z_max up it.
+  Surface surface = Surface::kFloor;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();  ///< world frame, metres
+  Eigen::Vector2d half_size = {1.0, 0.5};            ///< metres (kWall: only x, along the wall)
+  double z_min = 0.0, z_max = 1.0;                   ///< kWall: metres above the floor
   double strength = 3.0;                             ///< added illumination, in units of the normal level
+};
+/// A lamp (or bank of lamps) of the hall. When a scenario lists lamps, the artificial light at a
+/// floor point p is level * ((1 - diffuse) * sum_i state_i k_i(p) / sum_i k_i(p) + diffuse * mean_i state_i),
+/// k_i = exp(-|p - c_i|^2 / (2 spread^2)): the direct part is the share of the light at p that comes
+/// from lamps that are on, the diffuse part the light the ceiling and walls spread over the whole
+/// hall. With every lamp on it is `level` everywhere (the light the colour table was learned under);
+/// switching some off darkens their part of the hall smoothly.
+struct Lamp {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();  ///< world frame, metres (under the lamp)
+  double spread = 3.0;                               ///< metres, std of the lamp's footprint
+  double state = 1.0;                                ///< 0 = off, 1 = on (dimmed or warming up in between)
 };
 struct Lighting {
   double level = 1.0;            ///< global artificial level (0 = dark, 1 = normal)
-  std::vector<SunPatch> sun;     ///< bright sharp patches on the carpet
+  std::vector<SunPatch> sun;     ///< bright sharp patches on the carpet and walls
+  std::vector<Lamp> lamps;       ///< empty: the artificial light is `level` everywhere
+  double diffuse = 0.3;          ///< share of the lamps' light spread evenly over the hall (0..1)
+  /// Artificial light (without sun) at a world point, in units of the normal level.
+  double artificial_at(const Eigen::Vector2d& p) const;
+  /// Artificial light plus the floor sun beams covering p.
+  double at(const Eigen::Vector2d& p) const;
 };
 
 /// A flat coloured rectangle lying on the carpet (calibration patches, markers).

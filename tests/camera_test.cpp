@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/field.hpp"
 #include "sim/render/panoramic_camera.hpp"
@@ -140,6 +141,87 @@ TEST_F(CameraTest, ExposureSaturatesAndNoiseGrowsWithGain) {
   const double low = noise_std(6.0), high = noise_std(54.0);  // same brightness, different gain
   EXPECT_GT(low, 0.5);
   EXPECT_GT(high, 2.0 * low);
+}
+
+namespace {
+// Mean RGB over a 3 x 3 block around the image point of a robot-frame 3-D point.
+Eigen::Vector3d rgb_at(const PanoramicCamera& cam, const Image& im, const Eigen::Vector3d& robot_point) {
+  const auto px = cam.project(robot_point);
+  EXPECT_TRUE(px);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int dv = -1; dv <= 1; ++dv)
+    for (int du = -1; du <= 1; ++du) {
+      const std::uint8_t* c = im.row(static_cast<int>(px->y()) + dv) + 3 * (static_cast<int>(px->x()) + du);
+      sum += Eigen::Vector3d(c[0], c[1], c[2]);
+    }
+  return sum / 9.0;
+}
+// HSV hue in degrees and saturation in [0, 1].
+double hue_deg(const Eigen::Vector3d& c) {
+  const double mx = c.maxCoeff(), mn = c.minCoeff(), d = mx - mn;
+  if (d <= 0) return 0.0;
+  double h = mx == c[0] ? std::fmod((c[1] - c[2]) / d, 6.0) : mx == c[1] ? (c[2] - c[0]) / d + 2.0 : (c[0] - c[1]) / d + 4.0;
+  return 60.0 * (h < 0 ? h + 6.0 : h);
+}
+double saturation(const Eigen::Vector3d& c) { return c.maxCoeff() > 0 ? 1.0 - c.minCoeff() / c.maxCoeff() : 0.0; }
+}  // namespace
+
+TEST_F(CameraTest, SunPatchesAreSharpOnTheCarpetAndLightTheWall) {
+  // Observer at (0, -3) facing +x; a sun beam 1 m x 1 m centred 2 m ahead doubles the light there.
+  WorldState w = one_robot(Pose2(0.0, -3.0, 0.0));
+  SunPatch beam;
+  beam.centre = {2.0, -3.0};
+  beam.half_size = {0.5, 0.5};
+  beam.strength = 1.0;
+  w.lighting.sun.push_back(beam);
+  Rng rng(1);
+  const CameraSettings half{9.0, 18.0};  // carpet green ~90 DN under the lamps, ~180 DN in the beam
+  const Image im = cam_->render(w, 0, half, rng);
+  const double inside = rgb_at(*cam_, im, {2.0, 0.0, 0.0})[1];
+  EXPECT_NEAR(inside, 2.0 * PanoramicCamera::response(0.34, 1.0, half), 4.0);
+  // The far edge x = 2.5 m: 8 cm either side (~3 px) it is fully in or out of the beam.
+  EXPECT_NEAR(rgb_at(*cam_, im, {2.42, 0.0, 0.0})[1], inside, 4.0);
+  EXPECT_NEAR(rgb_at(*cam_, im, {2.58, 0.0, 0.0})[1], PanoramicCamera::response(0.34, 1.0, half), 4.0);
+  EXPECT_NEAR(rgb_at(*cam_, im, {0.5, -1.0, 0.0})[1], PanoramicCamera::response(0.34, 1.0, half), 4.0);  // elsewhere
+
+  // Sun on the wall: observer at the centre facing +y, the wall's inner face at y = 7 m (1 m beyond
+  // the touch line), lit 3x between x = -1 and 1 m, 0.1-0.4 m up.
+  WorldState v = one_robot(Pose2(0.0, 0.0, kPi / 2));
+  const Image dark = cam_->render(v, 0, half, rng);
+  SunPatch window;
+  window.surface = SunPatch::Surface::kWall;
+  window.centre = {0.0, 7.0};
+  window.half_size = {1.0, 0.0};
+  window.z_min = 0.1;
+  window.z_max = 0.4;
+  window.strength = 2.0;
+  v.lighting.sun.push_back(window);
+  const Image lit = cam_->render(v, 0, half, rng);
+  const Eigen::Vector3d in_patch(6.99, 0.0, 0.25), beside(6.99, -2.0, 0.25);  // robot frame: ahead = +y world
+  EXPECT_NEAR(rgb_at(*cam_, lit, in_patch)[2] / rgb_at(*cam_, dark, in_patch)[2], 3.0, 0.3);
+  EXPECT_NEAR(rgb_at(*cam_, lit, beside)[2], rgb_at(*cam_, dark, beside)[2], 2.0);
+}
+
+TEST_F(CameraTest, LightChangesBrightnessAndSaturationNotHue) {
+  // The camera's white balance leaves the light white: a brighter scene is a brighter, and once a
+  // channel clips a paler, carpet of the same hue.
+  WorldState w = one_robot(Pose2(0.0, -3.0, 0.0));
+  const CameraSettings half{9.0, 18.0};
+  Rng rng(1);
+  std::vector<Eigen::Vector3d> carpet;
+  for (double level : {0.5, 1.0, 1.5, 4.0}) {
+    w.lighting.level = level;
+    carpet.push_back(rgb_at(*cam_, cam_->render(w, 0, half, rng), {1.0, 0.5, 0.0}));
+  }
+  // The albedo's hue is 125 degrees. Tolerance: the dim red and blue channels (~26 and ~31 DN at 1x)
+  // carry the 8-bit GL quantisation (+-1-2 DN, a few degrees of hue); when green clips at 4x the hue
+  // moves by 3-4 degrees towards cyan (a per-channel clip, as on a real sensor).
+  for (const auto& c : carpet) EXPECT_NEAR(hue_deg(c), 125.0, 6.0) << c.transpose();
+  EXPECT_LT(carpet[0][1], carpet[1][1]);
+  EXPECT_LT(carpet[1][1], carpet[2][1]);
+  EXPECT_NEAR(saturation(carpet[0]), saturation(carpet[1]), 0.1);  // no channel clips: the same saturation
+  EXPECT_EQ(carpet[3][1], 255.0);                                   // 4x: green clips ...
+  EXPECT_LT(saturation(carpet[3]), saturation(carpet[1]) - 0.08);   // ... and the carpet pales
 }
 
 TEST(CameraConfig, BadInputIsNamed) {

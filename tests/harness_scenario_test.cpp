@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <filesystem>
 #include <functional>
 
@@ -80,6 +82,25 @@ TEST(ScenarioValidation, EveryErrorNamesItsJsonPath) {
       {"lights without level", [](Json& j) { j["events"].push_back(Json::parse(R"({"type": "lights", "t": 0.5})")); }, "/events/1/level"},
       {"negative lamp level", [](Json& j) { j["lighting"] = {{"level", -1}}; }, "/lighting/level"},
       {"sun patch typo", [](Json& j) { j["lighting"] = Json::parse(R"({"sun": [{"centre": [0, 0], "strenght": 2}]})"); }, "/lighting/sun/0/strenght"},
+      {"lamp index out of range",
+       [](Json& j) {
+         j["lighting"] = Json::parse(R"({"lamp_grid": {"nx": 2, "ny": 2}})");
+         j["events"].push_back(Json::parse(R"({"type": "lights", "t": 0.5, "level": 0, "lamps": [1, 4]})"));
+       },
+       "/events/1/lamps/1"},
+      {"lamp event without lamps", [](Json& j) { j["events"].push_back(Json::parse(R"({"type": "lights", "t": 0.5, "level": 0, "lamps": [0]})")); }, "/events/1/lamps/0"},
+      {"lamp index not an integer",
+       [](Json& j) {
+         j["lighting"] = Json::parse(R"({"lamp_grid": {"nx": 2, "ny": 2}})");
+         j["events"].push_back(Json::parse(R"({"type": "lights", "t": 0.5, "level": 0, "lamps": ["left"]})"));
+       },
+       "/events/1/lamps/0"},
+      {"lamp spread", [](Json& j) { j["lighting"] = Json::parse(R"({"lamps": [{"centre": [0, 0], "spread": 0}]})"); }, "/lighting/lamps/0/spread"},
+      {"lamps and grid", [](Json& j) { j["lighting"] = Json::parse(R"({"lamps": [{"centre": [0, 0]}], "lamp_grid": {"nx": 2}})"); }, "/lighting/lamp_grid"},
+      {"wall sun upside down",
+       [](Json& j) { j["lighting"] = Json::parse(R"({"sun": [{"surface": "wall", "centre": [0, 7], "height": [0.5, 0.2]}]})"); },
+       "/lighting/sun/0/height"},
+      {"sun surface", [](Json& j) { j["lighting"] = Json::parse(R"({"sun": [{"surface": "ceiling", "centre": [0, 7]}]})"); }, "/lighting/sun/0/surface"},
       {"mark unknown robot", [](Json& j) { j["robots"][1]["motion"] = Json::parse(R"({"type": "behaviour", "kind": "mark", "target": 5})"); }, "/robots/1/motion/target"},
       {"unknown behaviour", [](Json& j) { j["robots"][1]["motion"] = Json::parse(R"({"type": "behaviour", "kind": "dance"})"); }, "/robots/1/motion/kind"},
   };
@@ -100,6 +121,35 @@ TEST(Scenario, LightingScriptInterpolatesLampsAndMovesTheSun) {
   EXPECT_NEAR(s.lighting_at(1.0).level, 0.6, 1e-12);  // half way through the dimming
   EXPECT_NEAR(s.lighting_at(2.0).level, 0.2, 1e-12);
   EXPECT_NEAR(s.lighting_at(2.0).sun[0].centre.x(), 0.2, 1e-12);
+}
+
+TEST(Scenario, LampSubsetsSwitchAndDarkenTheirPartOfTheHall) {
+  Json j = base();
+  // 2 x 1 grid on the 18 x 12 field (floor 20 x 14): lamp 0 at x = -5, lamp 1 at x = +5.
+  j["lighting"] = Json::parse(R"({"level": 1.0, "lamp_grid": {"nx": 2, "ny": 1, "spread": 3.0}, "lamp_diffuse": 0.25})");
+  j["events"] = Json::parse(R"([{"type": "lights", "t": 0.5, "level": 0.0, "transition": 1.0, "lamps": [1]},
+                                 {"type": "lights", "t": 2.0, "level": 0.5, "transition": 0.0}])");
+  j["duration"] = 3.0;
+  const Scenario s = parse_scenario(j, "lamps");
+  ASSERT_EQ(s.lighting.lamps.size(), 2u);
+  EXPECT_NEAR(s.lighting.lamps[0].centre.x(), -5.0, 1e-12);
+  EXPECT_NEAR(s.lighting.lamps[1].centre.x(), 5.0, 1e-12);
+  // All on: the normal level everywhere, whatever the lamps' layout.
+  for (double x : {-9.0, -2.0, 0.0, 3.0, 9.0}) EXPECT_NEAR(s.lighting_at(0.0).at({x, 1.0}), 1.0, 1e-12);
+  EXPECT_NEAR(s.lighting_at(1.0).lamps[1].state, 0.5, 1e-12);  // half way through switching off
+  const sim::Lighting off = s.lighting_at(1.6);
+  EXPECT_DOUBLE_EQ(off.lamps[1].state, 0.0);
+  EXPECT_DOUBLE_EQ(off.lamps[0].state, 1.0);
+  // Midway between the lamps: half the direct light plus the diffuse share of the mean state.
+  EXPECT_NEAR(off.at({0.0, 0.0}), 0.75 * 0.5 + 0.25 * 0.5, 1e-12);
+  // Under the lamp that is off: only what lamp 0's footprint reaches (exp(-100/18) of the direct part) and the diffuse light.
+  const double k = std::exp(-100.0 / 18.0);
+  EXPECT_NEAR(off.at({5.0, 0.0}), 0.75 * k / (1.0 + k) + 0.125, 1e-12);
+  EXPECT_GT(off.at({-5.0, 0.0}), 0.8);
+  // Far outside every footprint: the mean state.
+  EXPECT_NEAR(off.artificial_at({1e4, 0.0}), 0.5, 1e-12);
+  // A later global event scales the whole pattern.
+  EXPECT_NEAR(s.lighting_at(2.5).at({0.0, 0.0}), 0.25, 1e-12);
 }
 
 TEST(ScenarioValidation, SyntaxErrorNamesTheFile) {

@@ -114,11 +114,26 @@ void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const
     }
 }
 
-double illumination_at(const Lighting& l, const Eigen::Vector2d& p) {
-  double e = l.level;
-  for (const auto& s : l.sun)
-    if (std::fabs(p.x() - s.centre.x()) <= s.half_size.x() && std::fabs(p.y() - s.centre.y()) <= s.half_size.y()) e += s.strength;
-  return e;
+double illumination_at(const Lighting& l, const Eigen::Vector2d& p) { return l.at(p); }
+
+// The lit rectangle of a wall sun patch: a quad 1 cm in front of the inner face of the hall wall
+// nearest to the patch centre (drawn over the wall like floor patches over the carpet, so its edges
+// stay sharp whatever the wall's tessellation). Empty when the patch misses the wall.
+bool wall_patch_quad(const SunPatch& sp, double hx, double hy, double wall_height, std::array<Eigen::Vector3d, 4>& q) {
+  const double in = 0.01;
+  const Eigen::Vector2d c = sp.centre;
+  const double d[4] = {std::fabs(c.x() - hx), std::fabs(c.x() + hx), std::fabs(c.y() - hy), std::fabs(c.y() + hy)};
+  const int k = static_cast<int>(std::min_element(d, d + 4) - d);
+  const bool along_y = k < 2;  // walls at x = +-hx run along y
+  const double extent = along_y ? hy : hx;
+  const double a0 = std::max(-extent, (along_y ? c.y() : c.x()) - sp.half_size.x());
+  const double a1 = std::min(extent, (along_y ? c.y() : c.x()) + sp.half_size.x());
+  const double z0 = std::max(0.0, sp.z_min), z1 = std::min(wall_height, sp.z_max);
+  if (a1 <= a0 || z1 <= z0) return false;
+  const double face = k == 0 ? hx - in : k == 1 ? -hx + in : k == 2 ? hy - in : -hy + in;
+  auto pt = [&](double a, double z) { return along_y ? Eigen::Vector3d(face, a, z) : Eigen::Vector3d(a, face, z); };
+  q = {pt(a0, z0), pt(a1, z0), pt(a1, z1), pt(a0, z1)};
+  return true;
 }
 
 }  // namespace
@@ -134,7 +149,8 @@ struct PanoramicCameraImpl {
   std::vector<float> mesh_xy;          // render-space positions
   std::vector<Eigen::Vector3d> mesh_dir;  // camera-frame unit ray of each vertex
   std::vector<unsigned> mesh_idx;
-  std::vector<Tri> static_tris;        // walls, goals, landmarks
+  std::vector<Tri> wall_tris;          // the hall's walls
+  std::vector<Tri> static_tris;        // goals, landmarks
   std::vector<unsigned char> readback;
   std::vector<float> noise;            // standard normals, drawn once from the first render's Rng
   // Per-draw scratch.
@@ -243,10 +259,10 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   // Static scene: walls, goals, landmarks.
   const double wall_t = 0.1, wh = field.wall_height;
   if (wh > 0) {
-    add_box(m.static_tris, {0, m.hy + wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
-    add_box(m.static_tris, {0, -m.hy - wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
-    add_box(m.static_tris, {m.hx + wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
-    add_box(m.static_tris, {-m.hx - wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.wall_tris, {0, m.hy + wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.wall_tris, {0, -m.hy - wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.wall_tris, {m.hx + wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
+    add_box(m.wall_tris, {-m.hx - wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
   }
   for (const auto& g : field.goals) {
     const bool coloured = g.colour != "white";
@@ -351,7 +367,8 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   gl.MatrixMode(GL_MODELVIEW);
   gl.LoadIdentity();
   gl.ShadeModel(GL_SMOOTH);
-  const Eigen::Vector3f bg = labels ? Eigen::Vector3f::Zero() : Eigen::Vector3f(kBackground * (world.lighting.level / kRadianceScale));
+  const Eigen::Vector3f bg =
+      labels ? Eigen::Vector3f::Zero() : Eigen::Vector3f(kBackground * (world.lighting.artificial_at(pose.translation()) / kRadianceScale));
   gl.ClearColor(bg[0], bg[1], bg[2], 1.0f);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   gl.EnableClientState(GL_VERTEX_ARRAY);
@@ -378,7 +395,8 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     m.pos[3 * i + 2] = -999.0f;
     m.tex[2 * i] = static_cast<float>((w.x() + m.hx) / (2 * m.hx));
     m.tex[2 * i + 1] = static_cast<float>((w.y() + m.hy) / (2 * m.hy));
-    const float illum = labels ? 1.0f : static_cast<float>(std::min(1.0, illumination_at(world.lighting, w) / kRadianceScale));
+    // The lamps' light only: sun beams are drawn over this below, with sharp edges.
+    const float illum = labels ? 1.0f : static_cast<float>(std::min(1.0, world.lighting.artificial_at(w) / kRadianceScale));
     m.col[4 * i] = m.col[4 * i + 1] = m.col[4 * i + 2] = illum;
     m.col[4 * i + 3] = 1.0f;
   }
@@ -408,12 +426,13 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     out[2] = static_cast<float>(-std::min(999.0, q.norm()));
   };
   std::vector<Tri> tris;
-  auto emit_all = [&](const std::vector<Tri>& list, bool ground_level) {
+  // fixed_light >= 0: every triangle under that illumination instead of the floor light at its middle.
+  auto emit_all = [&](const std::vector<Tri>& list, bool ground_level, double fixed_light = -1.0) {
     m.pos.clear();
     m.col.clear();
     for (const Tri& t : list) {
       const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
-      const float illum = static_cast<float>(illumination_at(world.lighting, mid) / kRadianceScale);
+      const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : illumination_at(world.lighting, mid)) / kRadianceScale);
       for (const auto& v : t.p) {
         float xyz[3];
         project(v, xyz);
@@ -438,6 +457,44 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
     gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(m.pos.size() / 3));
   };
+  // Sun beams on the carpet: the floor under each beam drawn again from its texture under the beam's
+  // light, in cells of at most 0.1 m projected through the mirror, so a patch's edges are as sharp as
+  // the texture (a per-vertex light on the image-fixed floor mesh would smear them over a mesh cell).
+  if (!labels) {
+    gl.Enable(GL_TEXTURE_2D);
+    gl.BindTexture(GL_TEXTURE_2D, m.tex_albedo);
+    gl.TexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
+    for (const auto& sp : world.lighting.sun) {
+      if (sp.surface != SunPatch::Surface::kFloor) continue;
+      const double x0 = std::max(-m.hx, sp.centre.x() - sp.half_size.x()), x1 = std::min(m.hx, sp.centre.x() + sp.half_size.x());
+      const double y0 = std::max(-m.hy, sp.centre.y() - sp.half_size.y()), y1 = std::min(m.hy, sp.centre.y() + sp.half_size.y());
+      if (x1 <= x0 || y1 <= y0) continue;
+      const int nx = std::max(1, static_cast<int>(std::ceil((x1 - x0) / 0.1))), ny = std::max(1, static_cast<int>(std::ceil((y1 - y0) / 0.1)));
+      m.pos.clear();
+      m.col.clear();
+      m.tex.clear();
+      auto vertex = [&](int i, int j) {
+        const Eigen::Vector2d w(x0 + (x1 - x0) * i / nx, y0 + (y1 - y0) * j / ny);
+        float xyz[3];
+        project(Eigen::Vector3d(w.x(), w.y(), 0.0), xyz);
+        m.pos.insert(m.pos.end(), {xyz[0], xyz[1], -999.0f});
+        m.tex.insert(m.tex.end(), {static_cast<float>((w.x() + m.hx) / (2 * m.hx)), static_cast<float>((w.y() + m.hy) / (2 * m.hy))});
+        const float il = static_cast<float>(std::min(1.0, world.lighting.at(w) / kRadianceScale));
+        m.col.insert(m.col.end(), {il, il, il, 1.0f});
+      };
+      for (int i = 0; i < nx; ++i)
+        for (int j = 0; j < ny; ++j)
+          for (const auto& [a, b] : std::array<std::pair<int, int>, 6>{{{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j}, {i + 1, j + 1}, {i, j + 1}}})
+            vertex(a, b);
+      gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
+      gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
+      gl.TexCoordPointer(2, GL_FLOAT, 0, m.tex.data());
+      gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(m.pos.size() / 3));
+    }
+    gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
+    gl.Disable(GL_TEXTURE_2D);
+  }
   // Floor patches lie on the carpet: drawn over the floor, under everything standing on it.
   for (const auto& fp : world.floor_patches) {
     const Eigen::Vector3f alb = fp.reflectance.cast<float>();
@@ -450,6 +507,17 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     add_quad(tris, corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1), alb, lab, 0.05);
   }
   if (!tris.empty()) emit_all(tris, true);
+  // Walls first (depth written), then the sun on them painted over the walls without a depth test
+  // (the lit quads and the coarser wall triangles would z-fight: the mirror projection is not linear
+  // across a triangle), then everything standing in front, depth-tested against both.
+  emit_all(m.wall_tris, false);
+  for (const auto& sp : world.lighting.sun) {
+    std::array<Eigen::Vector3d, 4> q;
+    if (labels || sp.surface != SunPatch::Surface::kWall || !wall_patch_quad(sp, m.hx, m.hy, m.field.wall_height, q)) continue;
+    tris.clear();
+    add_quad(tris, q[0], q[1], q[2], q[3], kWall, kLabelWall, 0.25);
+    emit_all(tris, true, world.lighting.artificial_at(((q[0] + q[2]) / 2).head<2>()) + sp.strength);
+  }
   tris = m.static_tris;
   for (const auto& r : world.robots)
     if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5);
