@@ -26,12 +26,12 @@ def ours(folder):
         for g in agg["groups"]:
             m = g["metrics"]
             vals = [m.get(f"r0/{a}/{s}", {}).get("mean", float("nan")) for a, s in KEYS]
-            pts = m.get("r0/frames", {}).get("mean", float("nan"))
+            pts = m.get("r0/line_points/mean", {}).get("mean", float("nan"))
             rows.append((g["params"], vals, pts))
         return rows
     s = json.loads((folder / "summary.json").read_text())
     r = s["robots"][0]
-    return [(s["scenario"], [r[a][st] for a, st in KEYS], r["frames"])]
+    return [(s["scenario"], [r[a][st] for a, st in KEYS], r.get("line_points", {}).get("mean", float("nan")))]
 
 
 def main():
@@ -53,13 +53,13 @@ def main():
         return 2
     labels = a.labels or list(pub.keys())
     head = ["case", "source"] + [f"{s} {c}" for c, s in [("x", "mean"), ("y", "mean"), ("th", "mean"), ("x", "std"), ("y", "std"),
-                                                          ("th", "std"), ("x", "max"), ("y", "max"), ("th", "max")]]
+                                                          ("th", "std"), ("x", "max"), ("y", "max"), ("th", "max")]] + ["line points / frame"]
     lines = []
-    for i, (name, vals, _) in enumerate(rows):
+    for i, (name, vals, pts) in enumerate(rows):
         label = labels[i] if i < len(labels) else name
-        lines.append([label, "omniloc"] + [f"{v:.3f}" for v in vals])
+        lines.append([label, "omniloc"] + [f"{v:.3f}" for v in vals] + [f"{pts:.0f}"])
         if label in pub:
-            lines.append([label, "paper"] + [f"{v:.3f}" for v in pub[label]])
+            lines.append([label, "paper"] + [f"{v:.3f}" for v in pub[label]] + ["-"])
     if a.markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
