@@ -144,12 +144,15 @@ Estimate GridGlobalLocalizer::update(const Observations& obs, const Odometry& od
   } else {
     e = tracker_.track(obs, odo);
     if (e.mode == "tracking") {
-      const double dev = mean_deviation(tracker_.map(), subsample(obs.line_points, p_.matching.max_points), e.pose);
+      const auto pts = subsample(obs.line_points, p_.matching.max_points);
+      const double dev = line_deviation(tracker_.map(), pts, e.pose, p_.detection.deviation_quantile);
       e.extra["deviation_m"] = dev;
-      // MTi drift correction by the vision heading (paper 000), only for small disagreements.
+      // MTi drift correction by the vision heading (paper 000), only for small disagreements. "Good"
+      // is judged on the median: the detector's upper quartile of a correct pose is often above
+      // good_deviation through the far points, and a drifting MTi must be corrected all the same.
       if (heading) {
         const double diff = angle_diff(e.pose.theta, *heading);
-        good_frames_ = dev < p_.good_deviation && std::fabs(diff) < p_.detection.heading_threshold ? good_frames_ + 1 : 0;
+        good_frames_ = line_deviation(tracker_.map(), pts, e.pose, 0.5) < p_.good_deviation && std::fabs(diff) < p_.detection.heading_threshold ? good_frames_ + 1 : 0;
         if (good_frames_ >= p_.drift_frames) {
           offset_ = wrap_angle(offset_ + p_.drift_gain * diff);
           heading = wrap_angle(*raw_heading + offset_);

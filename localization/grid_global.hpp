@@ -30,11 +30,11 @@ struct GridGlobalParams {
   double accept_error = 0.12; ///< mean e(d) at matching.c under which a candidate is accepted at once
   double min_separation = 1.5;  ///< m: the 5 candidates are distinct samples at least this far apart
   bool record_traces = false; ///< keep each candidate's error per RPROP iteration (figures; costs time)
-  // MTi drift correction (paper 000): while tracking with a mean deviation under good_deviation for
+  // MTi drift correction (paper 000): while tracking with a median point deviation under good_deviation for
   // drift_frames frames, the offset between the vision heading and the MTi is learned with drift_gain
   // per frame. Corrections larger than detection.heading_threshold are not learned: that is a wrong
   // pose (or a turned-round compass), not drift, and is left to the detector.
-  double good_deviation = 0.15;  ///< m (median deviation; camera vibration puts far points a decimetre off)
+  double good_deviation = 0.15;  ///< m, median point deviation (camera vibration puts far points a decimetre off)
   int drift_frames = 10;
   double drift_gain = 0.1;
   MatchingParams matching;

@@ -54,7 +54,7 @@ Estimate HybridLocalizer::update(const Observations& obs, const Odometry& odo, s
     e = tracker_.track(obs, odo);
     // Wrong-localisation detection (paper 002).
     if (e.mode == "tracking") {
-      const double dev = mean_deviation(tracker_.map(), subsample(obs.line_points, p_.matching.max_points), e.pose);
+      const double dev = line_deviation(tracker_.map(), subsample(obs.line_points, p_.matching.max_points), e.pose, p_.detection.deviation_quantile);
       e.extra["deviation_m"] = dev;
       if (detector_.update(dev, e.pose, heading)) {
         mcl_.reset(std::nullopt);

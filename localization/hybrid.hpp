@@ -1,6 +1,6 @@
 #pragma once
 // The hybrid localizer of paper 002: MCL until it converges, then matching-optimisation tracking
-// from its mean. Wrong-localisation detection: the mean deviation of the line points from the field
+// from its mean. Wrong-localisation detection: the deviation (upper quartile) of the line points from the field
 // lines above a threshold AND |heading - compass| above a threshold for 5 consecutive frames
 // restarts MCL.
 #include "localization/matching.hpp"

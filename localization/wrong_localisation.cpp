@@ -10,6 +10,7 @@ namespace omniloc {
 DetectionParams DetectionParams::from_json(JsonReader& r) {
   DetectionParams p;
   p.deviation_threshold = r.positive("deviation_threshold", p.deviation_threshold, 10.0);
+  p.deviation_quantile = r.number("deviation_quantile", p.deviation_quantile, 0.0, 1.0);
   p.heading_threshold = r.positive("heading_threshold", p.heading_threshold, 3.2);
   p.consecutive = static_cast<int>(r.integer("consecutive", p.consecutive, 1, 1000));
   p.heading_only_frames = static_cast<int>(r.integer("heading_only_frames", p.heading_only_frames, 0, 100000));
@@ -17,18 +18,20 @@ DetectionParams DetectionParams::from_json(JsonReader& r) {
   return p;
 }
 
-double mean_deviation(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& pose) {
+double line_deviation(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& pose, double quantile) {
   if (pts.empty()) return 0.0;
-  // The median, not the papers' mean: far line points (6-7 m) are a few decimetres off through
-  // camera vibration and a handful of them lift the mean of a correct pose to 0.2 m, next to the
-  // 0.25 m threshold; the median of a correct pose stays at a few centimetres.
+  // Not the papers' mean: far line points (6-7 m) are a few decimetres off through camera vibration
+  // and a handful of them lift the mean of a correct pose to 0.2 m, next to the 0.25 m threshold.
+  // The median of a correct pose stays at a few centimetres, but so does that of a wrong pose on
+  // which half of the points happen to fall near some line; the upper quartile separates both.
   std::vector<double> d;
   d.reserve(pts.size());
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   for (const auto& o : pts) d.push_back(map.distance({pose.x + c * o.x() - s * o.y(), pose.y + s * o.x() + c * o.y()}));
-  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
-  std::nth_element(d.begin(), mid, d.end());
-  return *mid;
+  const auto k = std::min(d.size() - 1, static_cast<std::size_t>(std::clamp(quantile, 0.0, 1.0) * static_cast<double>(d.size())));
+  const auto it = d.begin() + static_cast<std::ptrdiff_t>(k);
+  std::nth_element(d.begin(), it, d.end());
+  return *it;
 }
 
 bool WrongLocalisationDetector::update(double deviation, const Pose2& pose, std::optional<double> heading) {

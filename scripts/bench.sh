@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every Google Benchmark program (build/bench_*) on one core and writes Google Benchmark JSON,
 # with the commit and machine in its context, to OUT_DIR (default results/bench/<commit>).
-# Usage: scripts/bench.sh [OUT_DIR] [extra benchmark flags], e.g. --benchmark_min_time=0.05s
+# Usage: scripts/bench.sh [OUT_DIR] [extra benchmark flags], e.g. --benchmark_min_time=0.05 (seconds; Debian 12 ships Google Benchmark 1.7.1, which takes a plain number)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -x build/omniloc ] || scripts/build.sh

@@ -5,6 +5,7 @@
 #include "core/angles.hpp"
 #include "core/field.hpp"
 #include "core/rng.hpp"
+#include "localization/field_map.hpp"
 #include "localization/grid_global.hpp"
 #include "localization/hybrid.hpp"
 #include "localization/mcl.hpp"
@@ -171,6 +172,23 @@ TEST(WrongLocalisation, AndRuleNeedsBothConditionsSingleWindowsNeedOne) {
   strict.heading_only_frames = strict.deviation_only_frames = 0;  // the paper's rule alone
   WrongLocalisationDetector s(strict);
   for (int k = 0; k < 100; ++k) EXPECT_FALSE(s.update(0.01, pose, kPi));  // misses the mirror, as the paper's AND does
+}
+
+TEST(WrongLocalisation, DeviationIsAnUpperQuantileOfTheLineDistances) {
+  const Field f = Field::preset("msl2012");
+  const FieldMap map(f);
+  // Robot at the centre facing +x: 6 points on the centre line (x = 0), 4 points 0.6 m off any
+  // marking (x = 0.6, y = -0.5 .. 1.0: inside the centre circle, 1.3 m and more from its arc).
+  std::vector<Eigen::Vector2d> pts;
+  for (double y : {-1.0, -0.6, -0.2, 0.2, 0.6, 1.0}) pts.emplace_back(0.0, y);
+  for (double y : {-0.5, 0.0, 0.5, 1.0}) pts.emplace_back(0.6, y);
+  const Pose2 pose(0, 0, 0);
+  // 40 % of the points off the lines: the median still sees a good pose, the upper quartile does not.
+  EXPECT_NEAR(line_deviation(map, pts, pose, 0.5), 0.0, 0.01);
+  EXPECT_NEAR(line_deviation(map, pts, pose, 0.75), 0.6, 0.02);
+  EXPECT_NEAR(line_deviation(map, pts, pose, 1.0), 0.6, 0.02);
+  EXPECT_GT(line_deviation(map, pts, pose, DetectionParams{}.deviation_quantile), DetectionParams{}.deviation_threshold);
+  EXPECT_EQ(line_deviation(map, {}, pose, 0.75), 0.0);
 }
 
 TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
