@@ -61,7 +61,7 @@ CoopRenderedConfig parse_coop_rendered(JsonReader& r, const Cooperative001Config
       g.headings.push_back(v.get<double>() * kPi / 180.0);
     }
   }
-  g.trials = static_cast<int>(r.integer("trials", 12, 1, 100000));
+  g.trials = static_cast<int>(r.integer("trials", 30, 1, 100000));
   g.quick_trials = static_cast<int>(r.integer("quick_trials", 1, 1, 100000));
   g.min_area_px = static_cast<int>(r.integer("min_area_px", 6, 1, 100000));
   g.ball_radius = r.positive("ball_radius", 0.11, 1.0);
@@ -159,8 +159,9 @@ double mean(const std::vector<double>& v) {
   return s / static_cast<double>(v.size());
 }
 
+/// Sample standard deviation; undefined (NaN, "n/a" in the report) below two values.
 double sd(const std::vector<double>& v) {
-  if (v.size() < 2) return 0.0;
+  if (v.size() < 2) return std::nan("");
   const double m = mean(v);
   double s = 0;
   for (double x : v) s += (x - m) * (x - m);
@@ -311,7 +312,13 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
   int miss_full = 0, miss_partial = 0, miss_clear = 0, seen_partial = 0, partial_total = 0;
   std::vector<int> missed_robot(nru, 0);
   FixAcc f_eq, f_w, f_eq_true, f_w_true;
-  std::vector<double> diff_per_trial;
+  // A robot whose self-localisation ends more than this far from the truth counts as a failure; the
+  // fixes are also reported over the trials without any (to separate the two effects).
+  constexpr double kSelflocFail = 0.1;  // m
+  FixAcc f_eq_ok, f_w_ok;
+  std::vector<std::string> failures;  // "trial t robot i: e mm, h deg"
+  int trials_ok = 0;
+  std::vector<double> diff_per_trial, diff_ok;  // per trial: 1/L mean - equal mean (all trials; without a self-localisation failure)
   std::vector<double> own_err;
   std::vector<std::vector<double>> own_err_robot(nru);
   // Robot-count curve: every subset, every trial, every step (no extra rendering: the same sightings).
@@ -367,8 +374,15 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
       const double pe = (est[i].translation() - truth[i].translation()).norm();
       pos_err.push_back(pe);
       pos_err_robot[i].push_back(pe);
+      if (pe > kSelflocFail)
+        failures.push_back(sf("trial %d robot %d: %.0f mm, %.1f deg", t + 1, static_cast<int>(i) + 1, 1000 * pe,
+                              std::abs(wrap_angle(est[i].theta - truth[i].theta)) * 180.0 / kPi));
       head_err.push_back(std::abs(wrap_angle(est[i].theta - truth[i].theta)));
     }
+
+    bool trial_ok = true;
+    for (std::size_t i = 0; i < nru; ++i) trial_ok = trial_ok && (est[i].translation() - truth[i].translation()).norm() <= kSelflocFail;
+    trials_ok += trial_ok;
 
     // 2. The ball rolls; every robot renders, detects and reports.
     std::vector<std::vector<std::optional<BallLine>>> L(static_cast<std::size_t>(K), std::vector<std::optional<BallLine>>(nru));
@@ -443,6 +457,10 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
       f_w.add(fw, B);
       f_eq_true.add(hough_ball_fix(all_true, eq_cfg), B);
       f_w_true.add(hough_ball_fix(all_true, w_cfg), B);
+      if (trial_ok) {
+        f_eq_ok.add(fe, B);
+        f_w_ok.add(fw, B);
+      }
       if (fw.status != BallFix::Status::NoObservation) seq_w.back()[ku] = fw.position;
       if (fe.status != BallFix::Status::NoObservation) seq_eq.back()[ku] = fe.position;
       for (unsigned mask = 1; mask < (1u << nr); ++mask) {
@@ -467,8 +485,11 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
       }
     }
     const double m_eq = f_eq.trial_n ? f_eq.trial_sum / f_eq.trial_n : std::nan(""), m_w = f_w.trial_n ? f_w.trial_sum / f_w.trial_n : std::nan("");
-    if (std::isfinite(m_eq) && std::isfinite(m_w)) diff_per_trial.push_back(m_w - m_eq);
-    for (FixAcc* a : {&f_eq, &f_w, &f_eq_true, &f_w_true}) a->end_trial();
+    if (std::isfinite(m_eq) && std::isfinite(m_w)) {
+      diff_per_trial.push_back(m_w - m_eq);
+      if (trial_ok) diff_ok.push_back(m_w - m_eq);
+    }
+    for (FixAcc* a : {&f_eq, &f_w, &f_eq_true, &f_w_true, &f_eq_ok, &f_w_ok}) a->end_trial();
     if (progress)
       *progress << sf("rendered mode: trial %d/%d done, %.0f s\n", t + 1, trials, std::chrono::duration<double>(Clock::now() - t_start).count())
                 << std::flush;
@@ -551,13 +572,24 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
   row("Hough fix, K_i = 1/L_i", f_w);
   row("equal weights, true poses (diagnostic)", f_eq_true);
   row("K_i = 1/L_i, true poses (diagnostic)", f_w_true);
+  const std::string ok_name = sf("%d trials without a self-localisation failure", trials_ok);
+  row(("equal weights, " + ok_name).c_str(), f_eq_ok);
+  row(("K_i = 1/L_i, " + ok_name).c_str(), f_w_ok);
   md << "| paired difference 1/L - equal (per-trial mean +- s.e.) | " << mm(mean(diff_per_trial)) << " +- "
-     << mm(diff_per_trial.size() > 1 ? sd(diff_per_trial) / std::sqrt(static_cast<double>(diff_per_trial.size())) : std::nan("")) << " | - | - | - |\n\n";
+     << mm(diff_per_trial.size() > 1 ? sd(diff_per_trial) / std::sqrt(static_cast<double>(diff_per_trial.size())) : std::nan("")) << " | - | - | - |\n"
+     << "| paired difference 1/L - equal, " << ok_name << " | " << mm(mean(diff_ok)) << " +- "
+     << mm(diff_ok.size() > 1 ? sd(diff_ok) / std::sqrt(static_cast<double>(diff_ok.size())) : std::nan("")) << " | - | - | - |\n\n";
 
   md << "Self-localisation: position error mean " << mm(mean(pos_err)) << " mm (median " << mm(median(pos_err)) << ", max "
      << mm(pos_err.empty() ? std::nan("") : *std::max_element(pos_err.begin(), pos_err.end())) << "), heading error mean " << deg(mean(head_err))
-     << " deg, from a start " << mm(mean(start_pos_err), 0) << " mm off. Per robot (mean position error, mm):";
+     << (g.pose_source == CoopPoseSource::Matching ? " deg, from a start " + mm(mean(start_pos_err), 0) + " mm off"
+                                                   : std::string(" deg (ground truth + noise, no self-localisation)"))
+     << ". Per robot (mean position error, mm):";
   for (std::size_t i = 0; i < nru; ++i) md << sf(" %d: ", static_cast<int>(i) + 1) << mm(mean(pos_err_robot[i]));
+  md << ".\n";
+  md << sf("Self-localisation failures (position error > %.0f mm): %d of %d robot-trials", 1000 * kSelflocFail, static_cast<int>(failures.size()),
+           trials * nr);
+  for (std::size_t f = 0; f < failures.size(); ++f) md << (f ? "; " : ": ") << failures[f];
   md << ".\n\n";
 
   md << sf("Sightings: %d robot-frames; ball found in %d (%.1f %%), with a distance in %d (%.1f %%); **missed %.1f %%**. ", n_sightings, n_seen,
@@ -636,11 +668,17 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
          {"equal_true_poses", fix_json(f_eq_true)},
          {"weighted_true_poses", fix_json(f_w_true)},
          {"weighted_minus_equal_mm", num(1000 * mean(diff_per_trial))},
+         {"weighted_minus_equal_no_selfloc_failure_mm", num(1000 * mean(diff_ok))},
          {"self_localisation",
           {{"position_error_mean_mm", num(1000 * mean(pos_err))},
            {"position_error_median_mm", num(1000 * median(pos_err))},
            {"heading_error_mean_deg", num(mean(head_err) * 180.0 / kPi)},
-           {"start_error_mm", num(1000 * mean(start_pos_err))}}},
+           {"position_error_max_mm", num(pos_err.empty() ? std::nan("") : 1000 * *std::max_element(pos_err.begin(), pos_err.end()))},
+           {"start_error_mm", num(1000 * mean(start_pos_err))},
+           {"failures_over_100_mm", failures}}},
+         {"trials_without_selfloc_failure", trials_ok},
+         {"equal_no_selfloc_failure", fix_json(f_eq_ok)},
+         {"weighted_no_selfloc_failure", fix_json(f_w_ok)},
          {"sightings",
           {{"total", n_sightings},
            {"seen", n_seen},

@@ -46,7 +46,7 @@ struct CoopRenderedConfig {
   Field field;                    ///< the rendered field, field frame; same length / width as /field
   sim::CameraConfig camera;       ///< every robot's camera (default: the project's default camera)
   std::vector<double> headings;   ///< rad, world heading of each robot; empty: each faces the path's middle
-  int trials = 12;                ///< Monte Carlo runs of the whole path with new image noise
+  int trials = 30;                ///< Monte Carlo runs of the whole path with new image noise
   int quick_trials = 1;
   int min_area_px = 6;            ///< smallest orange region accepted as the ball (pixels)
   double ball_radius = 0.11;      ///< m, the ball every robot knows (MSL size-5 ball, sim default)
