@@ -305,6 +305,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
   std::vector<double> pos_err, head_err, start_pos_err;           // self-localisation, per robot and trial
   std::vector<std::vector<double>> pos_err_robot(nru);
   std::vector<double> d_err, d_abs, c_err, b_abs;                 // per usable sighting: distance (corrected, contact), bearing
+  std::vector<double> part_d_abs, part_b_abs;                     // the same for sightings with the ball partly behind a robot
   constexpr int kBins = 5;                                          // true distance 0-1, 1-2, 2-3, 3-4, >= 4 m
   std::vector<std::vector<double>> bin_d_abs(kBins), bin_d_err(kBins), bin_b_abs(kBins);
   int bin_missed[kBins] = {0, 0, 0, 0, 0}, bin_total[kBins] = {0, 0, 0, 0, 0};
@@ -422,6 +423,10 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
         d_abs.push_back(std::abs(de));
         c_err.push_back(s.contact_distance - D);
         b_abs.push_back(std::abs(be));
+        if (occ == 1) {
+          part_d_abs.push_back(std::abs(de));
+          part_b_abs.push_back(std::abs(be));
+        }
         bin_d_abs[static_cast<std::size_t>(bin)].push_back(std::abs(de));
         bin_d_err[static_cast<std::size_t>(bin)].push_back(de);
         bin_b_abs[static_cast<std::size_t>(bin)].push_back(std::abs(be));
@@ -595,9 +600,11 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
   md << sf("Sightings: %d robot-frames; ball found in %d (%.1f %%), with a distance in %d (%.1f %%); **missed %.1f %%**. ", n_sightings, n_seen,
            100.0 * n_seen / std::max(1, n_sightings), n_usable, 100.0 * n_usable / std::max(1, n_sightings), 100.0 * missed_frac)
      << sf("No orange region: %d with the ball fully behind another robot, %d partly behind one, %d in clear view (too small or lost); "
-           "%d found beyond the calibrated range (bearing only, dropped). Of %d partly occluded sightings %d were still used. "
+           "%d found beyond the calibrated range (bearing only, dropped). Of %d partly occluded sightings %d were still used "
+           "(median abs errors %s mm, %s deg). "
            "More than one orange region: %d frames; sightings more than 0.5 m off (outliers): %d.\n\n",
-           miss_full, miss_partial, miss_clear, n_no_distance, partial_total, seen_partial, n_multi, n_outlier)
+           miss_full, miss_partial, miss_clear, n_no_distance, partial_total, seen_partial, mm(median(part_d_abs)).c_str(),
+           deg(median(part_b_abs)).c_str(), n_multi, n_outlier)
      << "Missed per robot:";
   for (std::size_t i = 0; i < nru; ++i) md << sf(" %d: %d", static_cast<int>(i) + 1, missed_robot[i]);
   md << sf(" (of %d each).\n\n", n_sightings / std::max(1, nr));
@@ -690,6 +697,8 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
            {"seen_without_distance", n_no_distance},
            {"partly_occluded_total", partial_total},
            {"partly_occluded_used", seen_partial},
+           {"partly_occluded_median_abs_distance_error_mm", num(1000 * median(part_d_abs))},
+           {"partly_occluded_median_abs_bearing_error_deg", num(median(part_b_abs) * 180.0 / kPi)},
            {"multiple_regions", n_multi},
            {"outliers_over_0_5_m", n_outlier},
            {"missed_per_robot", missed_robot}}},
