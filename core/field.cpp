@@ -94,7 +94,13 @@ void add_msl_markings(Field& f, JsonReader& r) {
   const double pen_mark = r.number("penalty_mark_distance", 3.0, 0.0, 0.5 * L);
   const double spot_r = r.number("spot_radius", 0.075, 0.0, 0.5);
   double pa_depth = 2.25, pa_width = 6.5, ga_depth = 0.75, ga_width = 3.5;
-  if (auto pa = r.object("penalty_area")) {
+  // "penalty_area": null leaves it out: small fields (e.g. the 2012 humanoid kid-size field of
+  // paper 001) have only a goal area, and a made-up penalty area a few decimetres outside it would
+  // add parallel lines that alias for a line-matching localizer.
+  bool with_pa = true;
+  if (r.has("penalty_area") && r.raw("penalty_area")->is_null()) {
+    with_pa = false;
+  } else if (auto pa = r.object("penalty_area")) {
     pa_depth = pa->positive("depth", 2.25, 0.5 * L);
     pa_width = pa->positive("width", 6.5, W);
     pa->finish();
@@ -104,7 +110,7 @@ void add_msl_markings(Field& f, JsonReader& r) {
     ga_width = ga->positive("width", 3.5, W);
     ga->finish();
   }
-  if (ga_depth >= pa_depth || ga_width >= pa_width)
+  if (with_pa && (ga_depth >= pa_depth || ga_width >= pa_width))
     throw ConfigError(r.child_path("goal_area"), "goal area " + std::to_string(ga_depth) + " x " + std::to_string(ga_width),
                       "a goal area smaller than the penalty area");
   auto seg = [&](double x0, double y0, double x1, double y1) { f.segments.push_back({{x0, y0}, {x1, y1}}); };
@@ -117,9 +123,11 @@ void add_msl_markings(Field& f, JsonReader& r) {
   for (int s : {-1, 1}) {
     const double gx = s * hx;
     // Penalty area: two lines out from the goal line and one parallel to it.
-    seg(gx, -0.5 * pa_width, gx - s * pa_depth, -0.5 * pa_width);
-    seg(gx, 0.5 * pa_width, gx - s * pa_depth, 0.5 * pa_width);
-    seg(gx - s * pa_depth, -0.5 * pa_width, gx - s * pa_depth, 0.5 * pa_width);
+    if (with_pa) {
+      seg(gx, -0.5 * pa_width, gx - s * pa_depth, -0.5 * pa_width);
+      seg(gx, 0.5 * pa_width, gx - s * pa_depth, 0.5 * pa_width);
+      seg(gx - s * pa_depth, -0.5 * pa_width, gx - s * pa_depth, 0.5 * pa_width);
+    }
     seg(gx, -0.5 * ga_width, gx - s * ga_depth, -0.5 * ga_width);
     seg(gx, 0.5 * ga_width, gx - s * ga_depth, 0.5 * ga_width);
     seg(gx - s * ga_depth, -0.5 * ga_width, gx - s * ga_depth, 0.5 * ga_width);

@@ -65,6 +65,14 @@ Json shipped() {
   return Json::parse(in);
 }
 
+/// The shipped description without its rendered-image mode: these tests are about the direct-noise
+/// simulation (the rendered mode renders hundreds of frames; tests/cooperative_rendered_test.cpp).
+Json direct_only() {
+  Json j = shipped();
+  j.erase("rendered");
+  return j;
+}
+
 /// The ConfigError a parse of `j` raises (fails the test if none).
 ConfigError parse_error(const Json& j) {
   try {
@@ -304,10 +312,13 @@ TEST(Cooperative001Config, BadValuesNameTheirPath) {
 
 TEST(Cooperative001Experiment, QuickModeWritesFilesWithFiniteNumbers) {
   const fs::path d = temp_dir("quick");
+  const fs::path cfg = fs::temp_directory_path() / ("omniloc_coop_direct_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + ".json");
+  std::ofstream(cfg) << direct_only().dump(1);
   harness::ExperimentArgs a;
   a.seed = 1;
   a.quick = true;
   a.out_dir = d.string();
+  a.config = cfg.string();
   std::ostringstream out;
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(harness::run_cooperative_001(a, out), 0);
@@ -345,13 +356,14 @@ TEST(Cooperative001Experiment, QuickModeWritesFilesWithFiniteNumbers) {
   EXPECT_EQ(j["tracking"], j2["tracking"]);
   fs::remove_all(d);
   fs::remove_all(d2);
+  fs::remove(cfg);
 }
 
 // Paper 001's claim: K_i = 1/L_i beats equal weights. It holds when the noise enters at the bearing
 // (polar model, the headline); with noise that does not grow with distance (cartesian, robot_pose)
 // it does not, and the test records that too. Both fixes always beat one robot alone.
 TEST(Cooperative001Experiment, WeightedBeatsEqualUnderBearingNoise) {
-  Json cfg = shipped();
+  Json cfg = direct_only();
   cfg["quick_trials"] = {{"path", 600}, {"per_subset", 1}, {"tracking", 1}, {"growth_model", 2}};
   const Json j = run_quick(cfg, "claim");
   const Json& polar = j["noise_models"]["polar"];

@@ -150,6 +150,7 @@ Cooperative001Config parse_cooperative_001(const Json& j) {
     c.tracking_threshold = t->number("threshold", 0.5, 0.0, 1.0);
     t->finish();
   }
+  if (auto g = r.object("rendered")) c.rendered = parse_coop_rendered(*g, c);
   r.finish();
   return c;
 }
@@ -761,6 +762,10 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   }
   md << "\n\n";
 
+  // 6. Rendered-image mode: the same path seen through each robot's own camera.
+  Json rendered_json = nullptr;
+  if (c.rendered) rendered_json = run_cooperative_rendered(c, args.quick ? c.rendered->quick_trials : c.rendered->trials, seed, md, dir, &out);
+
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   md << sf("Run time %.1f s.\n", elapsed);
 
@@ -797,6 +802,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
          {"robots_vs_error", robots_json},
          {"growth_model", growth_json},
          {"tracking", tracking_json},
+         {"rendered", rendered_json},
          {"elapsed_s", elapsed}};
   if (std::isnan(p_equal)) j["paper"] = nullptr;
   dir.write("cooperative_001.json", j.dump(1) + "\n");
@@ -806,7 +812,8 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
     dir.write("field.png", png_bytes(field_figure(c, run_trial(c, c.noise_model, ref, all_robots(c), c.network, c.fusion_deadline, noise, netr))));
   }
   dir.commit();
-  out << md.str() << "files: " << dir.final_dir() << "/{cooperative_001.json,cooperative_001.md,robots_vs_error.png,robots_vs_error.csv,field.png}\n";
+  out << md.str() << "files: " << dir.final_dir() << "/{cooperative_001.json,cooperative_001.md,robots_vs_error.png,robots_vs_error.csv,field.png"
+      << (c.rendered ? ",robots_vs_error_rendered.png,robots_vs_error_rendered.csv" : "") << "}\n";
   return 0;
 }
 

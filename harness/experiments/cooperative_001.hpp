@@ -14,6 +14,7 @@
 
 #include "core/json_reader.hpp"
 #include "harness/experiment.hpp"
+#include "harness/experiments/cooperative_001_rendered.hpp"
 #include "sim/network.hpp"
 
 namespace omniloc::harness {
@@ -60,6 +61,8 @@ struct Cooperative001Config {
   double accel_sigma = 5.0;   ///< m/s^2, trackers' process noise (ball_trackers.hpp default)
   int particles = 100;        ///< particle filters' N_s (paper: 100)
   double tracking_threshold = 0.5;  ///< N_th / N_s (paper: 0.5 for MFBPF)
+  /// The rendered-image mode (key "rendered"; absent: direct-noise mode only).
+  std::optional<CoopRenderedConfig> rendered;
 
   /// Number of ball positions on the path (start included; the end when the length is a multiple of the step).
   int path_positions() const;
@@ -75,7 +78,8 @@ std::string cooperative_001_default_file();
 void validate_cooperative_001(const std::string& file);
 
 /// Runs the experiment (args.config or the default file), writes cooperative_001.{json,md},
-/// robots_vs_error.{png,csv}, field.png into args.out_dir and prints the tables.
+/// robots_vs_error.{png,csv}, field.png (and with "rendered": robots_vs_error_rendered.{png,csv})
+/// into args.out_dir and prints the tables.
 int run_cooperative_001(const ExperimentArgs& args, std::ostream& out);
 
 }  // namespace omniloc::harness
