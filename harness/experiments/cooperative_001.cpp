@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/rng.hpp"
+#include "harness/experiments/text_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
 #include "harness/run_directory.hpp"
@@ -190,21 +191,14 @@ double Cooperative001Config::reference_distance_or_mean() const {
   return s / static_cast<double>(n * static_cast<int>(robots.size()));
 }
 
+Rng cooperative_trial_rng(std::uint64_t seed, const std::string& name, int t) {
+  return Rng(splitmix64(derive_seed(seed, name) + splitmix64(static_cast<std::uint64_t>(t) + 1)));
+}
+
 // --- simulation -----------------------------------------------------------------------------------------
 
 namespace {
 
-template <class... A>
-std::string sf(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
-
-/// Trial t of the stream `name` under the run's seed (independent of every other name and trial).
-Rng trial_rng(std::uint64_t seed, const char* name, int t) {
-  return Rng(splitmix64(derive_seed(seed, name) + splitmix64(static_cast<std::uint64_t>(t) + 1)));
-}
 
 struct Sighting {
   int step = 0;
@@ -415,8 +409,8 @@ PathStats run_path(const Cooperative001Config& c, CoopNoiseModel model, const si
   const double ref = c.reference_distance_or_mean();
   const std::vector<int> team = all_robots(c);
   for (int t = 0; t < trials; ++t) {
-    Rng noise = trial_rng(seed, "path/noise", t);  // the same observations for every model and network
-    Rng netr = trial_rng(seed, net_stream, t);
+    Rng noise = cooperative_trial_rng(seed, "path/noise", t);  // the same observations for every model and network
+    Rng netr = cooperative_trial_rng(seed, net_stream, t);
     accumulate(s, c, run_trial(c, model, ref, team, net, c.fusion_deadline, noise, netr), true);
   }
   return s;
@@ -448,7 +442,7 @@ double published(const Json& p, const char* group, const char* key) {
   return std::nan("");
 }
 
-std::string mm(double m_value, int prec = 1) { return std::isnan(m_value) ? "n/a" : sf("%.*f", prec, 1000.0 * m_value); }
+std::string mm(double m_value, int prec = 1) { return std::isnan(m_value) ? "n/a" : strprintf("%.*f", prec, 1000.0 * m_value); }
 
 cv::Mat field_figure(const Cooperative001Config& c, const Trial& tr) {
   const double s = 110.0;  // px per metre
@@ -493,11 +487,11 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   if (!c.description.empty()) md << c.description << "\n\n";
   md
      << "Description file `" << file << "`; seed " << seed << (args.quick ? " (quick mode)" : "") << "; machine: " << machine_text() << ".\n"
-     << sf("Field %.1f m x %.1f m, ", c.field_length, c.field_width) << c.robots.size() << " robots, ball "
-     << sf("(%.0f, %.0f) -> (%.0f, %.0f) mm", 1000 * c.ball_start.x(), 1000 * c.ball_start.y(), 1000 * c.ball_end.x(), 1000 * c.ball_end.y())
-     << sf(" in %.0f mm steps (%d positions, %.3f s per step). ", 1000 * c.ball_step, c.path_positions(), c.step_time)
+     << strprintf("Field %.1f m x %.1f m, ", c.field_length, c.field_width) << c.robots.size() << " robots, ball "
+     << strprintf("(%.0f, %.0f) -> (%.0f, %.0f) mm", 1000 * c.ball_start.x(), 1000 * c.ball_start.y(), 1000 * c.ball_end.x(), 1000 * c.ball_end.y())
+     << strprintf(" in %.0f mm steps (%d positions, %.3f s per step). ", 1000 * c.ball_step, c.path_positions(), c.step_time)
      << "Noise model **" << to_string(c.noise_model) << "**, sigma " << mm(c.sigma, 0) << " mm"
-     << (c.noise_model == CoopNoiseModel::Polar ? sf(" (bearing sigma %.2f deg = sigma / L_ref, L_ref = %.0f mm)", 180.0 / std::numbers::pi * c.sigma / ref, 1000 * ref)
+     << (c.noise_model == CoopNoiseModel::Polar ? strprintf(" (bearing sigma %.2f deg = sigma / L_ref, L_ref = %.0f mm)", 180.0 / std::numbers::pi * c.sigma / ref, 1000 * ref)
                                                  : std::string())
      << ".\n\n";
 
@@ -517,7 +511,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
      << mm(head.diff.sd()) << " | " << mm(p_weighted - p_equal, 0) << " |\n\n";
   const double real_before = published(paper, "001_real_mean_error_cm", "before"), real_after = published(paper, "001_real_mean_error_cm", "after");
   if (!std::isnan(real_before))
-    md << sf("Paper's real-robot result (not simulated here): mean error %.1f cm -> %.1f cm. ", real_before, real_after)
+    md << strprintf("Paper's real-robot result (not simulated here): mean error %.1f cm -> %.1f cm. ", real_before, real_after)
        << "The paper does not say where its simulated noise enters; the next table runs the same draws through three readings.\n\n";
 
   md << "Same observations under each noise model (sigma " << mm(c.sigma, 0) << " mm; mean error in mm):\n\n"
@@ -531,7 +525,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
        << mm(s.equal.mean()) << " | " << mm(s.weighted.mean()) << " | " << mm(s.diff.mean) << " +- " << mm(s.diff.se()) << " |\n";
   }
   md << "\nPer robot (headline model), own-estimate mean error in mm:";
-  for (std::size_t i = 0; i < head.own.size(); ++i) md << sf(" robot %d: ", static_cast<int>(i) + 1) << mm(head.own[i].mean());
+  for (std::size_t i = 0; i < head.own.size(); ++i) md << strprintf(" robot %d: ", static_cast<int>(i) + 1) << mm(head.own[i].mean());
   md << ".\n\n";
 
   // 2. Network: ideal vs lossy, fixes used at their stamps.
@@ -539,12 +533,12 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   auto net_row = [&](const char* name, const sim::NetworkConfig& nc, const PathStats& s) {
     const double steps = static_cast<double>(s.trials) * c.path_positions();
     std::ostringstream r;
-    r << "| " << name << sf(" (latency %.3g s, jitter %.3g s ", nc.latency, nc.jitter) << sim::to_string(nc.jitter_kind)
-      << sf(", loss %.2g)", nc.loss) << " | " << sf("%.1f %%", 100.0 * s.lost / std::max(1.0, s.sent)) << " | "
-      << sf("%.2f %%", 100.0 * s.late / std::max(1.0, s.sent)) << " | " << sf("%.2f", s.received_sum / steps) << " | "
-      << sf("%.2f %%", 100.0 * (s.status_weighted.count("single_robot") ? s.status_weighted.at("single_robot") : 0.0) / steps) << " | "
-      << sf("%.2f %%", 100.0 * (s.status_weighted.count("no_observation") ? s.status_weighted.at("no_observation") : 0.0) / steps) << " | "
-      << mm(s.equal.mean()) << " | " << mm(s.weighted.mean()) << " | " << sf("%.0f", 1000.0 * (s.age_n > 0 ? s.age_sum / s.age_n : 0.0)) << " | "
+    r << "| " << name << strprintf(" (latency %.3g s, jitter %.3g s ", nc.latency, nc.jitter) << sim::to_string(nc.jitter_kind)
+      << strprintf(", loss %.2g)", nc.loss) << " | " << strprintf("%.1f %%", 100.0 * s.lost / std::max(1.0, s.sent)) << " | "
+      << strprintf("%.2f %%", 100.0 * s.late / std::max(1.0, s.sent)) << " | " << strprintf("%.2f", s.received_sum / steps) << " | "
+      << strprintf("%.2f %%", 100.0 * (s.status_weighted.count("single_robot") ? s.status_weighted.at("single_robot") : 0.0) / steps) << " | "
+      << strprintf("%.2f %%", 100.0 * (s.status_weighted.count("no_observation") ? s.status_weighted.at("no_observation") : 0.0) / steps) << " | "
+      << mm(s.equal.mean()) << " | " << mm(s.weighted.mean()) << " | " << strprintf("%.0f", 1000.0 * (s.age_n > 0 ? s.age_sum / s.age_n : 0.0)) << " | "
       << mm(s.weighted_at_use.mean()) << " |\n";
     return r.str();
   };
@@ -570,8 +564,8 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
     const auto k = subset.size();
     PathStats s;
     for (int t = 0; t < n.per_subset; ++t) {
-      Rng noise = trial_rng(seed, "robots/noise", t);  // shared by every subset: subsets differ only in who is asked
-      Rng netr = trial_rng(seed, "robots/net", t);
+      Rng noise = cooperative_trial_rng(seed, "robots/noise", t);  // shared by every subset: subsets differ only in who is asked
+      Rng netr = cooperative_trial_rng(seed, "robots/net", t);
       const Trial tr = run_trial(c, c.noise_model, ref, subset, c.network, c.fusion_deadline, noise, netr);
       accumulate(s, c, tr, false);
       for (int k = 0; k < c.path_positions(); ++k) {
@@ -603,8 +597,8 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
     std::nth_element(we.begin(), we.begin() + static_cast<std::ptrdiff_t>(we.size() / 2), we.end());
     const double w_median = we.empty() ? 0.0 : we[we.size() / 2];
     md << "| " << k << " | " << subsets_k[ku] << " | " << mm(eq_all[ku].mean) << " | " << mm(w_all[ku].mean) << " | " << mm(eq_first[ku]) << " | "
-       << mm(w_first[ku]) << " | " << mm(w_median) << " | " << sf("%.2f %%", 100.0 * deg) << " |\n";
-    csv += sf("%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.5f\n", k, subsets_k[ku], n.per_subset, 1000 * eq_all[ku].mean, 1000 * w_all[ku].mean,
+       << mm(w_first[ku]) << " | " << mm(w_median) << " | " << strprintf("%.2f %%", 100.0 * deg) << " |\n";
+    csv += strprintf("%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.5f\n", k, subsets_k[ku], n.per_subset, 1000 * eq_all[ku].mean, 1000 * w_all[ku].mean,
               1000 * eq_first[ku], 1000 * w_first[ku], deg);
     for (Series* se : {&s_eq, &s_w, &s_eqf, &s_wf}) se->x.push_back(k);
     s_eq.y.push_back(1000 * eq_all[ku].mean);
@@ -629,7 +623,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   std::vector<double> rm[3];
   for (int i = 0; i < n.growth_model; ++i)
     for (int k = 0; k < 3; ++k) {
-      Rng rng = trial_rng(seed, "growth", i);  // every filter sees the same trajectory
+      Rng rng = cooperative_trial_rng(seed, "growth", i);  // every filter sees the same trajectory
       rm[k].push_back(growth_model_rmse(kinds[k], 100, 50, rng));
     }
   Json growth_json = Json::object();
@@ -642,7 +636,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
     std::sort(sorted.begin(), sorted.end());
     const std::size_t h = sorted.size() / 2;
     const double med = sorted.size() % 2 ? sorted[h] : 0.5 * (sorted[h - 1] + sorted[h]);
-    md << "| " << to_string(kinds[k]) << sf(" | %.3f | %.3f | %.3f |\n", st.mean, st.sd(), med);
+    md << "| " << to_string(kinds[k]) << strprintf(" | %.3f | %.3f | %.3f |\n", st.mean, st.sd(), med);
     growth_json[to_string(kinds[k])] = {{"mean", st.mean}, {"std", st.sd()}, {"median", med}};
   }
   auto paired = [&](int a, int b) {
@@ -653,14 +647,14 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
       lower += rm[a][i] < rm[b][i];
     }
     growth_json[std::string(to_string(kinds[a])) + "_minus_" + to_string(kinds[b])] = {{"mean", d.mean}, {"se", d.se()}, {"a_lower", lower}};
-    return sf("%.3f +- %.3f (", d.mean, d.se()) + to_string(kinds[a]) + sf(" lower in %d of %d runs)", lower, static_cast<int>(rm[a].size()));
+    return strprintf("%.3f +- %.3f (", d.mean, d.se()) + to_string(kinds[a]) + strprintf(" lower in %d of %d runs)", lower, static_cast<int>(rm[a].size()));
   };
   const std::string d_mf = paired(2, 1), d_fp = paired(1, 0);
   const double dm = growth_json["mfbpf_minus_fbpf"]["mean"].get<double>(), dse = growth_json["mfbpf_minus_fbpf"]["se"].get<double>();
   const double z = dse > 0.0 ? dm / dse : 0.0;
-  const std::string verdict = z < -2.0  ? sf("reproduced: MFBPF is lower by %.3f (%.1f standard errors)", -dm, -z)
-                              : z < 0.0 ? sf("not established: MFBPF is lower by %.3f, only %.1f standard errors", -dm, -z)
-                                        : sf("not reproduced: MFBPF is not lower (MFBPF - FBPF = %+.3f, %.1f standard errors)", dm, z);
+  const std::string verdict = z < -2.0  ? strprintf("reproduced: MFBPF is lower by %.3f (%.1f standard errors)", -dm, -z)
+                              : z < 0.0 ? strprintf("not established: MFBPF is lower by %.3f, only %.1f standard errors", -dm, -z)
+                                        : strprintf("not reproduced: MFBPF is not lower (MFBPF - FBPF = %+.3f, %.1f standard errors)", dm, z);
   md << "\nPaired differences (mean +- standard error): MFBPF - FBPF = " << d_mf << "; FBPF - PF = " << d_fp << ".\n"
      << "Paper's claim: "
      << (paper.contains("001_growth_model") && paper["001_growth_model"].contains("claim") ? paper["001_growth_model"]["claim"].get<std::string>()
@@ -683,8 +677,8 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   // err[input][tracker + 1] (0 = the input itself), pooled over steps: all steps and steps >= settle.
   std::vector<std::vector<std::array<double, 4>>> acc(inputs.size(), std::vector<std::array<double, 4>>(trackers.size() + 1, {0, 0, 0, 0}));
   for (int t = 0; t < n.tracking; ++t) {
-    Rng noise = trial_rng(seed, "tracking/noise", t), noise2 = trial_rng(seed, "tracking/noise", t);
-    Rng net1 = trial_rng(seed, "tracking/net", t), net2 = trial_rng(seed, "tracking/lossy_net", t);
+    Rng noise = cooperative_trial_rng(seed, "tracking/noise", t), noise2 = cooperative_trial_rng(seed, "tracking/noise", t);
+    Rng net1 = cooperative_trial_rng(seed, "tracking/net", t), net2 = cooperative_trial_rng(seed, "tracking/lossy_net", t);
     const Trial ideal = run_trial(c, c.noise_model, ref, all_robots(c), c.network, c.fusion_deadline, noise, net1);
     const Trial lossy_tr = run_trial(c, c.noise_model, ref, all_robots(c), c.lossy_network, c.fusion_deadline, noise2, net2);
     for (std::size_t in = 0; in < inputs.size(); ++in) {
@@ -717,7 +711,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
           const double ps = mc.obs_sigma, vs = 2.0;  // m, m/s: the ball may roll at up to a few m/s
           tracker->init(x0, Eigen::Vector4d(ps * ps, ps * ps, vs * vs, vs * vs).asDiagonal());
         }
-        Rng frng = trial_rng(seed, ("tracking/filter/" + (tk ? trackers[tk - 1] : std::string("none"))).c_str(), t);
+        Rng frng = cooperative_trial_rng(seed, ("tracking/filter/" + (tk ? trackers[tk - 1] : std::string("none"))).c_str(), t);
         for (int k = 0; k < K; ++k) {
           const auto ku = static_cast<std::size_t>(k);
           const Eigen::Vector2d B = c.ball_at(k * c.step_time);
@@ -737,7 +731,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   }
   auto cell = [&](std::size_t in, std::size_t tk) {
     const auto& a = acc[in][tk];
-    return sf("%.0f (%.0f)", 1000 * a[0] / std::max(1.0, a[1]), 1000 * a[2] / std::max(1.0, a[3]));
+    return strprintf("%.0f (%.0f)", 1000 * a[0] / std::max(1.0, a[1]), 1000 * a[2] / std::max(1.0, a[3]));
   };
   md << "## Tracking (" << n.tracking << " trials; mean position error in mm over all " << K << " steps, in brackets over steps " << settle
      << "-" << K - 1 << ")\n\n"
@@ -767,7 +761,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   if (c.rendered) rendered_json = run_cooperative_rendered(c, args.quick ? c.rendered->quick_trials : c.rendered->trials, seed, md, dir, &out);
 
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  md << sf("Run time %.1f s.\n", elapsed);
+  md << strprintf("Run time %.1f s.\n", elapsed);
 
   // Outputs.
   auto stats_json = [&](const PathStats& s) {
@@ -808,7 +802,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   dir.write("cooperative_001.json", j.dump(1) + "\n");
   dir.write("cooperative_001.md", md.str());
   {
-    Rng noise = trial_rng(seed, "path/noise", 0), netr = trial_rng(seed, "path/net", 0);
+    Rng noise = cooperative_trial_rng(seed, "path/noise", 0), netr = cooperative_trial_rng(seed, "path/net", 0);
     dir.write("field.png", png_bytes(field_figure(c, run_trial(c, c.noise_model, ref, all_robots(c), c.network, c.fusion_deadline, noise, netr))));
   }
   dir.commit();

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "core/json_reader.hpp"
+#include "core/rng.hpp"
 #include "harness/experiment.hpp"
 #include "harness/experiments/cooperative_001_rendered.hpp"
 #include "sim/network.hpp"
@@ -80,6 +81,10 @@ void validate_cooperative_001(const std::string& file);
 /// Runs the experiment (args.config or the default file), writes cooperative_001.{json,md},
 /// robots_vs_error.{png,csv}, field.png (and with "rendered": robots_vs_error_rendered.{png,csv})
 /// into args.out_dir and prints the tables.
+/// Trial t of the random stream `name` under the run's seed (independent of every other name and
+/// trial): every draw of the experiment, in both observation modes, comes from one of these.
+Rng cooperative_trial_rng(std::uint64_t seed, const std::string& name, int t);
+
 int run_cooperative_001(const ExperimentArgs& args, std::ostream& out);
 
 }  // namespace omniloc::harness

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "harness/experiments/cooperative_001.hpp"
+#include "harness/experiments/text_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/plot.hpp"
@@ -131,18 +132,6 @@ RenderedBallSighting ball_sighting_from_blobs(const std::vector<Blob>& blobs, in
 
 namespace {
 
-template <class... A>
-std::string sf(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
-
-/// Same construction as cooperative_001.cpp's trial_rng, under names of their own ("rendered/...").
-Rng trial_rng(std::uint64_t seed, const std::string& name, int t) {
-  return Rng(splitmix64(derive_seed(seed, name) + splitmix64(static_cast<std::uint64_t>(t) + 1)));
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return std::nan("");
   const std::size_t h = v.size() / 2;
@@ -170,8 +159,8 @@ double sd(const std::vector<double>& v) {
 
 /// Json cannot hold NaN: undefined figures (e.g. an empty distance bin) become null.
 Json num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-std::string mm(double m_value, int prec = 1) { return std::isfinite(m_value) ? sf("%.*f", prec, 1000.0 * m_value) : std::string("n/a"); }
-std::string deg(double rad, int prec = 2) { return std::isfinite(rad) ? sf("%.*f", prec, rad * 180.0 / kPi) : std::string("n/a"); }
+std::string mm(double m_value, int prec = 1) { return std::isfinite(m_value) ? strprintf("%.*f", prec, 1000.0 * m_value) : std::string("n/a"); }
+std::string deg(double rad, int prec = 2) { return std::isfinite(rad) ? strprintf("%.*f", prec, rad * 180.0 / kPi) : std::string("n/a"); }
 
 /// Ground truth for the report only: is the ball (partly) behind another robot as seen by `obs`?
 /// 0 = clear, 1 = partly (the robot's footprint disc overlaps the ball's angular extent), 2 = fully.
@@ -336,8 +325,8 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
     // One camera stream per robot and trial (vibration, pixel noise), used for its self-localisation
     // frames and then its path frames.
     std::vector<Rng> cam_rng;
-    for (int i = 0; i < nr; ++i) cam_rng.push_back(trial_rng(seed, "rendered/camera/" + std::to_string(i), t));
-    Rng start_rng = trial_rng(seed, "rendered/start", t);
+    for (int i = 0; i < nr; ++i) cam_rng.push_back(cooperative_trial_rng(seed, "rendered/camera/" + std::to_string(i), t));
+    Rng start_rng = cooperative_trial_rng(seed, "rendered/start", t);
 
     // 1. Self-localisation: robots stand still, the ball lies at the path's start.
     std::vector<Pose2> est(nru);
@@ -376,7 +365,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
       pos_err.push_back(pe);
       pos_err_robot[i].push_back(pe);
       if (pe > kSelflocFail)
-        failures.push_back(sf("trial %d robot %d: %.0f mm, %.1f deg", t + 1, static_cast<int>(i) + 1, 1000 * pe,
+        failures.push_back(strprintf("trial %d robot %d: %.0f mm, %.1f deg", t + 1, static_cast<int>(i) + 1, 1000 * pe,
                               std::abs(wrap_angle(est[i].theta - truth[i].theta)) * 180.0 / kPi));
       head_err.push_back(std::abs(wrap_angle(est[i].theta - truth[i].theta)));
     }
@@ -496,7 +485,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
     }
     for (FixAcc* a : {&f_eq, &f_w, &f_eq_true, &f_w_true, &f_eq_ok, &f_w_ok}) a->end_trial();
     if (progress)
-      *progress << sf("rendered mode: trial %d/%d done, %.0f s\n", t + 1, trials, std::chrono::duration<double>(Clock::now() - t_start).count())
+      *progress << strprintf("rendered mode: trial %d/%d done, %.0f s\n", t + 1, trials, std::chrono::duration<double>(Clock::now() - t_start).count())
                 << std::flush;
   }
 
@@ -535,7 +524,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
             auto tracker = make_ball_tracker(trackers[tk], mc, pc);
             const double ps = mc.obs_sigma, vs = 2.0;  // as the direct-noise tracking table
             tracker->init(Eigen::Vector4d(first->x(), first->y(), 0.0, 0.0), Eigen::Vector4d(ps * ps, ps * ps, vs * vs, vs * vs).asDiagonal());
-            Rng frng = trial_rng(seed, "rendered/tracking/" + trackers[tk] + "/" + tin[in].name, static_cast<int>(tr) * 10007 + rep);
+            Rng frng = cooperative_trial_rng(seed, "rendered/tracking/" + trackers[tk] + "/" + tin[in].name, static_cast<int>(tr) * 10007 + rep);
             for (int k = 0; k < K; ++k) {
               const Eigen::Vector2d B = c.ball_at(k * c.step_time);
               sum += (tracker->step(z[static_cast<std::size_t>(k)], frng).state.head<2>() - B).norm();
@@ -562,22 +551,22 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
         "centre (ball radius "
      << mm(g.ball_radius, 0) << " mm, viewpoint " << mm(g.camera.mount_height, 0) << " mm high) and reports the line from its own pose. "
      << "Poses: " << (g.pose_source == CoopPoseSource::Matching
-                          ? sf("self-localised with `%s` on %d frames from a start %.0f mm / %.1f deg off", g.localizer["type"].get<std::string>().c_str(),
+                          ? strprintf("self-localised with `%s` on %d frames from a start %.0f mm / %.1f deg off", g.localizer["type"].get<std::string>().c_str(),
                                g.selfloc_frames, 1000 * g.start_offset, g.start_heading_offset * 180.0 / kPi)
-                          : sf("ground truth + N(0, (%.0f mm)^2) per axis (no self-localisation)", 1000 * g.pose_sigma))
+                          : strprintf("ground truth + N(0, (%.0f mm)^2) per axis (no self-localisation)", 1000 * g.pose_sigma))
      << ". Headings: " << (g.headings.empty() ? "each robot faces the middle of the ball path" : "from the file") << ".\n\n";
 
   md << "| estimate | mean error (mm) | median (mm) | per-trial std (mm) | no fix |\n|---|---|---|---|---|\n"
      << "| one robot's own estimate (pooled over robots, seen steps) | " << mm(mean(own_err)) << " | " << mm(median(own_err)) << " | - | - |\n";
   auto row = [&](const char* name, const FixAcc& a) {
     md << "| " << name << " | " << mm(mean(a.errors)) << " | " << mm(median(a.errors)) << " | " << mm(sd(a.per_trial)) << " | "
-       << sf("%.1f %%", 100.0 * a.no_fix / std::max(1, a.steps)) << " |\n";
+       << strprintf("%.1f %%", 100.0 * a.no_fix / std::max(1, a.steps)) << " |\n";
   };
   row("Hough fix, equal weights", f_eq);
   row("Hough fix, K_i = 1/L_i", f_w);
   row("equal weights, true poses (diagnostic)", f_eq_true);
   row("K_i = 1/L_i, true poses (diagnostic)", f_w_true);
-  const std::string ok_name = sf("%d trials without a self-localisation failure", trials_ok);
+  const std::string ok_name = strprintf("%d trials without a self-localisation failure", trials_ok);
   row(("equal weights, " + ok_name).c_str(), f_eq_ok);
   row(("K_i = 1/L_i, " + ok_name).c_str(), f_w_ok);
   md << "| paired difference 1/L - equal (per-trial mean +- s.e.) | " << mm(mean(diff_per_trial)) << " +- "
@@ -590,24 +579,24 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
      << (g.pose_source == CoopPoseSource::Matching ? " deg, from a start " + mm(mean(start_pos_err), 0) + " mm off"
                                                    : std::string(" deg (ground truth + noise, no self-localisation)"))
      << ". Per robot (mean position error, mm):";
-  for (std::size_t i = 0; i < nru; ++i) md << sf(" %d: ", static_cast<int>(i) + 1) << mm(mean(pos_err_robot[i]));
+  for (std::size_t i = 0; i < nru; ++i) md << strprintf(" %d: ", static_cast<int>(i) + 1) << mm(mean(pos_err_robot[i]));
   md << ".\n";
-  md << sf("Self-localisation failures (position error > %.0f mm): %d of %d robot-trials", 1000 * kSelflocFail, static_cast<int>(failures.size()),
+  md << strprintf("Self-localisation failures (position error > %.0f mm): %d of %d robot-trials", 1000 * kSelflocFail, static_cast<int>(failures.size()),
            trials * nr);
   for (std::size_t f = 0; f < failures.size(); ++f) md << (f ? "; " : ": ") << failures[f];
   md << ".\n\n";
 
-  md << sf("Sightings: %d robot-frames; ball found in %d (%.1f %%), with a distance in %d (%.1f %%); **missed %.1f %%**. ", n_sightings, n_seen,
+  md << strprintf("Sightings: %d robot-frames; ball found in %d (%.1f %%), with a distance in %d (%.1f %%); **missed %.1f %%**. ", n_sightings, n_seen,
            100.0 * n_seen / std::max(1, n_sightings), n_usable, 100.0 * n_usable / std::max(1, n_sightings), 100.0 * missed_frac)
-     << sf("No orange region: %d with the ball fully behind another robot, %d partly behind one, %d in clear view (too small or lost); "
+     << strprintf("No orange region: %d with the ball fully behind another robot, %d partly behind one, %d in clear view (too small or lost); "
            "%d found beyond the calibrated range (bearing only, dropped). Of %d partly occluded sightings %d were still used "
            "(median abs errors %s mm, %s deg). "
            "More than one orange region: %d frames; sightings more than 0.5 m off (outliers): %d.\n\n",
            miss_full, miss_partial, miss_clear, n_no_distance, partial_total, seen_partial, mm(median(part_d_abs)).c_str(),
            deg(median(part_b_abs)).c_str(), n_multi, n_outlier)
      << "Missed per robot:";
-  for (std::size_t i = 0; i < nru; ++i) md << sf(" %d: %d", static_cast<int>(i) + 1, missed_robot[i]);
-  md << sf(" (of %d each).\n\n", n_sightings / std::max(1, nr));
+  for (std::size_t i = 0; i < nru; ++i) md << strprintf(" %d: %d", static_cast<int>(i) + 1, missed_robot[i]);
+  md << strprintf(" (of %d each).\n\n", n_sightings / std::max(1, nr));
 
   md << "Measured sighting errors against the truth (robot frame; distance after the radius correction, signed = measured - true):\n\n"
      << "| true distance | sightings | missed | median abs distance error (mm) | median signed (mm) | median abs bearing error (deg) |\n"
@@ -638,8 +627,8 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
   for (std::size_t k = 1; k <= nru; ++k) {
     const double e = sub_n[k] > 0 ? sub_eq_sum[k] / sub_n[k] : std::nan(""), w = sub_n[k] > 0 ? sub_w_sum[k] / sub_n[k] : std::nan("");
     const double med = median(sub_w_err[k]), nf = sub_nofix[k] / std::max(1.0, sub_steps[k]);
-    md << "| " << k << " | " << mm(e) << " | " << mm(w) << " | " << mm(med) << " | " << sf("%.1f %%", 100.0 * nf) << " |\n";
-    csv += sf("%d,%d,%.3f,%.3f,%.3f,%.5f\n", static_cast<int>(k), trials, 1000 * e, 1000 * w, 1000 * med, nf);
+    md << "| " << k << " | " << mm(e) << " | " << mm(w) << " | " << mm(med) << " | " << strprintf("%.1f %%", 100.0 * nf) << " |\n";
+    csv += strprintf("%d,%d,%.3f,%.3f,%.3f,%.5f\n", static_cast<int>(k), trials, 1000 * e, 1000 * w, 1000 * med, nf);
     s_eq.x.push_back(static_cast<double>(k));
     s_w.x.push_back(static_cast<double>(k));
     s_eq.y.push_back(1000 * e);
@@ -660,7 +649,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
       md << "| " << trackers[tk] << " | " << mm(track_mean[0][tk], 0) << " | " << mm(track_mean[1][tk], 0) << " |\n";
     md << "\n";
   }
-  md << sf("Rendered mode: %d frames rendered at %.1f ms each (llvmpipe); set-up (calibration map and colour table, cached) %.1f s; "
+  md << strprintf("Rendered mode: %d frames rendered at %.1f ms each (llvmpipe); set-up (calibration map and colour table, cached) %.1f s; "
            "total %.1f s.\n\n",
            renders, ms_per_frame, setup_s, elapsed);
 

@@ -13,6 +13,7 @@
 #include "core/atomic_file.hpp"
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
+#include "harness/experiments/text_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
 #include "harness/run_directory.hpp"
@@ -26,12 +27,6 @@ namespace {
 using landmarks::BearingObs;
 using landmarks::Fix;
 
-template <class... A>
-std::string fmt(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -225,7 +220,7 @@ struct TableCell {
 std::vector<std::vector<TableCell>> run_table(const Field004& f, int trials, double sigma, std::uint64_t seed) {
   const auto& S = solvers();
   const auto posts = f.posts();
-  Rng rng = Rng::stream(seed, "landmark_maps/table1_004/" + fmt("%.4f", rad2deg(sigma)));
+  Rng rng = Rng::stream(seed, "landmark_maps/table1_004/" + strprintf("%.4f", rad2deg(sigma)));
   std::vector<std::vector<TableCell>> rows(kTable1True.size(), std::vector<TableCell>(S.size()));
   for (std::size_t k = 0; k < kTable1True.size(); ++k) {
     const Eigen::Vector2d p = kTable1True[k] / 100.0;
@@ -466,14 +461,14 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
 
   const auto posts = field.posts();
   out << "landmark_maps (seed " << args.seed << (args.quick ? ", quick" : "") << ")\n";
-  out << fmt("Paper 004 field, paper's frame (origin at a line corner, cm): %.0f x %.0f cm; yellow goal posts (%.0f,%.0f) (%.0f,%.0f), "
+  out << strprintf("Paper 004 field, paper's frame (origin at a line corner, cm): %.0f x %.0f cm; yellow goal posts (%.0f,%.0f) (%.0f,%.0f), "
              "blue goal posts (%.0f,%.0f) (%.0f,%.0f)\n",
              100 * field.length, 100 * field.width, 100 * posts[0].x(), 100 * posts[0].y(), 100 * posts[1].x(), 100 * posts[1].y(),
              100 * posts[2].x(), 100 * posts[2].y(), 100 * posts[3].x(), 100 * posts[3].y());
 
   // ---- (a) maps
   const MapResult m = run_maps(field, cell_m, map_trials, sigma_map, args.seed);
-  out << fmt("\n(a) Mean position error maps: %d x %d cells of %.0f cm, %d trials per cell, bearing noise N(0, %.1f deg), random heading\n",
+  out << strprintf("\n(a) Mean position error maps: %d x %d cells of %.0f cm, %d trials per cell, bearing noise N(0, %.1f deg), random heading\n",
              m.cols, m.rows, 100 * cell_m, map_trials, m.sigma_deg);
   out << "solver                     | field mean cm | median cm | p95 cm | worst cell cm | cells > " << cap_cm
       << " cm | trials refused | max |fix - total_like| cm\n";
@@ -484,9 +479,9 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
   for (int r = 0; r < m.rows; ++r)
     for (int c = 0; c < m.cols; ++c) {
       const std::size_t i = static_cast<std::size_t>(r) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(c);
-      csv += fmt("%.1f,%.1f", 100 * (c + 0.5) * cell_m, 100 * (r + 0.5) * cell_m);
+      csv += strprintf("%.1f,%.1f", 100 * (c + 0.5) * cell_m, 100 * (r + 0.5) * cell_m);
       for (std::size_t s = 0; s < S.size(); ++s)
-        csv += std::isfinite(m.mean_cm[s][i]) ? fmt(",%.4f,%.4f", m.mean_cm[s][i], m.refused[s][i]) : fmt(",nan,%.4f", m.refused[s][i]);
+        csv += std::isfinite(m.mean_cm[s][i]) ? strprintf(",%.4f,%.4f", m.mean_cm[s][i], m.refused[s][i]) : strprintf(",nan,%.4f", m.refused[s][i]);
       csv += "\n";
     }
   for (std::size_t s = 0; s < S.size(); ++s) {
@@ -497,8 +492,8 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
     for (double x : m.refused[s]) refused += x;
     refused /= static_cast<double>(m.refused[s].size());
     const double fm = mean_of(v), med = quantile(v, 0.5), p95 = quantile(v, 0.95), worst = max_of(v);
-    out << fmt("%-26s | %13.2f | %9.2f | %6.2f | %13.1f | %10.2f %% | %12.4f %% | ", S[s].name, fm, med, p95, worst, 100 * over, 100 * refused)
-        << (S[s].exact ? fmt("%.2e", m.max_diff_vs_total_cm[s]) : std::string("(diagnostic)")) << "\n";
+    out << strprintf("%-26s | %13.2f | %9.2f | %6.2f | %13.1f | %10.2f %% | %12.4f %% | ", S[s].name, fm, med, p95, worst, 100 * over, 100 * refused)
+        << (S[s].exact ? strprintf("%.2e", m.max_diff_vs_total_cm[s]) : std::string("(diagnostic)")) << "\n";
     maps_json.push_back({{"solver", S[s].name},
                          {"label", S[s].label},
                          {"field_mean_cm", fm},
@@ -515,10 +510,10 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
     const int cell_px = std::max(1, static_cast<int>(std::lround(600.0 / m.cols)));
     dir.write(std::string("map_") + S[s].name + ".png",
               png_bytes(heat_map(capped, m.cols, m.rows, 0.0, 100 * field.length, 0.0, 100 * field.width,
-                                 fmt("%s: mean error cm (0.5 deg, capped %.0f)", S[s].name, cap_cm), "x cm (paper 004 frame)", "y cm",
+                                 strprintf("%s: mean error cm (0.5 deg, capped %.0f)", S[s].name, cap_cm), "x cm (paper 004 frame)", "y cm",
                                  cell_px)));
   }
-  out << fmt("(the four exact solvers compared with total_like on %ld trials; diagnostics: eqs. (8)/(9) of paper 004 with a fixed "
+  out << strprintf("(the four exact solvers compared with total_like on %ld trials; diagnostics: eqs. (8)/(9) of paper 004 with a fixed "
              "rotation sign)\n",
              m.compared);
   dir.write("maps_004.csv", csv);
@@ -528,7 +523,7 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
   if (!pub.found) out << "(published numbers unavailable: " << pub.note << ")\n";
   Json table_json = Json::array();
   std::string md = "# Paper 004, table 1, reproduced (omniloc experiment landmark_maps)\n\n";
-  md += fmt("Field %.0f x %.0f cm (paper 004 frame, origin at a line corner), landmarks = the four goal posts; %d trials per position, "
+  md += strprintf("Field %.0f x %.0f cm (paper 004 frame, origin at a line corner), landmarks = the four goal posts; %d trials per position, "
             "random heading, seed %llu.\n",
             100 * field.length, 100 * field.width, table_trials, static_cast<unsigned long long>(args.seed));
   md += "Ours: mean of the estimates (cm) and mean error (cm) under Gaussian bearing noise. Published: paper 004's single real-robot "
@@ -540,23 +535,23 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
         "| true (cm) | two-circle mean (cm) | err | three-point mean (cm) | err | published two-circle | err | published three-point | err "
         "| eq. (8) literal err | eq. (9) literal err |\n";
     const std::string rule = "|---|---|---|---|---|---|---|---|---|---|---|\n";
-    out << fmt("\n(b) Paper 004 table 1, bearing noise N(0, %.1f deg), %d trials per position (ours: mean estimate, mean error, cm)\n", sd,
+    out << strprintf("\n(b) Paper 004 table 1, bearing noise N(0, %.1f deg), %d trials per position (ours: mean estimate, mean error, cm)\n", sd,
                table_trials)
         << head << rule;
-    md += fmt("\n## Bearing noise N(0, %.1f deg)\n\n", sd) + head + rule;
+    md += strprintf("\n## Bearing noise N(0, %.1f deg)\n\n", sd) + head + rule;
     Json jrows = Json::array();
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const auto& tc = rows[k][TC];
       const auto& tp = rows[k][TP];
-      std::string line = fmt("| (%.0f, %.0f) | (%.1f, %.1f) | %.2f | (%.1f, %.1f) | %.2f | ", kTable1True[k].x(), kTable1True[k].y(), tc.mean_x,
+      std::string line = strprintf("| (%.0f, %.0f) | (%.1f, %.1f) | %.2f | (%.1f, %.1f) | %.2f | ", kTable1True[k].x(), kTable1True[k].y(), tc.mean_x,
                              tc.mean_y, tc.mean_err, tp.mean_x, tp.mean_y, tp.mean_err);
       if (pub.found) {
         const auto& p = pub.rows[k];
-        line += fmt("(%.0f, %.0f) | %.3f | (%.0f, %.0f) | %.3f | ", p[2], p[3], p[4], p[5], p[6], p[7]);
+        line += strprintf("(%.0f, %.0f) | %.3f | (%.0f, %.0f) | %.3f | ", p[2], p[3], p[4], p[5], p[6], p[7]);
       } else {
         line += "- | - | - | - | ";
       }
-      line += fmt("%.1f | %.1f |\n", rows[k][E8].mean_err, rows[k][E9].mean_err);
+      line += strprintf("%.1f | %.1f |\n", rows[k][E8].mean_err, rows[k][E9].mean_err);
       out << line;
       md += line;
       Json per = Json::object();
@@ -578,7 +573,7 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
       const double centre = (rows[0][s].mean_err + rows[1][s].mean_err + rows[3][s].mean_err) / 3.0;
       return edge / centre;
     };
-    const std::string trend = fmt("edge/centre mean-error ratio: two-circle %.2f, three-point %.2f (published: two-circle %.2f, three-point %.2f); "
+    const std::string trend = strprintf("edge/centre mean-error ratio: two-circle %.2f, three-point %.2f (published: two-circle %.2f, three-point %.2f); "
                                   "max |two-circle - three-point| mean error over the rows %.2e cm",
                                   ratio(TC), ratio(TP),
                                   pub.found ? 0.5 * (pub.rows[2][4] + pub.rows[4][4]) / ((pub.rows[0][4] + pub.rows[1][4] + pub.rows[3][4]) / 3) : kNaN,
@@ -622,9 +617,9 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
     std::array<Json, 2> per_path = {Json::array(), Json::array()};
     for (int k = 0; k < sim_paths; ++k) {
       // The same frames (truth, noise, distractor) for both ways of recognising groups.
-      const auto frames = make_sim_frames(derive_seed(args.seed, fmt("sim003/path%d", k)), sim_waypoints, distractor);
+      const auto frames = make_sim_frames(derive_seed(args.seed, strprintf("sim003/path%d", k)), sim_waypoints, distractor);
       for (const bool remember : {false, true}) {
-        const std::string cname = fmt("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
+        const std::string cname = strprintf("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
         const SimStats st = run_sim(frames, remember);
         SimStats& a = all[remember ? 1 : 0];
         per_path[remember ? 1 : 0].push_back(sim_summary(st));
@@ -655,11 +650,11 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
       }
     }
     for (const bool remember : {false, true}) {
-      const std::string cname = fmt("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
+      const std::string cname = strprintf("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
       const SimStats& a = all[remember ? 1 : 0];
       const Json sum = sim_summary(a);
       sim_json[cname] = {{"all_paths", sum}, {"per_path", per_path[remember ? 1 : 0]}};
-      out << fmt("%-22s | %6d | %10.3f %7.3f (%5ld) | %9.3f %6.3f | %7.3f %6.3f | %9d | %6d | %d\n", cname.c_str(), a.frames,
+      out << strprintf("%-22s | %6d | %10.3f %7.3f (%5ld) | %9.3f %6.3f | %7.3f %6.3f | %9d | %6d | %d\n", cname.c_str(), a.frames,
                  mean_of(a.fix_errors), max_of(a.fix_errors), static_cast<long>(sum["fixes_over_1m"].get<long>()), mean_of(a.err_novote),
                  max_of(a.err_novote), mean_of(a.err_vote), max_of(a.err_vote), a.kept, a.forced, a.new_groups_vote);
     }

@@ -114,8 +114,6 @@ void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const
     }
 }
 
-double illumination_at(const Lighting& l, const Eigen::Vector2d& p) { return l.at(p); }
-
 // The lit rectangle of a wall sun patch: a quad 1 cm in front of the inner face of the hall wall
 // nearest to the patch centre (drawn over the wall like floor patches over the carpet, so its edges
 // stay sharp whatever the wall's tessellation). Empty when the patch misses the wall.
@@ -432,7 +430,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     m.col.clear();
     for (const Tri& t : list) {
       const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
-      const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : illumination_at(world.lighting, mid)) / kRadianceScale);
+      const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : world.lighting.at(mid)) / kRadianceScale);
       for (const auto& v : t.p) {
         float xyz[3];
         project(v, xyz);
@@ -527,7 +525,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
 
   // The robot's own body in the image centre (its brightness follows the light on the robot).
   gl.Disable(GL_DEPTH_TEST);
-  const float body_illum = static_cast<float>(illumination_at(world.lighting, pose.translation()) / kRadianceScale);
+  const float body_illum = static_cast<float>(world.lighting.at(pose.translation()) / kRadianceScale);
   m.pos.clear();
   m.col.clear();
   const int n = 64;
