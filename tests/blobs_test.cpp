@@ -13,29 +13,16 @@
 #include "localization/vision/blobs.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/render/panoramic_camera.hpp"
+#include "test_scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
 
 namespace {
 
-CameraConfig ideal() {
-  CameraConfig c;
-  c.vibration_std = 0;
-  c.read_noise = 0;
-  c.shot_noise = 0;
-  return c;
-}
+using testing_scenes::quiet_camera;
 
-WorldState world(const Pose2& p) {
-  WorldState w;
-  RobotState r;
-  r.id = 0;
-  r.pose = p;
-  w.robots.push_back(r);
-  w.has_ball = false;
-  return w;
-}
+using testing_scenes::one_robot;
 
 double bearing_to(const Pose2& robot, const Eigen::Vector2d& target) {
   const Eigen::Vector2d d = target - robot.translation();
@@ -61,9 +48,9 @@ class BlobsTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     arena_ = new Field(Field::preset("arena_10x8"));
-    cam_ = new PanoramicCamera(ideal(), *arena_);
-    map_ = new CalibrationMap(harness::calibrate_camera(ideal(), 1).map);
-    table_ = new ColourTable(harness::colour_calibrate(ideal(), *arena_, 1, 8));
+    cam_ = new PanoramicCamera(quiet_camera(), *arena_);
+    map_ = new CalibrationMap(harness::calibrate_camera(quiet_camera(), 1).map);
+    table_ = new ColourTable(harness::colour_calibrate(quiet_camera(), *arena_, 1, 8));
   }
   static void TearDownTestSuite() {
     delete table_;
@@ -109,7 +96,7 @@ TEST_F(BlobsTest, ArenaFieldHasTheFourCubesOfPaper003) {
 
 TEST_F(BlobsTest, OneBlobPerCubeWithBearingAndDistance) {
   Rng rng(1);
-  const Image img = cam_->render(world(kPose), 0, {}, rng);
+  const Image img = cam_->render(one_robot(kPose), 0, {}, rng);
   const BlobDetector det(BlobParams{}, *map_, *table_);
   const std::vector<Blob> blobs = det.detect(img);
   const std::vector<Blob> reg = regions(blobs);
@@ -146,7 +133,7 @@ TEST_F(BlobsTest, NoisyCameraStillFindsTheCubes) {
   const CameraConfig noisy;
   PanoramicCamera cam(noisy, *arena_);
   Rng rng(7);
-  const Image img = cam.render(world(kPose), 0, noisy.initial, rng);
+  const Image img = cam.render(one_robot(kPose), 0, noisy.initial, rng);
   const BlobDetector det(BlobParams{}, *map_, *table_);
   const std::vector<Blob> reg = regions(det.detect(img));
   ASSERT_EQ(reg.size(), 4u);
@@ -175,7 +162,7 @@ TEST_F(BlobsTest, CoveredImageGivesNoBlobs) {
 
 TEST_F(BlobsTest, LocalizerRecoversThePoseFromTheFrame) {
   Rng rng(1);
-  const Image img = cam_->render(world(kPose), 0, {}, rng);
+  const Image img = cam_->render(one_robot(kPose), 0, {}, rng);
   const BlobDetector det(BlobParams{}, *map_, *table_);
   Observations obs;
   obs.blobs = det.detect(img);
@@ -196,7 +183,7 @@ TEST_F(BlobsTest, LocalizerRecoversThePoseFromTheFrame) {
 
 TEST_F(BlobsTest, FewerThanThreeLandmarksGiveNoFixWithAReason) {
   Rng rng(1);
-  Image img = cam_->render(world(kPose), 0, {}, rng);
+  Image img = cam_->render(one_robot(kPose), 0, {}, rng);
   // Black sectors (e.g. robots close by) over two of the cubes.
   std::vector<Sector> sectors;
   for (const auto& l : arena_->landmarks)
@@ -225,7 +212,7 @@ TEST_F(BlobsTest, FewerThanThreeLandmarksGiveNoFixWithAReason) {
 
 TEST_F(BlobsTest, TwoRedCubesAreToldApartWithThreeBearings) {
   Rng rng(1);
-  Image img = cam_->render(world(kPose), 0, {}, rng);
+  Image img = cam_->render(one_robot(kPose), 0, {}, rng);
   std::vector<Sector> sectors;
   for (const auto& l : arena_->landmarks)
     if (l.id == "B") sectors.push_back({bearing_to(kPose, l.position) - deg2rad(10), deg2rad(20)});
@@ -288,7 +275,7 @@ TEST(LandmarkLocalizerTest, SameColouredLandmarksAreAmbiguousWithoutDistancesOrP
 
 TEST_F(BlobsTest, DetectionTimePerFrame) {
   Rng rng(1);
-  const Image img = cam_->render(world(kPose), 0, {}, rng);
+  const Image img = cam_->render(one_robot(kPose), 0, {}, rng);
   const BlobDetector det(BlobParams{}, *map_, *table_);
   std::size_t n = 0;
   const int reps = 20;
@@ -303,9 +290,9 @@ TEST_F(BlobsTest, DetectionTimePerFrame) {
 // Paper 004's setting: goal edges on the legacy field.
 TEST(BlobsGoalTest, GoalEdgesAndPoseOnTheLegacyField) {
   const Field field = Field::preset("msl2007");
-  PanoramicCamera cam(ideal(), field);
-  const CalibrationMap map = harness::calibrate_camera(ideal(), 1).map;
-  const ColourTable table = harness::colour_calibrate(ideal(), field, 1, 8);
+  PanoramicCamera cam(quiet_camera(), field);
+  const CalibrationMap map = harness::calibrate_camera(quiet_camera(), 1).map;
+  const ColourTable table = harness::colour_calibrate(quiet_camera(), field, 1, 8);
   BlobParams bp;
   bp.edge_colours = {kYellow, kBlue};
   const BlobDetector det(bp, map, table);
@@ -317,7 +304,7 @@ TEST(BlobsGoalTest, GoalEdgesAndPoseOnTheLegacyField) {
   for (const Pose2& pose : poses) {
     Rng rng(3);
     Observations obs;
-    obs.blobs = det.detect(cam.render(world(pose), 0, {}, rng));
+    obs.blobs = det.detect(cam.render(one_robot(pose), 0, {}, rng));
     int edges = 0;
     for (const auto& b : obs.blobs) {
       if (b.kind == Blob::Kind::kRegion) continue;

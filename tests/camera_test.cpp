@@ -6,32 +6,19 @@
 #include "core/error.hpp"
 #include "core/field.hpp"
 #include "sim/render/panoramic_camera.hpp"
+#include "test_scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
 
 namespace {
-CameraConfig quiet() {
-  CameraConfig c;
-  c.vibration_std = 0;
-  c.read_noise = 0;
-  c.shot_noise = 0;
-  return c;
-}
-WorldState one_robot(const Pose2& p) {
-  WorldState w;
-  RobotState r;
-  r.id = 0;
-  r.pose = p;
-  w.robots.push_back(r);
-  w.has_ball = false;
-  return w;
-}
+using testing_scenes::quiet_camera;
+using testing_scenes::one_robot;
 }  // namespace
 
 class CameraTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { cam_ = new PanoramicCamera(quiet(), Field::preset("msl2012")); }
+  static void SetUpTestSuite() { cam_ = new PanoramicCamera(quiet_camera(), Field::preset("msl2012")); }
   static void TearDownTestSuite() {
     delete cam_;
     cam_ = nullptr;
@@ -127,7 +114,7 @@ TEST_F(CameraTest, ExposureSaturatesAndNoiseGrowsWithGain) {
   EXPECT_NEAR(PanoramicCamera::response(0.85, 1.0, {18, 18}), 450.0, 1e-9);
   EXPECT_LT(PanoramicCamera::response(0.34, 1.0, {18, 18}), 255.0);  // the carpet green channel (albedo 0.34)
 
-  CameraConfig noisy = quiet();
+  CameraConfig noisy = quiet_camera();
   noisy.read_noise = 2.0;
   noisy.shot_noise = 0.5;
   PanoramicCamera cam(noisy, Field::preset("msl2012"));
@@ -249,7 +236,7 @@ TEST(CameraConfig, BadInputIsNamed) {
 }
 
 TEST(CameraBackends, EglSurfacelessRendersTheSameScene) {
-  CameraConfig c = quiet();
+  CameraConfig c = quiet_camera();
   c.backend = "egl";
   std::unique_ptr<PanoramicCamera> egl;
   try {
@@ -257,7 +244,7 @@ TEST(CameraBackends, EglSurfacelessRendersTheSameScene) {
   } catch (const RuntimeFailure& e) {
     GTEST_SKIP() << "EGL surfaceless unavailable here: " << e.what();
   }
-  PanoramicCamera osm(quiet(), Field::preset("msl2012"));
+  PanoramicCamera osm(quiet_camera(), Field::preset("msl2012"));
   const WorldState w = one_robot(Pose2(2.0, 1.0, -0.5));
   const Image a = egl->render_labels(w, 0), b = osm.render_labels(w, 0);
   std::size_t diff = 0;

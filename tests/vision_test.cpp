@@ -10,27 +10,22 @@
 #include "localization/vision/scan_lines.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/render/panoramic_camera.hpp"
+#include "test_scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
 
 namespace {
-CameraConfig ideal() {
-  CameraConfig c;
-  c.vibration_std = 0;
-  c.read_noise = 0;
-  c.shot_noise = 0;
-  return c;
-}
+using testing_scenes::quiet_camera;
 }  // namespace
 
 class VisionTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     field_ = new Field(Field::preset("msl2012"));
-    cam_ = new PanoramicCamera(ideal(), *field_);
-    map_ = new CalibrationMap(harness::calibrate_camera(ideal(), 1).map);
-    table_ = new ColourTable(harness::colour_calibrate(ideal(), *field_, 1, 8));
+    cam_ = new PanoramicCamera(quiet_camera(), *field_);
+    map_ = new CalibrationMap(harness::calibrate_camera(quiet_camera(), 1).map);
+    table_ = new ColourTable(harness::colour_calibrate(quiet_camera(), *field_, 1, 8));
   }
   static void TearDownTestSuite() {
     delete table_;
@@ -38,15 +33,7 @@ class VisionTest : public ::testing::Test {
     delete cam_;
     delete field_;
   }
-  static WorldState world(const Pose2& p) {
-    WorldState w;
-    RobotState r;
-    r.id = 0;
-    r.pose = p;
-    w.robots.push_back(r);
-    w.has_ball = false;
-    return w;
-  }
+  static WorldState world(const Pose2& p) { return testing_scenes::one_robot(p); }
   static Field* field_;
   static PanoramicCamera* cam_;
   static CalibrationMap* map_;

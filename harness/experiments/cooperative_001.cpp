@@ -195,6 +195,21 @@ Rng cooperative_trial_rng(std::uint64_t seed, const std::string& name, int t) {
   return Rng(splitmix64(derive_seed(seed, name) + splitmix64(static_cast<std::uint64_t>(t) + 1)));
 }
 
+std::unique_ptr<BallTracker> make_coop_tracker(const Cooperative001Config& c, const std::string& name, double obs_sigma,
+                                               const Eigen::Vector2d& first) {
+  CvModelConfig mc;
+  mc.dt = c.step_time;
+  mc.accel_sigma = c.accel_sigma;
+  mc.obs_sigma = std::max(1e-3, obs_sigma);
+  ParticleTrackerConfig pc;
+  pc.particles = c.particles;
+  pc.threshold = c.tracking_threshold;
+  auto tracker = make_ball_tracker(name, mc, pc);
+  const double ps = mc.obs_sigma, vs = 2.0;  // m, m/s
+  tracker->init(Eigen::Vector4d(first.x(), first.y(), 0.0, 0.0), Eigen::Vector4d(ps * ps, ps * ps, vs * vs, vs * vs).asDiagonal());
+  return tracker;
+}
+
 // --- simulation -----------------------------------------------------------------------------------------
 
 namespace {
@@ -698,19 +713,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
             first = *zz;
             break;
           }
-        if (tk > 0) {
-          CvModelConfig mc;
-          mc.dt = c.step_time;
-          mc.accel_sigma = c.accel_sigma;
-          mc.obs_sigma = std::max(1e-3, inputs[in].obs_sigma);
-          ParticleTrackerConfig pc;
-          pc.particles = c.particles;
-          pc.threshold = c.tracking_threshold;
-          tracker = make_ball_tracker(trackers[tk - 1], mc, pc);
-          Eigen::Vector4d x0(first.x(), first.y(), 0.0, 0.0);
-          const double ps = mc.obs_sigma, vs = 2.0;  // m, m/s: the ball may roll at up to a few m/s
-          tracker->init(x0, Eigen::Vector4d(ps * ps, ps * ps, vs * vs, vs * vs).asDiagonal());
-        }
+        if (tk > 0) tracker = make_coop_tracker(c, trackers[tk - 1], inputs[in].obs_sigma, first);
         Rng frng = cooperative_trial_rng(seed, ("tracking/filter/" + (tk ? trackers[tk - 1] : std::string("none"))).c_str(), t);
         for (int k = 0; k < K; ++k) {
           const auto ku = static_cast<std::size_t>(k);

@@ -6,6 +6,7 @@
 // file, by default scenarios/experiments/cooperative_001.json; docs/cooperative.md has the results.
 //
 // Coordinates: the paper's frame, metres, origin at a field corner, x along the 6 m side.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "core/rng.hpp"
 #include "harness/experiment.hpp"
 #include "harness/experiments/cooperative_001_rendered.hpp"
+#include "localization/cooperative/ball_trackers.hpp"
 #include "sim/network.hpp"
 
 namespace omniloc::harness {
@@ -81,6 +83,12 @@ void validate_cooperative_001(const std::string& file);
 /// Runs the experiment (args.config or the default file), writes cooperative_001.{json,md},
 /// robots_vs_error.{png,csv}, field.png (and with "rendered": robots_vs_error_rendered.{png,csv})
 /// into args.out_dir and prints the tables.
+/// Ball tracker `name` ("kf", "pf", "fbpf", "mfbpf") with the experiment's motion model and particle
+/// settings, for fixes of about `obs_sigma` metres error, started at rest at `first` (world, metres)
+/// with a prior of obs_sigma in position and 2 m/s in velocity (the ball may roll at a few m/s).
+std::unique_ptr<BallTracker> make_coop_tracker(const Cooperative001Config& c, const std::string& name, double obs_sigma,
+                                               const Eigen::Vector2d& first);
+
 /// Trial t of the random stream `name` under the run's seed (independent of every other name and
 /// trial): every draw of the experiment, in both observation modes, comes from one of these.
 Rng cooperative_trial_rng(std::uint64_t seed, const std::string& name, int t);

@@ -514,16 +514,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
             }
           if (!first) continue;
           for (int rep = 0; rep < reps; ++rep) {
-            CvModelConfig mc;
-            mc.dt = c.step_time;
-            mc.accel_sigma = c.accel_sigma;
-            mc.obs_sigma = std::max(1e-3, tin[in].obs_sigma);
-            ParticleTrackerConfig pc;
-            pc.particles = c.particles;
-            pc.threshold = c.tracking_threshold;
-            auto tracker = make_ball_tracker(trackers[tk], mc, pc);
-            const double ps = mc.obs_sigma, vs = 2.0;  // as the direct-noise tracking table
-            tracker->init(Eigen::Vector4d(first->x(), first->y(), 0.0, 0.0), Eigen::Vector4d(ps * ps, ps * ps, vs * vs, vs * vs).asDiagonal());
+            auto tracker = make_coop_tracker(c, trackers[tk], tin[in].obs_sigma, *first);  // as the direct-noise tracking table
             Rng frng = cooperative_trial_rng(seed, "rendered/tracking/" + trackers[tk] + "/" + tin[in].name, static_cast<int>(tr) * 10007 + rep);
             for (int k = 0; k < K; ++k) {
               const Eigen::Vector2d B = c.ball_at(k * c.step_time);
