@@ -29,6 +29,35 @@ bool GlContext::has_extension(const std::string& name) const {
   return ext && std::strstr(ext, name.c_str()) != nullptr;
 }
 
+unsigned GlContext::fragment_program(const char* source, const std::string& what) const {
+  auto fail = [&](const std::string& stage, const std::string& log) {
+    throw RuntimeFailure("GL back-end \"" + backend_ + "\": " + what + " shader " + stage + " failed: " + log);
+  };
+  const GLuint sh = gl_.CreateShader(GL_FRAGMENT_SHADER);
+  if (!sh) fail("creation", "glCreateShader returned 0");
+  gl_.ShaderSource(sh, 1, &source, nullptr);
+  gl_.CompileShader(sh);
+  GLint ok = GL_FALSE;
+  char log[2048] = {};
+  gl_.GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    gl_.GetShaderInfoLog(sh, sizeof log, nullptr, log);
+    gl_.DeleteShader(sh);
+    fail("compilation", log);
+  }
+  const GLuint prog = gl_.CreateProgram();
+  gl_.AttachShader(prog, sh);
+  gl_.LinkProgram(prog);
+  gl_.DeleteShader(sh);  // stays alive while attached
+  gl_.GetProgramiv(prog, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    gl_.GetProgramInfoLog(prog, sizeof log, nullptr, log);
+    gl_.DeleteProgram(prog);
+    fail("linking", log);
+  }
+  return prog;
+}
+
 void GlContext::release_framebuffer() {
   if (fbo_) gl_.DeleteFramebuffers(1, &fbo_);
   if (color_) gl_.DeleteRenderbuffers(1, &color_);

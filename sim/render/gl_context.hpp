@@ -31,6 +31,7 @@ struct GlApi {
   X(void, DeleteTextures, (GLsizei, const GLuint*))                                               \
   X(void, BindTexture, (GLenum, GLuint))                                                          \
   X(void, TexImage2D, (GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum, const void*)) \
+  X(void, TexSubImage2D, (GLenum, GLint, GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, const void*)) \
   X(void, TexParameteri, (GLenum, GLenum, GLint))                                                 \
   X(void, TexParameterf, (GLenum, GLenum, GLfloat))                                               \
   X(void, TexParameterfv, (GLenum, GLenum, const GLfloat*))                                       \
@@ -55,7 +56,29 @@ struct GlApi {
   X(void, GenRenderbuffers, (GLsizei, GLuint*))                                                   \
   X(void, DeleteRenderbuffers, (GLsizei, const GLuint*))                                          \
   X(void, BindRenderbuffer, (GLenum, GLuint))                                                     \
-  X(void, RenderbufferStorage, (GLenum, GLenum, GLsizei, GLsizei))
+  X(void, RenderbufferStorage, (GLenum, GLenum, GLsizei, GLsizei))                               \
+  X(GLuint, CreateShader, (GLenum))                                                               \
+  X(void, DeleteShader, (GLuint))                                                                 \
+  X(void, ShaderSource, (GLuint, GLsizei, const GLchar* const*, const GLint*))                    \
+  X(void, CompileShader, (GLuint))                                                                \
+  X(void, GetShaderiv, (GLuint, GLenum, GLint*))                                                  \
+  X(void, GetShaderInfoLog, (GLuint, GLsizei, GLsizei*, GLchar*))                                 \
+  X(GLuint, CreateProgram, ())                                                                    \
+  X(void, DeleteProgram, (GLuint))                                                                \
+  X(void, AttachShader, (GLuint, GLuint))                                                         \
+  X(void, LinkProgram, (GLuint))                                                                  \
+  X(void, GetProgramiv, (GLuint, GLenum, GLint*))                                                 \
+  X(void, GetProgramInfoLog, (GLuint, GLsizei, GLsizei*, GLchar*))                                \
+  X(void, UseProgram, (GLuint))                                                                   \
+  X(GLint, GetUniformLocation, (GLuint, const GLchar*))                                           \
+  X(void, Uniform1i, (GLint, GLint))                                                              \
+  X(void, Uniform1f, (GLint, GLfloat))                                                            \
+  X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))                                          \
+  X(void, Uniform2f, (GLint, GLfloat, GLfloat))                                                   \
+  X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))                                 \
+  X(void, UniformMatrix3fv, (GLint, GLsizei, GLboolean, const GLfloat*))                          \
+  X(void, ActiveTexture, (GLenum))                                                                \
+  X(void, Color4f, (GLfloat, GLfloat, GLfloat, GLfloat))
 #define OMNILOC_GL_MEMBER(ret, name, args) ret(*name) args = nullptr;
   OMNILOC_GL_FUNCS(OMNILOC_GL_MEMBER)
 #undef OMNILOC_GL_MEMBER
@@ -74,6 +97,9 @@ class GlContext {
   /// Reads the bound framebuffer as RGBA8, rows bottom-up (GL order).
   void read_rgba(std::vector<unsigned char>& out) const;
   bool has_extension(const std::string& name) const;
+  /// Compiles and links a program of one GLSL fragment shader (the vertex stage stays fixed
+  /// function). Throws RuntimeFailure with the compiler's log, naming the back-end and `what`.
+  unsigned fragment_program(const char* source, const std::string& what) const;
 
  protected:
   void load(void* (*proc)(const char*));

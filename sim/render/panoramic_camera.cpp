@@ -15,7 +15,6 @@ namespace {
 const Eigen::Vector3f kCarpet(0.10f, 0.34f, 0.12f);
 const Eigen::Vector3f kLineWhite(0.85f, 0.85f, 0.85f);
 const Eigen::Vector3f kHallFloor(0.30f, 0.29f, 0.27f);
-const Eigen::Vector3f kBackground(0.08f, 0.08f, 0.09f);
 const Eigen::Vector3f kWall(0.14f, 0.14f, 0.20f);
 const Eigen::Vector3f kRobot(0.05f, 0.05f, 0.05f);
 const Eigen::Vector3f kBall(0.85f, 0.30f, 0.05f);
@@ -32,6 +31,46 @@ constexpr float kRadianceScale = 4.0f;
 // the carpet's green channel then sits near 180 DN and the white lines clip, as on many robot cameras.
 // (v1 put the lines at 200 DN at 18 / 18; its entropy peak lay at 26-30.)
 constexpr double kResponse = 2.25 * 200.0 / (0.85 * 18.0 * 18.0);
+// Pixel noise: standard normals kept in 1/32 steps from -4 to +4 (one byte each); the step is a
+// thirtieth of a DN at the largest noise (about 5 DN), well below the output's rounding.
+constexpr double kNoiseStep = 1.0 / 32.0;
+constexpr double kNoiseZero = 127.5;  // index of 0 (halfway, so the steps are symmetric)
+
+// Floor markings from a distance field: each texel holds the distance from its centre to the nearest
+// marking's centre line (a 16-bit fraction of kDistanceRange metres). The shader takes the pixel's
+// extent across the line from the screen-space change of that distance (fwidth) and returns the
+// exact share of a pixel-wide box that the line covers. That anti-aliases far lines across the line
+// only, where trilinear mip-mapping of a 1 cm RGBA texture blurred them by the pixel's largest
+// extent in every direction, and costs one bilinear fetch per pixel instead of eight (the floor pass
+// 1.3x faster on llvmpipe, docs/camera.md). Bilinear interpolation keeps the distance exact to a
+// fraction of a millimetre where the field is linear in position, i.e. across a line's edges.
+constexpr double kDistanceTexel = 0.02;  // metres
+constexpr double kDistanceRange = 2.0;   // metres; farther is stored as 2 m
+const char* const kFloorShader = R"(#version 130
+uniform sampler2D distance_map;
+uniform float range, half_width;
+uniform vec3 line, carpet, outside;  // albedos
+void main() {
+  vec2 uv = gl_TexCoord[0].st;
+  float d = texture(distance_map, uv).r * range;
+  float fw = max(fwidth(d), 1e-4);
+  float cover = clamp((min(d + 0.5 * fw, half_width) - max(d - 0.5 * fw, -half_width)) / fw, 0.0, 1.0);
+  bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+  gl_FragColor = vec4((inside ? mix(carpet, line, cover) : outside) * gl_Color.rgb, 1.0);
+}
+)";
+// The same field as flat class ids (a pixel is line where its centre is).
+const char* const kFloorLabelShader = R"(#version 130
+uniform sampler2D distance_map;
+uniform float range, half_width;
+uniform vec3 line, carpet, outside;  // label ids / 255
+void main() {
+  vec2 uv = gl_TexCoord[0].st;
+  float d = texture(distance_map, uv).r * range;
+  bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+  gl_FragColor = vec4(inside ? (d <= half_width ? line : carpet) : outside, 1.0);
+}
+)";
 
 Eigen::Vector3f colour_of(const std::string& c) {
   if (c == "yellow") return {0.85f, 0.78f, 0.08f};
@@ -86,22 +125,28 @@ void add_box(std::vector<Tri>& out, const Eigen::Vector2d& c, double hx, double 
   add_quad(out, corner(-1, -1, z1), corner(1, -1, z1), corner(1, 1, z1), corner(-1, 1, z1), alb, lab, max_edge);
 }
 
+// `eye` (world, metres), when given: the faces turned away from it are left out (the depth test
+// hides them anyway; llvmpipe's cost per triangle is not small).
 void add_cylinder(std::vector<Tri>& out, const Eigen::Vector2d& c, double r, double z0, double z1, const Eigen::Vector3f& alb,
-                  std::uint8_t lab, int sides, int rows) {
+                  std::uint8_t lab, int sides, int rows, const Eigen::Vector3d* eye = nullptr) {
   for (int k = 0; k < sides; ++k) {
     const double a0 = kTwoPi * k / sides, a1 = kTwoPi * (k + 1) / sides;
     const Eigen::Vector2d p0 = c + r * Eigen::Vector2d(std::cos(a0), std::sin(a0));
     const Eigen::Vector2d p1 = c + r * Eigen::Vector2d(std::cos(a1), std::sin(a1));
+    // A side facet is out of sight from behind its plane.
+    if (eye && (0.5 * (p0 + p1) - c).dot(eye->head<2>() - p0) <= 0) continue;
     for (int j = 0; j < rows; ++j) {
       const double za = z0 + (z1 - z0) * j / rows, zb = z0 + (z1 - z0) * (j + 1) / rows;
       out.push_back({{Eigen::Vector3d(p0.x(), p0.y(), za), Eigen::Vector3d(p1.x(), p1.y(), za), Eigen::Vector3d(p1.x(), p1.y(), zb)}, alb, lab});
       out.push_back({{Eigen::Vector3d(p0.x(), p0.y(), za), Eigen::Vector3d(p1.x(), p1.y(), zb), Eigen::Vector3d(p0.x(), p0.y(), zb)}, alb, lab});
     }
-    out.push_back({{Eigen::Vector3d(c.x(), c.y(), z1), Eigen::Vector3d(p0.x(), p0.y(), z1), Eigen::Vector3d(p1.x(), p1.y(), z1)}, alb, lab});
+    if (!eye || eye->z() > z1)  // the top is out of sight from below
+      out.push_back({{Eigen::Vector3d(c.x(), c.y(), z1), Eigen::Vector3d(p0.x(), p0.y(), z1), Eigen::Vector3d(p1.x(), p1.y(), z1)}, alb, lab});
   }
 }
 
-void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const Eigen::Vector3f& alb, std::uint8_t lab) {
+void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const Eigen::Vector3f& alb, std::uint8_t lab,
+                const Eigen::Vector3d& eye) {
   const int nl = 8, na = 14;
   auto pt = [&](int i, int j) {
     const double th = kPi * i / nl, ph = kTwoPi * j / na;
@@ -109,6 +154,10 @@ void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const
   };
   for (int i = 0; i < nl; ++i)
     for (int j = 0; j < na; ++j) {
+      // A patch is out of sight when all its corners face away from the eye.
+      bool seen = false;
+      for (const auto& q : {pt(i, j), pt(i + 1, j), pt(i + 1, j + 1), pt(i, j + 1)}) seen = seen || (q - c).dot(eye - q) > 0;
+      if (!seen) continue;
       out.push_back({{pt(i, j), pt(i + 1, j), pt(i + 1, j + 1)}, alb, lab});
       out.push_back({{pt(i, j), pt(i + 1, j + 1), pt(i, j + 1)}, alb, lab});
     }
@@ -141,7 +190,8 @@ struct PanoramicCameraImpl {
   Field field;
   int ss = 2;                // supersampling factor
   int W = 0, H = 0;          // render size (W * ss ...)
-  unsigned tex_albedo = 0, tex_label = 0;
+  unsigned tex_distance = 0;           // floor distance field (kFloorShader)
+  unsigned prog_floor = 0, prog_floor_labels = 0;
   double hx = 0, hy = 0;     // floor half extents covered by the texture
   // Polar floor mesh, fixed in the image.
   std::vector<float> mesh_xy;          // render-space positions
@@ -150,9 +200,13 @@ struct PanoramicCameraImpl {
   std::vector<Tri> wall_tris;          // the hall's walls
   std::vector<Tri> static_tris;        // goals, landmarks
   std::vector<unsigned char> readback;
-  std::vector<float> noise;            // standard normals, drawn once from the first render's Rng
+  std::vector<std::uint8_t> noise;     // standard normals in steps of kNoiseStep, drawn once from the first render's Rng
+  std::vector<std::uint8_t> table;     // output value by GL level and noise step, for table_settings
+  CameraSettings table_settings;
   // Per-draw scratch.
   std::vector<float> pos, col, tex;
+  std::vector<std::uint8_t> hidden;    // floor mesh vertex behind walls (bit per wall)
+  std::vector<unsigned> idx;           // floor triangles drawn this frame
 };
 
 PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
@@ -168,57 +222,54 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   const GlApi& gl = m.ctx->gl();
   m.ctx->bind_framebuffer(m.W, m.H);
 
-  // Field textures: 1 cm texels over the floor inside the walls; lines anti-aliased by coverage.
+  // The floor's markings as a distance field (see kFloorShader): 2 cm texels over the floor inside
+  // the walls, texel centres at uv = (i + 0.5) / size.
   m.hx = field.half_floor_x();
   m.hy = field.half_floor_y();
-  const double texel = 0.01;
-  const int tw = static_cast<int>(std::ceil(2 * m.hx / texel)), th = static_cast<int>(std::ceil(2 * m.hy / texel));
-  std::vector<unsigned char> albedo(static_cast<std::size_t>(tw) * th * 4), label(static_cast<std::size_t>(tw) * th * 4);
-  const double half_w = 0.5 * field.line_width;
+  const int tw = static_cast<int>(std::ceil(2 * m.hx / kDistanceTexel)), th = static_cast<int>(std::ceil(2 * m.hy / kDistanceTexel));
+  std::vector<std::uint16_t> dist(static_cast<std::size_t>(tw) * th);
   for (int j = 0; j < th; ++j)
     for (int i = 0; i < tw; ++i) {
-      const Eigen::Vector2d p(-m.hx + (i + 0.5) * texel, -m.hy + (j + 0.5) * texel);
-      const double d = field.distance_to_marking(p);
-      const double cover = std::clamp(0.5 + (half_w - d) / texel, 0.0, 1.0);
-      const Eigen::Vector3f c = kCarpet * static_cast<float>(1 - cover) + kLineWhite * static_cast<float>(cover);
-      unsigned char* a = &albedo[(static_cast<std::size_t>(j) * tw + i) * 4];
-      for (int k = 0; k < 3; ++k) a[k] = static_cast<unsigned char>(std::lround(255 * c[k]));
-      a[3] = 255;
-      unsigned char* l = &label[(static_cast<std::size_t>(j) * tw + i) * 4];
-      l[0] = l[1] = l[2] = static_cast<unsigned char>(d <= half_w ? kLabelLine : kLabelField);
-      l[3] = 255;
+      const Eigen::Vector2d p(-m.hx + (i + 0.5) * 2 * m.hx / tw, -m.hy + (j + 0.5) * 2 * m.hy / th);
+      const double d = std::min(field.distance_to_marking(p), kDistanceRange);
+      dist[static_cast<std::size_t>(j) * tw + i] = static_cast<std::uint16_t>(std::lround(65535.0 * d / kDistanceRange));
     }
-  auto upload = [&](unsigned& id, const std::vector<unsigned char>& px, bool filtered, const Eigen::Vector3f& border, std::uint8_t border_label) {
-    gl.GenTextures(1, &id);
-    gl.BindTexture(GL_TEXTURE_2D, id);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    const float bc[4] = {filtered ? border[0] : border_label / 255.0f, filtered ? border[1] : border_label / 255.0f,
-                         filtered ? border[2] : border_label / 255.0f, 1.0f};
-    gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, bc);
-    if (filtered) {
-      gl.TexParameteri(GL_TEXTURE_2D, GL_GENERATE_MIPMAP, GL_TRUE);
-      // Trilinear mip-mapping anti-aliases the far lines. (Anisotropic filtering would be sharper
-      // along the radius, but llvmpipe takes seconds per frame with it: measured, not used.)
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    } else {
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    }
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, tw, th, 0, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
-    if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + m.ctx->backend() + "\": field texture upload failed");
+  gl.GenTextures(1, &m.tex_distance);
+  gl.BindTexture(GL_TEXTURE_2D, m.tex_distance);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R16, tw, th, 0, GL_RED, GL_UNSIGNED_SHORT, dist.data());
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + m.ctx->backend() + "\": floor distance texture upload failed");
+  const double half_w = 0.5 * field.line_width;
+  auto floor_program = [&](const char* src, const std::string& what, const Eigen::Vector3f& line, const Eigen::Vector3f& carpet,
+                           const Eigen::Vector3f& outside) {
+    const unsigned prog = m.ctx->fragment_program(src, what);
+    gl.UseProgram(prog);
+    gl.Uniform1i(gl.GetUniformLocation(prog, "distance_map"), 0);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "range"), static_cast<float>(kDistanceRange));
+    gl.Uniform1f(gl.GetUniformLocation(prog, "half_width"), static_cast<float>(half_w));
+    gl.Uniform3f(gl.GetUniformLocation(prog, "line"), line[0], line[1], line[2]);
+    gl.Uniform3f(gl.GetUniformLocation(prog, "carpet"), carpet[0], carpet[1], carpet[2]);
+    gl.Uniform3f(gl.GetUniformLocation(prog, "outside"), outside[0], outside[1], outside[2]);
+    gl.UseProgram(0);
+    if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + m.ctx->backend() + "\": " + what + " shader set-up failed");
+    return prog;
   };
-  upload(m.tex_albedo, albedo, true, kHallFloor, kLabelFloorOutside);
-  upload(m.tex_label, label, false, kHallFloor, kLabelFloorOutside);
+  m.prog_floor = floor_program(kFloorShader, "floor", kLineWhite, kCarpet, kHallFloor);
+  auto label = [](LabelClass l) { return Eigen::Vector3f::Constant(static_cast<float>(l) / 255.0f); };
+  m.prog_floor_labels = floor_program(kFloorLabelShader, "floor label", label(kLabelLine), label(kLabelField), label(kLabelFloorOutside));
 
   // Polar floor mesh in render space. Texture coordinates are interpolated linearly across each
   // cell, so rings are placed where the floor distance stops being linear in the image radius: a
   // new ring whenever the midpoint of the floor distance deviates by more than `tol` from the chord
-  // (the mirror's isometric part needs few rings, the inner and outer parts many). Sectors of 3
-  // degrees bend a line by at most 4 mm at 8 m (chord against arc).
+  // (the mirror's isometric part needs few rings, the inner and outer parts many), and each ring
+  // has the fewest sectors whose chord strays at most `tol` from the arc on the floor (few near
+  // the robot, 128 at 8 m). llvmpipe's cost per triangle is a large share of the frame: the
+  // default mesh has about 2900 triangles where a fixed 120 sectors made 6720 (docs/camera.md).
   const double tol = cfg_.quality == "low" ? 0.01 : 0.003;
-  const int sectors = cfg_.quality == "low" ? 90 : 120;
   auto floor_dist = [&](double r) {
     const double e = mirror_.elevation(std::clamp(r, mirror_.body_radius(), mirror_.rim()));
     return e < -1e-3 ? cfg_.mount_height / std::tan(-e) : 1e3;
@@ -227,10 +278,12 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   double r0 = mirror_.body_radius() - 1.0;
   radii.push_back(r0);
   while (r0 < mirror_.rim() + 1.0) {
-    double step = 16.0;
+    // Up to 30 m (beyond, the far floor is one colour); far away, where a pixel spans decimetres
+    // of floor, within a tenth of a pixel.
+    double step = 32.0;
     while (step > 0.5) {
       const double a = floor_dist(r0), b = floor_dist(r0 + step), mid = floor_dist(r0 + 0.5 * step);
-      if (b > 30.0 || std::fabs(mid - 0.5 * (a + b)) <= tol) break;  // beyond 30 m nothing is resolved anyway
+      if (a > 30.0 || (b <= 30.0 && std::fabs(mid - 0.5 * (a + b)) <= std::max(tol, 0.1 * (b - a) / step))) break;
       step *= 0.5;
     }
     r0 = std::min(r0 + step, mirror_.rim() + 1.0);
@@ -238,7 +291,14 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
     if (r0 >= mirror_.rim() + 1.0) break;
   }
   const Eigen::Vector2d c = centre();
+  std::vector<unsigned> ring_start;
+  std::vector<int> ring_sectors;
+  int sectors = 16;
   for (double r : radii) {
+    const double R = std::min(floor_dist(r), 30.0);  // beyond: the hall's far floor, one colour
+    while (sectors < 128 && R * (1.0 - std::cos(kPi / sectors)) > tol) sectors *= 2;
+    ring_start.push_back(static_cast<unsigned>(m.mesh_dir.size()));
+    ring_sectors.push_back(sectors);
     const double e = mirror_.elevation(std::clamp(r, mirror_.body_radius(), mirror_.rim()));
     for (int k = 0; k <= sectors; ++k) {
       const double b = kTwoPi * k / sectors;
@@ -247,20 +307,37 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
       m.mesh_dir.emplace_back(std::cos(e) * std::cos(b), std::cos(e) * std::sin(b), std::sin(e));
     }
   }
-  const unsigned row = static_cast<unsigned>(sectors) + 1;
-  for (unsigned i = 0; i + 1 < radii.size(); ++i)
-    for (unsigned k = 0; k < static_cast<unsigned>(sectors); ++k) {
-      const unsigned a = i * row + k, b = a + 1, cc = a + row, d = cc + 1;
-      m.mesh_idx.insert(m.mesh_idx.end(), {a, b, d, a, d, cc});
+  // Neighbouring rings zipped together by angle (an outer ring has as many or twice... as many sectors).
+  for (std::size_t i = 0; i + 1 < radii.size(); ++i) {
+    const unsigned na = static_cast<unsigned>(ring_sectors[i]), nb = static_cast<unsigned>(ring_sectors[i + 1]);
+    unsigned ka = 0, kb = 0;
+    while (ka < na || kb < nb) {
+      const unsigned a = ring_start[i] + ka, b = ring_start[i + 1] + kb;
+      // Advance on the ring whose next vertex comes first (ka / na against kb / nb, exactly).
+      if (kb == nb || (ka < na && (ka + 1) * nb <= (kb + 1) * na)) {
+        m.mesh_idx.insert(m.mesh_idx.end(), {a, a + 1, b});
+        ++ka;
+      } else {
+        m.mesh_idx.insert(m.mesh_idx.end(), {a, b + 1, b});
+        ++kb;
+      }
     }
+  }
 
   // Static scene: walls, goals, landmarks.
   const double wall_t = 0.1, wh = field.wall_height;
   if (wh > 0) {
-    add_box(m.wall_tris, {0, m.hy + wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
-    add_box(m.wall_tris, {0, -m.hy - wall_t}, m.hx + 2 * wall_t, wall_t, 0, 0, wh, kWall, kLabelWall, 0.6);
-    add_box(m.wall_tris, {m.hx + wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
-    add_box(m.wall_tris, {-m.hx - wall_t, 0}, wall_t, m.hy, 0, 0, wh, kWall, kLabelWall, 0.6);
+    // Only what can be seen from inside the hall: each wall's inner face and its top.
+    const double ex = m.hx + 2 * wall_t;
+    auto wall = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& out) {
+      const Eigen::Vector2d a2 = a + 2 * wall_t * out, b2 = b + 2 * wall_t * out;
+      add_quad(m.wall_tris, {a.x(), a.y(), 0}, {b.x(), b.y(), 0}, {b.x(), b.y(), wh}, {a.x(), a.y(), wh}, kWall, kLabelWall, 0.6);
+      add_quad(m.wall_tris, {a.x(), a.y(), wh}, {b.x(), b.y(), wh}, {b2.x(), b2.y(), wh}, {a2.x(), a2.y(), wh}, kWall, kLabelWall, 0.6);
+    };
+    wall({-ex, m.hy}, {ex, m.hy}, {0, 1});
+    wall({-ex, -m.hy}, {ex, -m.hy}, {0, -1});
+    wall({m.hx, -m.hy}, {m.hx, m.hy}, {1, 0});
+    wall({-m.hx, -m.hy}, {-m.hx, m.hy}, {-1, 0});
   }
   for (const auto& g : field.goals) {
     const bool coloured = g.colour != "white";
@@ -290,8 +367,9 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
 PanoramicCamera::~PanoramicCamera() {
   if (impl_ && impl_->ctx) {
     impl_->ctx->make_current();
-    impl_->ctx->gl().DeleteTextures(1, &impl_->tex_albedo);
-    impl_->ctx->gl().DeleteTextures(1, &impl_->tex_label);
+    impl_->ctx->gl().DeleteTextures(1, &impl_->tex_distance);
+    impl_->ctx->gl().DeleteProgram(impl_->prog_floor);
+    impl_->ctx->gl().DeleteProgram(impl_->prog_floor_labels);
   }
 }
 
@@ -365,29 +443,47 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   gl.MatrixMode(GL_MODELVIEW);
   gl.LoadIdentity();
   gl.ShadeModel(GL_SMOOTH);
-  const Eigen::Vector3f bg =
-      labels ? Eigen::Vector3f::Zero() : Eigen::Vector3f(kBackground * (world.lighting.artificial_at(pose.translation()) / kRadianceScale));
+  // Above the walls: the hall, seen as its far floor under the light at the robot (the floor mesh
+  // skips the rays that miss the floor).
+  const Eigen::Vector3f bg = labels ? Eigen::Vector3f::Constant(static_cast<float>(kLabelFloorOutside) / 255.0f)
+                                    : Eigen::Vector3f(kHallFloor * (world.lighting.artificial_at(pose.translation()) / kRadianceScale));
   gl.ClearColor(bg[0], bg[1], bg[2], 1.0f);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   gl.EnableClientState(GL_VERTEX_ARRAY);
   gl.EnableClientState(GL_COLOR_ARRAY);
 
-  // Floor: texture coordinates are this frame's floor points of the image-fixed rays.
+  // Floor: texture coordinates are this frame's floor points of the image-fixed rays. Each vertex
+  // also gets a bit per hall wall that hides its floor point (bits 0-3: beyond x = hx, x = -hx,
+  // y = hy, y = -hy and below the line of sight over that wall) and all bits when its ray misses
+  // the floor; a triangle whose vertices share a bit is not drawn, as the wall is drawn over it or
+  // nothing of the floor is there (a third of the floor's pixels at the default mirror: the
+  // rasteriser's fill is the renderer's largest cost).
   const std::size_t nv = m.mesh_dir.size();
   m.pos.resize(nv * 3);
   m.col.resize(nv * 4);
   m.tex.resize(nv * 2);
+  m.hidden.resize(nv);
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double keep = m.field.wall_height > 0 ? 1.0 - std::min(1.0, m.field.wall_height / h) : 2.0;  // hidden beyond a wall at t > keep
   for (std::size_t i = 0; i < nv; ++i) {
     const Eigen::Vector3d d = R * m.mesh_dir[i];
     Eigen::Vector2d w;
+    std::uint8_t hidden = 0;
     if (d.z() < -1e-6) {
       const double t = h / -d.z();
       const double rx = t * d.x(), ry = t * d.y();
       w = {pose.x + c * rx - s * ry, pose.y + s * rx + c * ry};
+      // The wall plane at fraction t_w of the way to the floor point hides it when t_w > keep.
+      auto behind = [&](double wall, double p, double f) { return (f - p) * wall > 0 && std::fabs(wall - p) > keep * std::fabs(f - p); };
+      if (w.x() > m.hx && behind(m.hx, pose.x, w.x())) hidden |= 1;
+      if (w.x() < -m.hx && behind(-m.hx, pose.x, w.x())) hidden |= 2;
+      if (w.y() > m.hy && behind(m.hy, pose.y, w.y())) hidden |= 4;
+      if (w.y() < -m.hy && behind(-m.hy, pose.y, w.y())) hidden |= 8;
     } else {
       w = {pose.x + 1e4 * (c * d.x() - s * d.y()), pose.y + 1e4 * (s * d.x() + c * d.y())};  // no floor: far beyond the walls
+      hidden = 15;
     }
+    m.hidden[i] = hidden;
     m.pos[3 * i] = m.mesh_xy[2 * i];
     m.pos[3 * i + 1] = m.mesh_xy[2 * i + 1];
     m.pos[3 * i + 2] = -999.0f;
@@ -398,29 +494,32 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     m.col[4 * i] = m.col[4 * i + 1] = m.col[4 * i + 2] = illum;
     m.col[4 * i + 3] = 1.0f;
   }
+  m.idx.clear();
+  for (std::size_t t = 0; t < m.mesh_idx.size(); t += 3) {
+    const unsigned a = m.mesh_idx[t], b = m.mesh_idx[t + 1], cc = m.mesh_idx[t + 2];
+    if ((m.hidden[a] & m.hidden[b] & m.hidden[cc]) == 0) m.idx.insert(m.idx.end(), {a, b, cc});
+  }
   gl.Disable(GL_DEPTH_TEST);
   gl.DepthMask(GL_FALSE);
-  gl.Enable(GL_TEXTURE_2D);
-  gl.BindTexture(GL_TEXTURE_2D, labels ? m.tex_label : m.tex_albedo);
-  gl.TexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, labels ? GL_REPLACE : GL_MODULATE);
+  gl.BindTexture(GL_TEXTURE_2D, m.tex_distance);
+  gl.UseProgram(labels ? m.prog_floor_labels : m.prog_floor);
   gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
   gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
   gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
   gl.TexCoordPointer(2, GL_FLOAT, 0, m.tex.data());
-  gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.mesh_idx.size()), GL_UNSIGNED_INT, m.mesh_idx.data());
+  gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.idx.size()), GL_UNSIGNED_INT, m.idx.data());
   gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
-  gl.Disable(GL_TEXTURE_2D);
+  gl.UseProgram(0);
 
   // Everything else: triangles projected per vertex through the mirror.
   const Eigen::Matrix3d Rt = R.transpose();
   auto project = [&](const Eigen::Vector3d& wp, float* out) {
     const double dx = wp.x() - pose.x, dy = wp.y() - pose.y;
     const Eigen::Vector3d q = Rt * Eigen::Vector3d(c * dx + s * dy, -s * dx + c * dy, wp.z() - h);
-    const double rho = std::hypot(q.x(), q.y());
-    const double e = std::atan2(q.z(), std::max(rho, 1e-9)), b = std::atan2(q.y(), q.x());
-    const double r = mirror.radius(e);
-    out[0] = static_cast<float>((centre.x() - r * std::sin(b)) * m.ss);
-    out[1] = static_cast<float>((centre.y() - r * std::cos(b)) * m.ss);
+    const double rho = std::max(std::hypot(q.x(), q.y()), 1e-9);
+    const double k = mirror.radius(std::atan2(q.z(), rho)) / rho;  // bearing b: (cos b, sin b) = (q.x, q.y) / rho
+    out[0] = static_cast<float>((centre.x() - k * q.y()) * m.ss);
+    out[1] = static_cast<float>((centre.y() - k * q.x()) * m.ss);
     out[2] = static_cast<float>(-std::min(999.0, q.norm()));
   };
   std::vector<Tri> tris;
@@ -459,9 +558,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   // light, in cells of at most 0.1 m projected through the mirror, so a patch's edges are as sharp as
   // the texture (a per-vertex light on the image-fixed floor mesh would smear them over a mesh cell).
   if (!labels) {
-    gl.Enable(GL_TEXTURE_2D);
-    gl.BindTexture(GL_TEXTURE_2D, m.tex_albedo);
-    gl.TexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    gl.UseProgram(m.prog_floor);
     gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
     for (const auto& sp : world.lighting.sun) {
       if (sp.surface != SunPatch::Surface::kFloor) continue;
@@ -491,7 +588,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
       gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(m.pos.size() / 3));
     }
     gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
-    gl.Disable(GL_TEXTURE_2D);
+    gl.UseProgram(0);
   }
   // Floor patches lie on the carpet: drawn over the floor, under everything standing on it.
   for (const auto& fp : world.floor_patches) {
@@ -517,10 +614,11 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     emit_all(tris, true, world.lighting.artificial_at(((q[0] + q[2]) / 2).head<2>()) + sp.strength);
   }
   tris = m.static_tris;
+  const Eigen::Vector3d eye(pose.x, pose.y, h);
   for (const auto& r : world.robots)
-    if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5);
+    if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5, &eye);
   if (world.has_ball)
-    add_sphere(tris, Eigen::Vector3d(world.ball.position.x(), world.ball.position.y(), world.ball.radius), world.ball.radius, kBall, kLabelBall);
+    add_sphere(tris, Eigen::Vector3d(world.ball.position.x(), world.ball.position.y(), world.ball.radius), world.ball.radius, kBall, kLabelBall, eye);
   emit_all(tris, false);
 
   // The robot's own body in the image centre (its brightness follows the light on the robot).
@@ -561,36 +659,49 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
   if (!me) throw RuntimeFailure("render: no robot with id " + std::to_string(robot_id));
   const CameraSettings st = clamp(requested);
   if (m.noise.empty()) {
-    m.noise.resize(1u << 20);
-    for (auto& x : m.noise) x = static_cast<float>(rng.normal());
+    // 2^20 standard normals, stored as steps of kNoiseStep (index kNoiseZero = 0), plus a copy of
+    // the first row's worth at the end, so that a row's samples are one contiguous run of the table
+    // (a strided walk of a float table missed the cache on every sample).
+    const std::size_t n = std::size_t{1} << 20;
+    m.noise.resize(n + 3 * static_cast<std::size_t>(cfg_.width));
+    for (std::size_t i = 0; i < n; ++i)
+      m.noise[i] = static_cast<std::uint8_t>(std::clamp(std::lround(kNoiseZero + rng.normal() / kNoiseStep), 0L, 255L));
+    std::copy(m.noise.begin(), m.noise.begin() + static_cast<std::ptrdiff_t>(m.noise.size() - n), m.noise.begin() + static_cast<std::ptrdiff_t>(n));
   }
   const double roll = cfg_.mirror_tilt + (cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0);
   const double pitch = cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0;
-  const std::uint64_t off = rng.next_u64(), stride = (rng.next_u64() | 1u);
+  const std::uint64_t off = rng.next_u64();
 
   m.ctx->make_current();
   m.ctx->bind_framebuffer(m.W, m.H);
   draw_scene(m, cfg_, mirror_, centre(), world, *me, camera_rotation(roll, pitch), false);
   m.ctx->read_rgba(m.readback);
 
-  // Photometry: mean value per GL level (sum of ss*ss samples), then noise and saturation.
+  // Photometry: the output value for every GL level (sum of ss * ss samples) and noise step, a
+  // table rebuilt when the settings change; then one lookup per pixel and channel.
   const int samples = m.ss * m.ss;
   const int levels = 255 * samples + 1;
-  const double gainf = st.gain / 18.0;
-  const double per_unit = kRadianceScale / 255.0 / samples * kResponse * st.exposure_ms * st.gain;
-  std::vector<float> mean(levels), sigma(levels);
-  for (int l = 0; l < levels; ++l) {
-    mean[l] = static_cast<float>(l * per_unit);
-    const double v = std::min(255.0, static_cast<double>(mean[l]));
-    sigma[l] = static_cast<float>(std::sqrt(cfg_.read_noise * cfg_.read_noise * gainf * gainf + cfg_.shot_noise * cfg_.shot_noise * v * gainf));
+  if (m.table_settings.exposure_ms != st.exposure_ms || m.table_settings.gain != st.gain || m.table.empty()) {
+    m.table_settings = st;
+    m.table.resize(static_cast<std::size_t>(levels) * 256);
+    const double gainf = st.gain / 18.0;
+    const double per_unit = kRadianceScale / 255.0 / samples * kResponse * st.exposure_ms * st.gain;
+    for (int l = 0; l < levels; ++l) {
+      const double mean = l * per_unit;
+      const double sigma = std::sqrt(cfg_.read_noise * cfg_.read_noise * gainf * gainf + cfg_.shot_noise * cfg_.shot_noise * std::min(255.0, mean) * gainf);
+      for (int q = 0; q < 256; ++q) {
+        const double val = mean + sigma * (q - kNoiseZero) * kNoiseStep;
+        m.table[static_cast<std::size_t>(l) * 256 + q] = static_cast<std::uint8_t>(val <= 0.0 ? 0.0 : (val >= 255.0 ? 255.0 : val + 0.5));
+      }
+    }
   }
+  const std::uint8_t* table = m.table.data();
   Image img;
   img.width = cfg_.width;
   img.height = cfg_.height;
   img.rgb.resize(static_cast<std::size_t>(img.width) * img.height * 3);
-  const std::size_t mask = m.noise.size() - 1;
+  const std::size_t mask = (std::size_t{1} << 20) - 1;
   std::size_t k = off & mask;
-  const std::size_t step = stride & mask;
   const Eigen::Vector2d c = centre();
   const double rim = mirror_.rim();
   std::fill(img.rgb.begin(), img.rgb.end(), std::uint8_t{0});  // outside the mirror: black
@@ -601,19 +712,23 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
     const double half = std::sqrt(rim * rim - dv * dv);
     const int u0 = std::max(0, static_cast<int>(std::ceil(c.x() - half - 0.5)));
     const int u1 = std::min(img.width - 1, static_cast<int>(std::floor(c.x() + half - 0.5)));
+    if (u1 < u0) continue;
     std::uint8_t* out = img.row(v);
-    const unsigned char* rows[2];
-    for (int sy = 0; sy < m.ss; ++sy) rows[sy] = &m.readback[static_cast<std::size_t>(m.H - 1 - (v * m.ss + sy)) * m.W * 4];  // GL rows bottom-up
-    for (int u = u0; u <= u1; ++u) {
-      for (int ch = 0; ch < 3; ++ch) {
-        int sum = 0;
-        for (int sy = 0; sy < m.ss; ++sy)
-          for (int sx = 0; sx < m.ss; ++sx) sum += rows[sy][(u * m.ss + sx) * 4 + ch];
-        const float val = mean[sum] + sigma[sum] * m.noise[k];
-        k = (k + step) & mask;
-        out[3 * u + ch] = static_cast<std::uint8_t>(val <= 0.0f ? 0.0f : (val >= 255.0f ? 255.0f : val + 0.5f));
-      }
+    const std::uint8_t* nz = &m.noise[k];
+    const unsigned char* r0 = &m.readback[static_cast<std::size_t>(m.H - 1 - v * m.ss) * m.W * 4];  // GL rows bottom-up
+    auto emit = [&](int u, int ch, int sum) { out[3 * u + ch] = table[(static_cast<std::size_t>(sum) << 8) | nz[3 * (u - u0) + ch]]; };
+    if (m.ss == 1) {
+      for (int u = u0; u <= u1; ++u)
+        for (int ch = 0; ch < 3; ++ch) emit(u, ch, r0[u * 4 + ch]);
+    } else {
+      const unsigned char* r1 = r0 - static_cast<std::ptrdiff_t>(m.W) * 4;
+      for (int u = u0; u <= u1; ++u)
+        for (int ch = 0; ch < 3; ++ch) {
+          const int a = (2 * u) * 4 + ch, b = a + 4;
+          emit(u, ch, r0[a] + r0[b] + r1[a] + r1[b]);
+        }
     }
+    k = (k + 3 * static_cast<std::size_t>(u1 - u0 + 1)) & mask;
   }
   return img;
 }

@@ -1,13 +1,15 @@
 #pragma once
 // The simulated catadioptric camera: renders what a robot's omnidirectional camera sees, off-screen.
 //
-// Approach (measured against a cube-map + warp design, see docs/camera.md): every vertex is projected
-// through the mirror model on the CPU and GL only rasterises. The floor is an image-fixed polar mesh
-// whose texture coordinates are the floor points its rays hit this frame, sampled from a mip-mapped,
-// anisotropically filtered field texture (1 cm texels), which anti-aliases the far lines; other
-// objects (robots, ball, goals, walls, landmarks, floor patches) are tessellated and projected per
-// vertex with depth testing. The default quality renders at 2x2 supersampling. Photometry (exposure,
-// gain, saturation, shot and read noise) is applied on the CPU.
+// Approach (measured against a cube-map + warp design and against per-pixel ray casting, see
+// docs/camera.md): every vertex is projected through the mirror model on the CPU and GL only
+// rasterises. The floor is an image-fixed polar mesh whose texture coordinates are the floor points
+// its rays hit this frame; a fragment shader turns them into the markings from a distance field,
+// anti-aliased over each pixel's extent across the line; mesh cells hidden behind the hall's walls
+// are skipped. Other objects (robots, ball, goals, walls, landmarks, floor patches) are tessellated
+// and projected per vertex with depth testing, faces turned away left out. "high" quality renders at
+// 2x2 supersampling. Photometry (exposure, gain, saturation, shot and read noise) is applied on the
+// CPU through a table by GL level and noise step.
 //
 // Frames: world (metres); robot (x forward, y left, z up, metres); image (u right, v down, pixels).
 // The robot's forward axis points up in the image (v decreasing), robot-left points left.
@@ -48,9 +50,9 @@ enum LabelClass : std::uint8_t {
 
 class PanoramicCamera {
  public:
-  /// Changes whenever the photometry (response, noise) changes: part of the cache key of the colour
-  /// tables and calibration maps learned from rendered images.
-  static constexpr int kPhotometryVersion = 2;
+  /// Changes whenever the rendered pixels change (photometry, noise, how the scene is drawn): part
+  /// of the cache key of the colour tables and calibration maps learned from rendered images.
+  static constexpr int kPhotometryVersion = 3;
   /// Throws ConfigError for a bad configuration, RuntimeFailure when the GL back-end fails.
   PanoramicCamera(const CameraConfig& config, const Field& field);
   ~PanoramicCamera();
