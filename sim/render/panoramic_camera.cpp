@@ -59,6 +59,19 @@ void main() {
   gl_FragColor = vec4((inside ? mix(carpet, line, cover) : outside) * gl_Color.rgb, 1.0);
 }
 )";
+// The same for triangles whose corners all lie on the floor inside the walls (most of them): the
+// test of the texture coordinates cost 4 % of the frame.
+const char* const kFloorShaderInside = R"(#version 130
+uniform sampler2D distance_map;
+uniform float range, half_width;
+uniform vec3 line, carpet, outside;  // albedos
+void main() {
+  float d = texture(distance_map, gl_TexCoord[0].st).r * range;
+  float fw = max(fwidth(d), 1e-4);
+  float cover = clamp((min(d + 0.5 * fw, half_width) - max(d - 0.5 * fw, -half_width)) / fw, 0.0, 1.0);
+  gl_FragColor = vec4(mix(carpet, line, cover) * gl_Color.rgb, 1.0);
+}
+)";
 // The same field as flat class ids (a pixel is line where its centre is).
 const char* const kFloorLabelShader = R"(#version 130
 uniform sampler2D distance_map;
@@ -92,11 +105,13 @@ struct Tri {
   std::array<Eigen::Vector3d, 3> p;  // world frame, metres
   Eigen::Vector3f albedo;
   std::uint8_t label;
+  Eigen::Vector3d facing = Eigen::Vector3d::Zero();  // outward normal of a closed solid's face; zero: seen from both sides
 };
 
 // Tessellated primitives in world coordinates.
 void add_quad(std::vector<Tri>& out, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-              const Eigen::Vector3d& d, const Eigen::Vector3f& alb, std::uint8_t lab, double max_edge) {
+              const Eigen::Vector3d& d, const Eigen::Vector3f& alb, std::uint8_t lab, double max_edge,
+              const Eigen::Vector3d& facing = Eigen::Vector3d::Zero()) {
   // Subdivide a planar quad a-b-c-d (in order) into a grid whose cells are at most max_edge.
   const int nu = std::max(1, static_cast<int>(std::ceil(std::max((b - a).norm(), (c - d).norm()) / max_edge)));
   const int nv = std::max(1, static_cast<int>(std::ceil(std::max((d - a).norm(), (c - b).norm()) / max_edge)));
@@ -106,8 +121,8 @@ void add_quad(std::vector<Tri>& out, const Eigen::Vector3d& a, const Eigen::Vect
   };
   for (int i = 0; i < nu; ++i)
     for (int j = 0; j < nv; ++j) {
-      out.push_back({{at(i, j), at(i + 1, j), at(i + 1, j + 1)}, alb, lab});
-      out.push_back({{at(i, j), at(i + 1, j + 1), at(i, j + 1)}, alb, lab});
+      out.push_back({{at(i, j), at(i + 1, j), at(i + 1, j + 1)}, alb, lab, facing});
+      out.push_back({{at(i, j), at(i + 1, j + 1), at(i, j + 1)}, alb, lab, facing});
     }
 }
 
@@ -120,9 +135,11 @@ void add_box(std::vector<Tri>& out, const Eigen::Vector2d& c, double hx, double 
   const double xs[4] = {-1, 1, 1, -1}, ys[4] = {-1, -1, 1, 1};
   for (int k = 0; k < 4; ++k) {
     const int n = (k + 1) % 4;
-    add_quad(out, corner(xs[k], ys[k], z0), corner(xs[n], ys[n], z0), corner(xs[n], ys[n], z1), corner(xs[k], ys[k], z1), alb, lab, max_edge);
+    const Eigen::Vector3d mid = 0.5 * (corner(xs[k], ys[k], z0) + corner(xs[n], ys[n], z0));
+    add_quad(out, corner(xs[k], ys[k], z0), corner(xs[n], ys[n], z0), corner(xs[n], ys[n], z1), corner(xs[k], ys[k], z1), alb, lab, max_edge,
+             Eigen::Vector3d(mid.x() - c.x(), mid.y() - c.y(), 0.0));
   }
-  add_quad(out, corner(-1, -1, z1), corner(1, -1, z1), corner(1, 1, z1), corner(-1, 1, z1), alb, lab, max_edge);
+  add_quad(out, corner(-1, -1, z1), corner(1, -1, z1), corner(1, 1, z1), corner(-1, 1, z1), alb, lab, max_edge, Eigen::Vector3d::UnitZ());
 }
 
 // `eye` (world, metres), when given: the faces turned away from it are left out (the depth test
@@ -191,7 +208,7 @@ struct PanoramicCameraImpl {
   int ss = 2;                // supersampling factor
   int W = 0, H = 0;          // render size (W * ss ...)
   unsigned tex_distance = 0;           // floor distance field (kFloorShader)
-  unsigned prog_floor = 0, prog_floor_labels = 0;
+  unsigned prog_floor = 0, prog_floor_inside = 0, prog_floor_labels = 0;
   double hx = 0, hy = 0;     // floor half extents covered by the texture
   // Polar floor mesh, fixed in the image.
   std::vector<float> mesh_xy;          // render-space positions
@@ -206,7 +223,7 @@ struct PanoramicCameraImpl {
   // Per-draw scratch.
   std::vector<float> pos, col, tex;
   std::vector<std::uint8_t> hidden;    // floor mesh vertex behind walls (bit per wall)
-  std::vector<unsigned> idx;           // floor triangles drawn this frame
+  std::vector<unsigned> idx, idx_inside;  // floor triangles drawn this frame (all corners inside the walls)
 };
 
 PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
@@ -259,6 +276,7 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
     return prog;
   };
   m.prog_floor = floor_program(kFloorShader, "floor", kLineWhite, kCarpet, kHallFloor);
+  m.prog_floor_inside = floor_program(kFloorShaderInside, "floor", kLineWhite, kCarpet, kHallFloor);
   auto label = [](LabelClass l) { return Eigen::Vector3f::Constant(static_cast<float>(l) / 255.0f); };
   m.prog_floor_labels = floor_program(kFloorLabelShader, "floor label", label(kLabelLine), label(kLabelField), label(kLabelFloorOutside));
 
@@ -369,6 +387,7 @@ PanoramicCamera::~PanoramicCamera() {
     impl_->ctx->make_current();
     impl_->ctx->gl().DeleteTextures(1, &impl_->tex_distance);
     impl_->ctx->gl().DeleteProgram(impl_->prog_floor);
+    impl_->ctx->gl().DeleteProgram(impl_->prog_floor_inside);
     impl_->ctx->gl().DeleteProgram(impl_->prog_floor_labels);
   }
 }
@@ -483,6 +502,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
       w = {pose.x + 1e4 * (c * d.x() - s * d.y()), pose.y + 1e4 * (s * d.x() + c * d.y())};  // no floor: far beyond the walls
       hidden = 15;
     }
+    if (std::fabs(w.x()) > m.hx || std::fabs(w.y()) > m.hy) hidden |= 16;  // not on the floor inside the walls
     m.hidden[i] = hidden;
     m.pos[3 * i] = m.mesh_xy[2 * i];
     m.pos[3 * i + 1] = m.mesh_xy[2 * i + 1];
@@ -495,9 +515,12 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     m.col[4 * i + 3] = 1.0f;
   }
   m.idx.clear();
+  m.idx_inside.clear();
   for (std::size_t t = 0; t < m.mesh_idx.size(); t += 3) {
     const unsigned a = m.mesh_idx[t], b = m.mesh_idx[t + 1], cc = m.mesh_idx[t + 2];
-    if ((m.hidden[a] & m.hidden[b] & m.hidden[cc]) == 0) m.idx.insert(m.idx.end(), {a, b, cc});
+    if ((m.hidden[a] & m.hidden[b] & m.hidden[cc] & 15) != 0) continue;
+    auto& list = labels || ((m.hidden[a] | m.hidden[b] | m.hidden[cc]) & 16) ? m.idx : m.idx_inside;
+    list.insert(list.end(), {a, b, cc});
   }
   gl.Disable(GL_DEPTH_TEST);
   gl.DepthMask(GL_FALSE);
@@ -508,6 +531,10 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
   gl.TexCoordPointer(2, GL_FLOAT, 0, m.tex.data());
   gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.idx.size()), GL_UNSIGNED_INT, m.idx.data());
+  if (!m.idx_inside.empty()) {
+    gl.UseProgram(m.prog_floor_inside);
+    gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.idx_inside.size()), GL_UNSIGNED_INT, m.idx_inside.data());
+  }
   gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
   gl.UseProgram(0);
 
@@ -524,10 +551,12 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   };
   std::vector<Tri> tris;
   // fixed_light >= 0: every triangle under that illumination instead of the floor light at its middle.
+  const Eigen::Vector3d eye(pose.x, pose.y, h);  // the camera, world frame (vibration aside)
   auto emit_all = [&](const std::vector<Tri>& list, bool ground_level, double fixed_light = -1.0) {
     m.pos.clear();
     m.col.clear();
     for (const Tri& t : list) {
+      if (t.facing.dot(eye - t.p[0]) < 0) continue;  // a face of a solid turned away: hidden behind the solid
       const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
       const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : world.lighting.at(mid)) / kRadianceScale);
       for (const auto& v : t.p) {
@@ -614,7 +643,6 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     emit_all(tris, true, world.lighting.artificial_at(((q[0] + q[2]) / 2).head<2>()) + sp.strength);
   }
   tris = m.static_tris;
-  const Eigen::Vector3d eye(pose.x, pose.y, h);
   for (const auto& r : world.robots)
     if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5, &eye);
   if (world.has_ball)
