@@ -31,7 +31,6 @@ struct GlApi {
   X(void, DeleteTextures, (GLsizei, const GLuint*))                                               \
   X(void, BindTexture, (GLenum, GLuint))                                                          \
   X(void, TexImage2D, (GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum, const void*)) \
-  X(void, TexSubImage2D, (GLenum, GLint, GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, const void*)) \
   X(void, TexParameteri, (GLenum, GLenum, GLint))                                                 \
   X(void, TexParameterf, (GLenum, GLenum, GLfloat))                                               \
   X(void, TexParameterfv, (GLenum, GLenum, const GLfloat*))                                       \
@@ -73,12 +72,7 @@ struct GlApi {
   X(GLint, GetUniformLocation, (GLuint, const GLchar*))                                           \
   X(void, Uniform1i, (GLint, GLint))                                                              \
   X(void, Uniform1f, (GLint, GLfloat))                                                            \
-  X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))                                          \
-  X(void, Uniform2f, (GLint, GLfloat, GLfloat))                                                   \
-  X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))                                 \
-  X(void, UniformMatrix3fv, (GLint, GLsizei, GLboolean, const GLfloat*))                          \
-  X(void, ActiveTexture, (GLenum))                                                                \
-  X(void, Color4f, (GLfloat, GLfloat, GLfloat, GLfloat))
+  X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))
 #define OMNILOC_GL_MEMBER(ret, name, args) ret(*name) args = nullptr;
   OMNILOC_GL_FUNCS(OMNILOC_GL_MEMBER)
 #undef OMNILOC_GL_MEMBER

@@ -222,7 +222,7 @@ struct PanoramicCameraImpl {
   CameraSettings table_settings;
   // Per-draw scratch.
   std::vector<float> pos, col, tex;
-  std::vector<std::uint8_t> hidden;    // floor mesh vertex behind walls (bit per wall)
+  std::vector<std::uint8_t> hidden;    // per floor mesh vertex: bits 0-3 behind a wall, bit 4 off the floor inside the walls
   std::vector<unsigned> idx, idx_inside;  // floor triangles drawn this frame (all corners inside the walls)
 };
 
