@@ -470,11 +470,82 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   const Eigen::Vector3f bg = labels ? Eigen::Vector3f::Constant(static_cast<float>(kLabelFloorOutside) / 255.0f)
                                     : Eigen::Vector3f(kHallFloor * (world.lighting.artificial_at(pose.translation()) / kRadianceScale));
   gl.ClearColor(bg[0], bg[1], bg[2], 1.0f);
+  gl.DepthMask(GL_TRUE);  // the clear writes depth only through the mask (the floor leaves it off)
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   gl.EnableClientState(GL_VERTEX_ARRAY);
   gl.EnableClientState(GL_COLOR_ARRAY);
 
-  // Floor: texture coordinates are this frame's floor points of the image-fixed rays. Each vertex
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  // Everything standing: triangles projected per vertex through the mirror.
+  const Eigen::Matrix3d Rt = R.transpose();
+  auto project = [&](const Eigen::Vector3d& wp, float* out) {
+    const double dx = wp.x() - pose.x, dy = wp.y() - pose.y;
+    const Eigen::Vector3d q = Rt * Eigen::Vector3d(c * dx + s * dy, -s * dx + c * dy, wp.z() - h);
+    const double rho = std::max(std::hypot(q.x(), q.y()), 1e-9);
+    const double k = mirror.radius(std::atan2(q.z(), rho)) / rho;  // bearing b: (cos b, sin b) = (q.x, q.y) / rho
+    out[0] = static_cast<float>((centre.x() - k * q.y()) * m.ss);
+    out[1] = static_cast<float>((centre.y() - k * q.x()) * m.ss);
+    out[2] = static_cast<float>(-std::min(999.0, q.norm()));
+  };
+  std::vector<Tri> tris;
+  // fixed_light >= 0: every triangle under that illumination instead of the floor light at its middle.
+  // kSolid: depth-tested and written; kOverWall: painted without a test; kOnFloor: at the far plane,
+  // tested, not written (under everything standing).
+  enum class Layer { kSolid, kOverWall, kOnFloor };
+  const Eigen::Vector3d eye(pose.x, pose.y, h);  // the camera, world frame (vibration aside)
+  auto emit_all = [&](const std::vector<Tri>& list, Layer layer, double fixed_light = -1.0) {
+    m.pos.clear();
+    m.col.clear();
+    for (const Tri& t : list) {
+      if (t.facing.dot(eye - t.p[0]) < 0) continue;  // a face of a solid turned away: hidden behind the solid
+      const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
+      const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : world.lighting.at(mid)) / kRadianceScale);
+      for (const auto& v : t.p) {
+        float xyz[3];
+        project(v, xyz);
+        if (layer == Layer::kOnFloor) xyz[2] = -999.0f;
+        m.pos.insert(m.pos.end(), xyz, xyz + 3);
+        if (labels) {
+          const float l = t.label / 255.0f;
+          m.col.insert(m.col.end(), {l, l, l, 1.0f});
+        } else {
+          m.col.insert(m.col.end(), {std::min(1.0f, t.albedo[0] * illum), std::min(1.0f, t.albedo[1] * illum),
+                                     std::min(1.0f, t.albedo[2] * illum), 1.0f});
+        }
+      }
+    }
+    if (layer == Layer::kOverWall) {
+      gl.Disable(GL_DEPTH_TEST);
+    } else {
+      gl.Enable(GL_DEPTH_TEST);
+      gl.DepthMask(layer == Layer::kSolid ? GL_TRUE : GL_FALSE);
+      gl.DepthFunc(GL_LESS);
+    }
+    gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
+    gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
+    gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(m.pos.size() / 3));
+  };
+  // Walls first (depth written), then the sun on them painted over the walls without a depth test
+  // (the lit quads and the coarser wall triangles would z-fight: the mirror projection is not linear
+  // across a triangle), then everything standing in front, depth-tested against both.
+  emit_all(m.wall_tris, Layer::kSolid);
+  for (const auto& sp : world.lighting.sun) {
+    std::array<Eigen::Vector3d, 4> q;
+    if (labels || sp.surface != SunPatch::Surface::kWall || !wall_patch_quad(sp, m.hx, m.hy, m.field.wall_height, q)) continue;
+    tris.clear();
+    add_quad(tris, q[0], q[1], q[2], q[3], kWall, kLabelWall, 0.25);
+    emit_all(tris, Layer::kOverWall, world.lighting.artificial_at(((q[0] + q[2]) / 2).head<2>()) + sp.strength);
+  }
+  tris = m.static_tris;
+  for (const auto& r : world.robots)
+    if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5, &eye);
+  if (world.has_ball)
+    add_sphere(tris, Eigen::Vector3d(world.ball.position.x(), world.ball.position.y(), world.ball.radius), world.ball.radius, kBall, kLabelBall, eye);
+  emit_all(tris, Layer::kSolid);
+
+  // Floor, after everything standing on it: depth-tested at the far plane (written by nothing), so
+  // llvmpipe skips the floor shader where walls and robots cover it. Texture coordinates are this
+  // frame's floor points of the image-fixed rays. Each vertex
   // also gets a bit per hall wall that hides its floor point (bits 0-3: beyond x = hx, x = -hx,
   // y = hy, y = -hy and below the line of sight over that wall) and all bits when its ray misses
   // the floor; a triangle whose vertices share a bit is not drawn, as the wall is drawn over it or
@@ -485,7 +556,6 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   m.col.resize(nv * 4);
   m.tex.resize(nv * 2);
   m.hidden.resize(nv);
-  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   const double keep = m.field.wall_height > 0 ? 1.0 - std::min(1.0, m.field.wall_height / h) : 2.0;  // hidden beyond a wall at t > keep
   for (std::size_t i = 0; i < nv; ++i) {
     const Eigen::Vector3d d = R * m.mesh_dir[i];
@@ -525,8 +595,9 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     auto& list = labels || ((m.hidden[a] | m.hidden[b] | m.hidden[cc]) & 16) ? m.idx : m.idx_inside;
     list.insert(list.end(), {a, b, cc});
   }
-  gl.Disable(GL_DEPTH_TEST);
+  gl.Enable(GL_DEPTH_TEST);  // behind walls and robots drawn before: not shaded
   gl.DepthMask(GL_FALSE);
+  gl.DepthFunc(GL_LESS);
   gl.BindTexture(GL_TEXTURE_2D, m.tex_distance);
   gl.UseProgram(labels ? m.prog_floor_labels : m.prog_floor);
   gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
@@ -541,51 +612,6 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
   gl.UseProgram(0);
 
-  // Everything else: triangles projected per vertex through the mirror.
-  const Eigen::Matrix3d Rt = R.transpose();
-  auto project = [&](const Eigen::Vector3d& wp, float* out) {
-    const double dx = wp.x() - pose.x, dy = wp.y() - pose.y;
-    const Eigen::Vector3d q = Rt * Eigen::Vector3d(c * dx + s * dy, -s * dx + c * dy, wp.z() - h);
-    const double rho = std::max(std::hypot(q.x(), q.y()), 1e-9);
-    const double k = mirror.radius(std::atan2(q.z(), rho)) / rho;  // bearing b: (cos b, sin b) = (q.x, q.y) / rho
-    out[0] = static_cast<float>((centre.x() - k * q.y()) * m.ss);
-    out[1] = static_cast<float>((centre.y() - k * q.x()) * m.ss);
-    out[2] = static_cast<float>(-std::min(999.0, q.norm()));
-  };
-  std::vector<Tri> tris;
-  // fixed_light >= 0: every triangle under that illumination instead of the floor light at its middle.
-  const Eigen::Vector3d eye(pose.x, pose.y, h);  // the camera, world frame (vibration aside)
-  auto emit_all = [&](const std::vector<Tri>& list, bool ground_level, double fixed_light = -1.0) {
-    m.pos.clear();
-    m.col.clear();
-    for (const Tri& t : list) {
-      if (t.facing.dot(eye - t.p[0]) < 0) continue;  // a face of a solid turned away: hidden behind the solid
-      const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
-      const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : world.lighting.at(mid)) / kRadianceScale);
-      for (const auto& v : t.p) {
-        float xyz[3];
-        project(v, xyz);
-        m.pos.insert(m.pos.end(), xyz, xyz + 3);
-        if (labels) {
-          const float l = t.label / 255.0f;
-          m.col.insert(m.col.end(), {l, l, l, 1.0f});
-        } else {
-          m.col.insert(m.col.end(), {std::min(1.0f, t.albedo[0] * illum), std::min(1.0f, t.albedo[1] * illum),
-                                     std::min(1.0f, t.albedo[2] * illum), 1.0f});
-        }
-      }
-    }
-    if (ground_level) {
-      gl.Disable(GL_DEPTH_TEST);
-    } else {
-      gl.Enable(GL_DEPTH_TEST);
-      gl.DepthMask(GL_TRUE);
-      gl.DepthFunc(GL_LESS);
-    }
-    gl.VertexPointer(3, GL_FLOAT, 0, m.pos.data());
-    gl.ColorPointer(4, GL_FLOAT, 0, m.col.data());
-    gl.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(m.pos.size() / 3));
-  };
   // Sun beams on the carpet: the floor under each beam drawn again from its texture under the beam's
   // light, in cells of at most 0.1 m projected through the mirror, so a patch's edges are as sharp as
   // the texture (a per-vertex light on the image-fixed floor mesh would smear them over a mesh cell).
@@ -623,6 +649,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     gl.UseProgram(0);
   }
   // Floor patches lie on the carpet: drawn over the floor, under everything standing on it.
+  tris.clear();
   for (const auto& fp : world.floor_patches) {
     const Eigen::Vector3f alb = fp.reflectance.cast<float>();
     const std::uint8_t lab = alb.maxCoeff() > 0.5f ? std::uint8_t{kLabelLine} : std::uint8_t{kLabelObstacle};
@@ -633,24 +660,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     };
     add_quad(tris, corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1), alb, lab, 0.05);
   }
-  if (!tris.empty()) emit_all(tris, true);
-  // Walls first (depth written), then the sun on them painted over the walls without a depth test
-  // (the lit quads and the coarser wall triangles would z-fight: the mirror projection is not linear
-  // across a triangle), then everything standing in front, depth-tested against both.
-  emit_all(m.wall_tris, false);
-  for (const auto& sp : world.lighting.sun) {
-    std::array<Eigen::Vector3d, 4> q;
-    if (labels || sp.surface != SunPatch::Surface::kWall || !wall_patch_quad(sp, m.hx, m.hy, m.field.wall_height, q)) continue;
-    tris.clear();
-    add_quad(tris, q[0], q[1], q[2], q[3], kWall, kLabelWall, 0.25);
-    emit_all(tris, true, world.lighting.artificial_at(((q[0] + q[2]) / 2).head<2>()) + sp.strength);
-  }
-  tris = m.static_tris;
-  for (const auto& r : world.robots)
-    if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5, &eye);
-  if (world.has_ball)
-    add_sphere(tris, Eigen::Vector3d(world.ball.position.x(), world.ball.position.y(), world.ball.radius), world.ball.radius, kBall, kLabelBall, eye);
-  emit_all(tris, false);
+  if (!tris.empty()) emit_all(tris, Layer::kOnFloor);
 
   // The robot's own body in the image centre (its brightness follows the light on the robot).
   gl.Disable(GL_DEPTH_TEST);
