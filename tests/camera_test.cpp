@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "core/angles.hpp"
 #include "core/error.hpp"
@@ -96,6 +97,42 @@ TEST_F(CameraTest, FarLineStaysContinuous) {
     gaps += !found;
   }
   EXPECT_EQ(gaps, 0);
+}
+
+// The floor's anti-aliasing keeps a line's light: summed over a radial profile across the side
+// line y = -6, the pixels' line coverage (from the green channel, read between carpet and white)
+// times each pixel's floor extent gives the line's width, whether the line is 3 px wide (6.5 m,
+// the isometric part) or under a pixel (9.5 m, beyond 8 m where a pixel spans decimetres).
+TEST_F(CameraTest, AntiAliasingKeepsTheLineWidth) {
+  CameraSettings st;
+  st.exposure_ms = 12;  // white below the clip
+  st.gain = 12;
+  const double carpet = PanoramicCamera::response(0.34, 1.0, st), white = PanoramicCamera::response(0.85, 1.0, st);
+  ASSERT_LT(white, 250.0);
+  const Field field = Field::preset("msl2012");
+  for (double ahead : {6.5, 9.5}) {
+    // Facing -y from (2, ahead - 6): the side line lies `ahead` metres straight ahead (up in the
+    // image, one pixel column), away from every other marking.
+    const WorldState w = one_robot(Pose2(2.0, ahead - 6.0, -kPi / 2));
+    Rng rng(1);
+    const Image img = cam_->render(w, 0, st, rng);
+    const auto px = cam_->project({ahead, 0.0, 0.0});
+    ASSERT_TRUE(px);
+    const int u = static_cast<int>(px->x()), v0 = static_cast<int>(px->y());
+    double width = 0.0, peak = 0.0;
+    for (int v = v0 - 8; v <= v0 + 8; ++v) {
+      const auto near = cam_->floor_point(u + 0.5, v + 1.0), far = cam_->floor_point(u + 0.5, v);
+      if (!near || !far || near->x() < ahead - 1.5 || far->x() > ahead + 0.9) continue;  // the wall stands 1 m beyond the line
+      const double cover = (img.row(v)[3 * u + 1] - carpet) / (white - carpet);
+      width += cover * (far->x() - near->x());
+      peak = std::max(peak, cover);
+    }
+    std::printf("line %.1f m ahead: width %.4f m from the profile, peak coverage %.2f\n", ahead, width, peak);
+    EXPECT_NEAR(width, field.line_width, 0.1 * field.line_width) << "line " << ahead << " m ahead";
+    if (ahead > 8) {
+      EXPECT_LT(peak, 0.9) << "a line under a pixel is blended with the carpet";
+    }
+  }
 }
 
 TEST_F(CameraTest, ExposureSaturatesAndNoiseGrowsWithGain) {
