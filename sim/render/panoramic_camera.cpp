@@ -46,42 +46,38 @@ constexpr double kNoiseZero = 127.5;  // index of 0 (halfway, so the steps are s
 // fraction of a millimetre where the field is linear in position, i.e. across a line's edges.
 constexpr double kDistanceTexel = 0.02;  // metres
 constexpr double kDistanceRange = 2.0;   // metres; farther is stored as 2 m
-const char* const kFloorShader = R"(#version 130
+// Shared by the floor shaders: line, carpet, outside are albedos (label ids / 255 for labels).
+const char* const kFloorCommon = R"(#version 130
 uniform sampler2D distance_map;
 uniform float range, half_width;
-uniform vec3 line, carpet, outside;  // albedos
+uniform vec3 line, carpet, outside;
+float distance_to_line(vec2 uv) { return texture(distance_map, uv).r * range; }
+// Share of a box as wide as the pixel's extent across the line that the line covers.
+float line_cover(float d) {
+  float fw = max(fwidth(d), 1e-4);
+  return clamp((min(d + 0.5 * fw, half_width) - max(d - 0.5 * fw, -half_width)) / fw, 0.0, 1.0);
+}
+bool on_floor(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
+)";
+const char* const kFloorShader = R"(
 void main() {
   vec2 uv = gl_TexCoord[0].st;
-  float d = texture(distance_map, uv).r * range;
-  float fw = max(fwidth(d), 1e-4);
-  float cover = clamp((min(d + 0.5 * fw, half_width) - max(d - 0.5 * fw, -half_width)) / fw, 0.0, 1.0);
-  bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
-  gl_FragColor = vec4((inside ? mix(carpet, line, cover) : outside) * gl_Color.rgb, 1.0);
+  float cover = line_cover(distance_to_line(uv));
+  gl_FragColor = vec4((on_floor(uv) ? mix(carpet, line, cover) : outside) * gl_Color.rgb, 1.0);
 }
 )";
 // The same for triangles whose corners all lie on the floor inside the walls (most of them): the
 // test of the texture coordinates cost 4 % of the frame.
-const char* const kFloorShaderInside = R"(#version 130
-uniform sampler2D distance_map;
-uniform float range, half_width;
-uniform vec3 line, carpet, outside;  // albedos
+const char* const kFloorShaderInside = R"(
 void main() {
-  float d = texture(distance_map, gl_TexCoord[0].st).r * range;
-  float fw = max(fwidth(d), 1e-4);
-  float cover = clamp((min(d + 0.5 * fw, half_width) - max(d - 0.5 * fw, -half_width)) / fw, 0.0, 1.0);
-  gl_FragColor = vec4(mix(carpet, line, cover) * gl_Color.rgb, 1.0);
+  gl_FragColor = vec4(mix(carpet, line, line_cover(distance_to_line(gl_TexCoord[0].st))) * gl_Color.rgb, 1.0);
 }
 )";
 // The same field as flat class ids (a pixel is line where its centre is).
-const char* const kFloorLabelShader = R"(#version 130
-uniform sampler2D distance_map;
-uniform float range, half_width;
-uniform vec3 line, carpet, outside;  // label ids / 255
+const char* const kFloorLabelShader = R"(
 void main() {
   vec2 uv = gl_TexCoord[0].st;
-  float d = texture(distance_map, uv).r * range;
-  bool inside = all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
-  gl_FragColor = vec4(inside ? (d <= half_width ? line : carpet) : outside, 1.0);
+  gl_FragColor = vec4(on_floor(uv) ? (distance_to_line(uv) <= half_width ? line : carpet) : outside, 1.0);
 }
 )";
 
@@ -261,9 +257,9 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R16, tw, th, 0, GL_RED, GL_UNSIGNED_SHORT, dist.data());
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + m.ctx->backend() + "\": floor distance texture upload failed");
   const double half_w = 0.5 * field.line_width;
-  auto floor_program = [&](const char* src, const std::string& what, const Eigen::Vector3f& line, const Eigen::Vector3f& carpet,
+  auto floor_program = [&](const char* body, const std::string& what, const Eigen::Vector3f& line, const Eigen::Vector3f& carpet,
                            const Eigen::Vector3f& outside) {
-    const unsigned prog = m.ctx->fragment_program(src, what);
+    const unsigned prog = m.ctx->fragment_program((std::string(kFloorCommon) + body).c_str(), what);
     gl.UseProgram(prog);
     gl.Uniform1i(gl.GetUniformLocation(prog, "distance_map"), 0);
     gl.Uniform1f(gl.GetUniformLocation(prog, "range"), static_cast<float>(kDistanceRange));
@@ -276,7 +272,7 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
     return prog;
   };
   m.prog_floor = floor_program(kFloorShader, "floor", kLineWhite, kCarpet, kHallFloor);
-  m.prog_floor_inside = floor_program(kFloorShaderInside, "floor", kLineWhite, kCarpet, kHallFloor);
+  m.prog_floor_inside = floor_program(kFloorShaderInside, "floor (inside the walls)", kLineWhite, kCarpet, kHallFloor);
   auto label = [](LabelClass l) { return Eigen::Vector3f::Constant(static_cast<float>(l) / 255.0f); };
   m.prog_floor_labels = floor_program(kFloorLabelShader, "floor label", label(kLabelLine), label(kLabelField), label(kLabelFloorOutside));
 
