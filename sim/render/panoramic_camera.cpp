@@ -545,8 +545,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   // also gets a bit per hall wall that hides its floor point (bits 0-3: beyond x = hx, x = -hx,
   // y = hy, y = -hy and below the line of sight over that wall) and all bits when its ray misses
   // the floor; a triangle whose vertices share a bit is not drawn, as the wall is drawn over it or
-  // nothing of the floor is there (a third of the floor's pixels at the default mirror: the
-  // rasteriser's fill is the renderer's largest cost).
+  // nothing of the floor is there (the rasteriser's fill is the renderer's largest cost).
   const std::size_t nv = m.mesh_dir.size();
   m.pos.resize(nv * 3);
   m.col.resize(nv * 4);
@@ -562,7 +561,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
       const double rx = t * d.x(), ry = t * d.y();
       w = {pose.x + c * rx - s * ry, pose.y + s * rx + c * ry};
       // The wall plane at fraction t_w of the way to the floor point hides it when t_w > keep.
-      auto behind = [&](double wall, double p, double f) { return (f - p) * wall > 0 && std::fabs(wall - p) > keep * std::fabs(f - p); };
+      auto behind = [&](double wall, double p, double f) { return std::fabs(wall - p) > keep * std::fabs(f - p); };
       if (w.x() > m.hx && behind(m.hx, pose.x, w.x())) hidden |= 1;
       if (w.x() < -m.hx && behind(-m.hx, pose.x, w.x())) hidden |= 2;
       if (w.y() > m.hy && behind(m.hy, pose.y, w.y())) hidden |= 4;
