@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 
 #include "core/angles.hpp"
 #include "core/error.hpp"
@@ -176,6 +177,30 @@ void add_sphere(std::vector<Tri>& out, const Eigen::Vector3d& c, double r, const
     }
 }
 
+// Triangles of the static scene with their corners as shared vertices, so that each vertex is
+// projected through the mirror once per frame instead of once per triangle using it (a grid vertex
+// is a corner of up to six).
+struct SharedTris {
+  std::vector<Tri> tris;
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<unsigned, 3>> corners;  // per triangle, indices into vertices
+};
+SharedTris share_vertices(std::vector<Tri> tris) {
+  SharedTris out;
+  std::map<std::array<double, 3>, unsigned> index;
+  for (const Tri& t : tris) {
+    std::array<unsigned, 3> c{};
+    for (int k = 0; k < 3; ++k) {
+      const auto [it, added] = index.try_emplace({t.p[k].x(), t.p[k].y(), t.p[k].z()}, static_cast<unsigned>(out.vertices.size()));
+      if (added) out.vertices.push_back(t.p[k]);
+      c[k] = it->second;
+    }
+    out.corners.push_back(c);
+  }
+  out.tris = std::move(tris);
+  return out;
+}
+
 // The lit rectangle of a wall sun patch: a quad 1 cm in front of the inner face of the hall wall
 // nearest to the patch centre (drawn over the wall like floor patches over the carpet, so its edges
 // stay sharp whatever the wall's tessellation). Empty when the patch misses the wall.
@@ -210,14 +235,15 @@ struct PanoramicCameraImpl {
   std::vector<float> mesh_xy;          // render-space positions
   std::vector<Eigen::Vector3d> mesh_dir;  // camera-frame unit ray of each vertex
   std::vector<unsigned> mesh_idx;
-  std::vector<Tri> wall_tris;          // the hall's walls
-  std::vector<Tri> static_tris;        // goals, landmarks
+  SharedTris walls;                    // the hall's walls
+  SharedTris statics;                  // goals, landmarks
   std::vector<unsigned char> readback;
   std::vector<std::uint8_t> noise;     // standard normals in steps of kNoiseStep, drawn once from the first render's Rng
   std::vector<std::uint8_t> table;     // output value by GL level and noise step, for table_settings
   CameraSettings table_settings;
   // Per-draw scratch.
   std::vector<float> pos, col, tex;
+  std::vector<float> shared_xyz;       // this frame's projections of a SharedTris' vertices
   std::vector<std::uint8_t> hidden;    // per floor mesh vertex: bits 0-3 behind a wall, bit 4 off the floor inside the walls
   std::vector<unsigned> idx, idx_inside;  // floor triangles drawn this frame (all corners inside the walls)
 };
@@ -342,14 +368,15 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   }
 
   // Static scene: walls, goals, landmarks.
+  std::vector<Tri> wall_tris, static_tris;
   const double wall_t = 0.1, wh = field.wall_height;
   if (wh > 0) {
     // Only what can be seen from inside the hall: each wall's inner face and its top.
     const double ex = m.hx + 2 * wall_t;
     auto wall = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& out) {
       const Eigen::Vector2d a2 = a + 2 * wall_t * out, b2 = b + 2 * wall_t * out;
-      add_quad(m.wall_tris, {a.x(), a.y(), 0}, {b.x(), b.y(), 0}, {b.x(), b.y(), wh}, {a.x(), a.y(), wh}, kWall, kLabelWall, 0.6);
-      add_quad(m.wall_tris, {a.x(), a.y(), wh}, {b.x(), b.y(), wh}, {b2.x(), b2.y(), wh}, {a2.x(), a2.y(), wh}, kWall, kLabelWall, 0.6);
+      add_quad(wall_tris, {a.x(), a.y(), 0}, {b.x(), b.y(), 0}, {b.x(), b.y(), wh}, {a.x(), a.y(), wh}, kWall, kLabelWall, 0.6);
+      add_quad(wall_tris, {a.x(), a.y(), wh}, {b.x(), b.y(), wh}, {b2.x(), b2.y(), wh}, {a2.x(), a2.y(), wh}, kWall, kLabelWall, 0.6);
     };
     wall({-ex, m.hy}, {ex, m.hy}, {0, 1});
     wall({-ex, -m.hy}, {ex, -m.hy}, {0, -1});
@@ -361,24 +388,26 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
     const Eigen::Vector3f post = coloured ? colour_of(g.colour) : kPost;
     const std::uint8_t plab = coloured ? label_of(g.colour) : std::uint8_t{kLabelGoal};
     const double hp = 0.5 * g.post_width, s = g.side();
-    for (const Eigen::Vector2d& pp : {g.left_post(), g.right_post()}) add_box(m.static_tris, pp, hp, hp, 0, 0, g.height, post, plab, 0.15);
+    for (const Eigen::Vector2d& pp : {g.left_post(), g.right_post()}) add_box(static_tris, pp, hp, hp, 0, 0, g.height, post, plab, 0.15);
     const double yw = 0.5 * g.width + g.post_width;
-    add_box(m.static_tris, {g.goal_line_x, 0}, hp, yw, 0, g.height - g.post_width, g.height, post, plab, 0.15);
+    add_box(static_tris, {g.goal_line_x, 0}, hp, yw, 0, g.height - g.post_width, g.height, post, plab, 0.15);
     // Net: back and side panels (coloured inside on the legacy field).
     const Eigen::Vector3f net = coloured ? colour_of(g.colour) : kNet;
     const std::uint8_t nlab = coloured ? label_of(g.colour) : std::uint8_t{kLabelGoal};
     const double x0 = g.goal_line_x + s * hp, x1 = g.goal_line_x + s * g.depth;
-    add_quad(m.static_tris, {x1, -yw, 0}, {x1, yw, 0}, {x1, yw, g.height}, {x1, -yw, g.height}, net, nlab, 0.2);
-    add_quad(m.static_tris, {x0, -yw, 0}, {x1, -yw, 0}, {x1, -yw, g.height}, {x0, -yw, g.height}, net, nlab, 0.2);
-    add_quad(m.static_tris, {x0, yw, 0}, {x1, yw, 0}, {x1, yw, g.height}, {x0, yw, g.height}, net, nlab, 0.2);
-    add_quad(m.static_tris, {x0, -yw, g.height}, {x1, -yw, g.height}, {x1, yw, g.height}, {x0, yw, g.height}, net, nlab, 0.2);
+    add_quad(static_tris, {x1, -yw, 0}, {x1, yw, 0}, {x1, yw, g.height}, {x1, -yw, g.height}, net, nlab, 0.2);
+    add_quad(static_tris, {x0, -yw, 0}, {x1, -yw, 0}, {x1, -yw, g.height}, {x0, -yw, g.height}, net, nlab, 0.2);
+    add_quad(static_tris, {x0, yw, 0}, {x1, yw, 0}, {x1, yw, g.height}, {x0, yw, g.height}, net, nlab, 0.2);
+    add_quad(static_tris, {x0, -yw, g.height}, {x1, -yw, g.height}, {x1, yw, g.height}, {x0, yw, g.height}, net, nlab, 0.2);
   }
   for (const auto& l : field.landmarks) {
     if (l.shape == "post")
-      add_cylinder(m.static_tris, l.position, 0.5 * l.size, 0, l.height, colour_of(l.colour), label_of(l.colour), 16, 6);
+      add_cylinder(static_tris, l.position, 0.5 * l.size, 0, l.height, colour_of(l.colour), label_of(l.colour), 16, 6);
     else
-      add_box(m.static_tris, l.position, 0.5 * l.size, 0.5 * l.size, 0, 0, l.height, colour_of(l.colour), label_of(l.colour), 0.1);
+      add_box(static_tris, l.position, 0.5 * l.size, 0.5 * l.size, 0, 0, l.height, colour_of(l.colour), label_of(l.colour), 0.1);
   }
+  m.walls = share_vertices(std::move(wall_tris));
+  m.statics = share_vertices(std::move(static_tris));
 }
 
 PanoramicCamera::~PanoramicCamera() {
@@ -489,18 +518,15 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   // tested, not written (under everything standing).
   enum class Layer { kSolid, kOverWall, kOnFloor };
   const Eigen::Vector3d eye(pose.x, pose.y, h);  // the camera, world frame (vibration aside)
-  auto emit_all = [&](const std::vector<Tri>& list, Layer layer, double fixed_light = -1.0) {
+  // `shared` (optional): drawn first, each of its vertices projected once.
+  auto emit_all = [&](const std::vector<Tri>& list, Layer layer, double fixed_light = -1.0, const SharedTris* shared = nullptr) {
     m.pos.clear();
     m.col.clear();
-    for (const Tri& t : list) {
-      if (t.facing.dot(eye - t.p[0]) < 0) continue;  // a face of a solid turned away: hidden behind the solid
+    auto append = [&](const Tri& t, const std::array<const float*, 3>& corners) {
       const Eigen::Vector2d mid = (t.p[0].head<2>() + t.p[1].head<2>() + t.p[2].head<2>()) / 3.0;
       const float illum = static_cast<float>((fixed_light >= 0 ? fixed_light : world.lighting.at(mid)) / kRadianceScale);
-      for (const auto& v : t.p) {
-        float xyz[3];
-        project(v, xyz);
-        if (layer == Layer::kOnFloor) xyz[2] = -999.0f;
-        m.pos.insert(m.pos.end(), xyz, xyz + 3);
+      for (const float* xyz : corners) {
+        m.pos.insert(m.pos.end(), {xyz[0], xyz[1], layer == Layer::kOnFloor ? -999.0f : xyz[2]});
         if (labels) {
           const float l = t.label / 255.0f;
           m.col.insert(m.col.end(), {l, l, l, 1.0f});
@@ -509,6 +535,23 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
                                      std::min(1.0f, t.albedo[2] * illum), 1.0f});
         }
       }
+    };
+    // A face of a solid turned away from the eye is hidden behind the solid.
+    auto turned_away = [&](const Tri& t) { return t.facing.dot(eye - t.p[0]) < 0; };
+    if (shared) {
+      m.shared_xyz.resize(3 * shared->vertices.size());
+      for (std::size_t i = 0; i < shared->vertices.size(); ++i) project(shared->vertices[i], &m.shared_xyz[3 * i]);
+      for (std::size_t k = 0; k < shared->tris.size(); ++k) {
+        if (turned_away(shared->tris[k])) continue;
+        const auto& c = shared->corners[k];
+        append(shared->tris[k], {&m.shared_xyz[3 * c[0]], &m.shared_xyz[3 * c[1]], &m.shared_xyz[3 * c[2]]});
+      }
+    }
+    for (const Tri& t : list) {
+      if (turned_away(t)) continue;
+      float xyz[9];
+      for (int k = 0; k < 3; ++k) project(t.p[k], xyz + 3 * k);
+      append(t, {xyz, xyz + 3, xyz + 6});
     }
     if (layer == Layer::kOverWall) {
       gl.Disable(GL_DEPTH_TEST);
@@ -524,7 +567,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   // Walls first (depth written), then the sun on them painted over the walls without a depth test
   // (the lit quads and the coarser wall triangles would z-fight: the mirror projection is not linear
   // across a triangle), then everything standing in front, depth-tested against both.
-  emit_all(m.wall_tris, Layer::kSolid);
+  emit_all({}, Layer::kSolid, -1.0, &m.walls);
   for (const auto& sp : world.lighting.sun) {
     std::array<Eigen::Vector3d, 4> q;
     if (labels || sp.surface != SunPatch::Surface::kWall || !wall_patch_quad(sp, m.hx, m.hy, m.field.wall_height, q)) continue;
@@ -532,12 +575,12 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     add_quad(tris, q[0], q[1], q[2], q[3], kWall, kLabelWall, 0.25);
     emit_all(tris, Layer::kOverWall, world.lighting.artificial_at(((q[0] + q[2]) / 2).head<2>()) + sp.strength);
   }
-  tris = m.static_tris;
+  tris.clear();
   for (const auto& r : world.robots)
     if (r.id != me.id) add_cylinder(tris, r.pose.translation(), r.radius, 0.0, r.height, kRobot, kLabelObstacle, 16, 5, &eye);
   if (world.has_ball)
     add_sphere(tris, Eigen::Vector3d(world.ball.position.x(), world.ball.position.y(), world.ball.radius), world.ball.radius, kBall, kLabelBall, eye);
-  emit_all(tris, Layer::kSolid);
+  emit_all(tris, Layer::kSolid, -1.0, &m.statics);
 
   // Floor, after everything standing on it: depth-tested at the far plane (written by nothing), so
   // llvmpipe skips the floor shader where walls and robots cover it. Texture coordinates are this
