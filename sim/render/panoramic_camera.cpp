@@ -350,7 +350,7 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
       m.mesh_dir.emplace_back(std::cos(e) * std::cos(b), std::cos(e) * std::sin(b), std::sin(e));
     }
   }
-  // Neighbouring rings zipped together by angle (an outer ring has as many or twice... as many sectors).
+  // Neighbouring rings zipped together by angle (an outer ring has as many sectors or more).
   for (std::size_t i = 0; i + 1 < radii.size(); ++i) {
     const unsigned na = static_cast<unsigned>(ring_sectors[i]), nb = static_cast<unsigned>(ring_sectors[i + 1]);
     unsigned ka = 0, kb = 0;
@@ -476,6 +476,12 @@ std::optional<Eigen::Vector2d> PanoramicCamera::floor_point(double u, double v) 
 }
 
 namespace {
+
+// Texture coordinates in the floor's distance field of a world floor point (metres).
+void floor_uv(const PanoramicCameraImpl& m, const Eigen::Vector2d& w, float* uv) {
+  uv[0] = static_cast<float>((w.x() + m.hx) / (2 * m.hx));
+  uv[1] = static_cast<float>((w.y() + m.hy) / (2 * m.hy));
+}
 
 // One draw of the scene into the bound framebuffer. `labels`: flat class colours, no lighting.
 void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorProfile& mirror, const Eigen::Vector2d& centre,
@@ -618,8 +624,7 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
     m.pos[3 * i] = m.mesh_xy[2 * i];
     m.pos[3 * i + 1] = m.mesh_xy[2 * i + 1];
     m.pos[3 * i + 2] = -999.0f;
-    m.tex[2 * i] = static_cast<float>((w.x() + m.hx) / (2 * m.hx));
-    m.tex[2 * i + 1] = static_cast<float>((w.y() + m.hy) / (2 * m.hy));
+    floor_uv(m, w, &m.tex[2 * i]);
     // The lamps' light only: sun beams are drawn over this below, with sharp edges.
     const float illum = labels ? 1.0f : static_cast<float>(std::min(1.0, world.lighting.artificial_at(w) / kRadianceScale));
     m.col[4 * i] = m.col[4 * i + 1] = m.col[4 * i + 2] = illum;
@@ -650,9 +655,10 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
   gl.DisableClientState(GL_TEXTURE_COORD_ARRAY);
   gl.UseProgram(0);
 
-  // Sun beams on the carpet: the floor under each beam drawn again from its texture under the beam's
-  // light, in cells of at most 0.1 m projected through the mirror, so a patch's edges are as sharp as
-  // the texture (a per-vertex light on the image-fixed floor mesh would smear them over a mesh cell).
+  // Sun beams on the carpet: the floor under each beam drawn again with the floor shader under the
+  // beam's light, in cells of at most 0.1 m projected through the mirror, so a patch's edges are as
+  // sharp as the pixels (a per-vertex light on the image-fixed floor mesh would smear them over a
+  // mesh cell).
   if (!labels) {
     gl.UseProgram(m.prog_floor);
     gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
@@ -670,7 +676,9 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
         float xyz[3];
         project(Eigen::Vector3d(w.x(), w.y(), 0.0), xyz);
         m.pos.insert(m.pos.end(), {xyz[0], xyz[1], -999.0f});
-        m.tex.insert(m.tex.end(), {static_cast<float>((w.x() + m.hx) / (2 * m.hx)), static_cast<float>((w.y() + m.hy) / (2 * m.hy))});
+        float uv[2];
+        floor_uv(m, w, uv);
+        m.tex.insert(m.tex.end(), uv, uv + 2);
         const float il = static_cast<float>(std::min(1.0, world.lighting.at(w) / kRadianceScale));
         m.col.insert(m.col.end(), {il, il, il, 1.0f});
       };
