@@ -1,0 +1,24 @@
+#pragma once
+// Which build made a result: every summary.json, aggregate.json and report records it, so results
+// of two commits can be told apart and compared (`omniloc --version`, scripts/compare.py).
+#include <string>
+
+#include "core/json_reader.hpp"
+
+namespace omniloc {
+
+struct BuildInfo {
+  std::string version;     ///< `git describe --always --dirty` of the source tree at build time ("unknown" without git)
+  std::string compiler;    ///< e.g. "GNU 12.2.0"
+  std::string build_type;  ///< CMake build type, e.g. "Release"
+};
+
+const BuildInfo& build_info();
+
+/// {"version": ..., "compiler": ..., "build_type": ...}: the "omniloc" block of result files.
+Json build_info_json();
+
+/// One line for `omniloc --version`.
+std::string version_line();
+
+}  // namespace omniloc
