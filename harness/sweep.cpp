@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <mutex>
 #include <ostream>
@@ -17,6 +18,7 @@
 #include <thread>
 
 #include "core/atomic_file.hpp"
+#include "core/version.hpp"
 #include "harness/scenario.hpp"
 
 namespace omniloc::harness {
@@ -68,6 +70,21 @@ std::map<std::string, double> run_metrics(const Json& summary) {
     }
   if (summary.contains("metrics")) flatten(summary["metrics"], "", m);
   return m;
+}
+
+// One CSV field per RFC 4180: quoted when it holds a comma, quote or line break, inner quotes
+// doubled (parameters such as occlusion={"fraction":0.5} hold all of them).
+std::string csv_field(const std::string& v) {
+  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string o = "\"";
+  for (char c : v) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+std::string csv_row(std::initializer_list<std::string> fields) {
+  std::string o;
+  for (const auto& f : fields) o += (o.empty() ? "" : ",") + csv_field(f);
+  return o + "\n";
 }
 
 std::string fmt(double v) {
@@ -146,47 +163,30 @@ SweepSpec load_sweep(const std::string& path) {
   spec.name = sanitize(spec.name);
   const fs::path base = fs::path(path).parent_path();
 
-  const Json* scen = r.raw("scenarios", true);
-  if (!scen->is_array() || scen->empty()) throw ConfigError("/scenarios", json_brief(*scen), "a non-empty array of scenario file paths");
-  struct Scen {
-    std::string name;
-    Json json;
-  };
-  std::vector<Scen> scenarios;
-  for (std::size_t i = 0; i < scen->size(); ++i) {
-    const std::string sp = json_child("/scenarios", i);
-    if (!(*scen)[i].is_string()) throw ConfigError(sp, json_brief((*scen)[i]), "a scenario file path (relative to the sweep file)");
-    fs::path p = (*scen)[i].get<std::string>();
-    if (p.is_relative()) p = base / p;
-    if (!fs::exists(p)) throw ConfigError(sp, json_brief((*scen)[i]), "an existing scenario file (looked for " + p.string() + ")");
-    Json sj = read_json_file(p.string(), sp);
-    scenarios.push_back({sj.is_object() && sj.contains("name") && sj["name"].is_string() ? sj["name"].get<std::string>() : p.stem().string(), sj});
-  }
-
-  std::vector<std::pair<std::string, Json>> locs;  // label, localizer JSON (empty = scenario's own)
-  if (const Json* l = r.raw("localizers")) {
-    if (!l->is_array() || l->empty()) throw ConfigError("/localizers", json_brief(*l), "a non-empty array of {\"type\": ...} objects");
-    for (std::size_t i = 0; i < l->size(); ++i) {
-      Json lj = (*l)[i];
-      if (!lj.is_object() || !lj.contains("type")) throw ConfigError(json_child("/localizers", i), json_brief(lj), "an object {\"type\": ...}");
+  using Combo = std::vector<std::pair<std::string, Json>>;  // JSON pointer -> value
+  using Localizers = std::vector<std::pair<std::string, Json>>;  // label, localizer JSON (null = scenario's own)
+  // "localizers": [{"type": ...}, ...] at `path`.
+  auto parse_localizers = [](const Json& l, const std::string& at) {
+    if (!l.is_array() || l.empty()) throw ConfigError(at, json_brief(l), "a non-empty array of {\"type\": ...} objects");
+    Localizers locs;
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      Json lj = l[i];
+      if (!lj.is_object() || !lj.contains("type")) throw ConfigError(json_child(at, i), json_brief(lj), "an object {\"type\": ...}");
       std::string label = lj.value("label", lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
       lj.erase("label");
       locs.emplace_back(sanitize(label), lj);
     }
-  } else {
-    locs.emplace_back("", Json());
-  }
-
-  // Parameter overrides: JSON pointer -> list of values; the cross product of all of them.
-  std::vector<std::vector<std::pair<std::string, Json>>> combos = {{}};
-  if (auto p = r.object("parameters")) {
-    const Json* pj = r.raw("parameters");
-    for (auto it = pj->begin(); it != pj->end(); ++it) {
-      p->allow(it.key());
-      const std::string pp = json_child("/parameters", it.key());
+    return locs;
+  };
+  // "parameters": {pointer: [values]} at `path`: the cross product of all of them, appended to `base`.
+  auto parse_combos = [](const Json& pj, const std::string& at, const std::vector<Combo>& base_combos) {
+    if (!pj.is_object()) throw ConfigError(at, json_brief(pj), "an object {\"/json/pointer\": [values, ...]}");
+    std::vector<Combo> combos = base_combos;
+    for (auto it = pj.begin(); it != pj.end(); ++it) {
+      const std::string pp = json_child(at, it.key());
       if (it.key().empty() || it.key()[0] != '/') throw ConfigError(pp, "\"" + it.key() + "\"", "a JSON pointer such as /robots/0/motion/speed");
       if (!it.value().is_array() || it.value().empty()) throw ConfigError(pp, json_brief(it.value()), "a non-empty array of values");
-      std::vector<std::vector<std::pair<std::string, Json>>> next;
+      std::vector<Combo> next;
       for (const auto& c : combos)
         for (const auto& v : it.value()) {
           auto c2 = c;
@@ -195,7 +195,49 @@ SweepSpec load_sweep(const std::string& path) {
         }
       combos = next;
     }
-    p->finish();
+    return combos;
+  };
+
+  // Sweep-wide localizers and parameters apply to every scenario entry; an entry written as
+  // {"file": ..., "parameters": {...}, "localizers": [...]} adds its own parameters to the sweep's and
+  // replaces the sweep's localizers, so one file can hold rows that vary different things (the paper suite).
+  Localizers locs = {{"", Json()}};
+  if (const Json* l = r.raw("localizers")) locs = parse_localizers(*l, "/localizers");
+  std::vector<Combo> combos = {{}};
+  if (const Json* pj = r.raw("parameters")) combos = parse_combos(*pj, "/parameters", combos);
+
+  const Json* scen = r.raw("scenarios", true);
+  if (!scen->is_array() || scen->empty()) throw ConfigError("/scenarios", json_brief(*scen), "a non-empty array of scenario file paths");
+  struct Scen {
+    std::string name;
+    Json json;
+    Localizers locs;
+    std::vector<Combo> combos;
+  };
+  std::vector<Scen> scenarios;
+  for (std::size_t i = 0; i < scen->size(); ++i) {
+    const std::string sp = json_child("/scenarios", i);
+    const Json& entry = (*scen)[i];
+    Scen sc{"", Json(), locs, combos};
+    const Json* file = &entry;
+    std::string fp = sp;
+    if (entry.is_object()) {
+      JsonReader er(entry, sp);
+      er.allow("comment");
+      file = er.raw("file", true);
+      fp = json_child(sp, "file");
+      if (const Json* l = er.raw("localizers")) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
+      if (const Json* pj = er.raw("parameters")) sc.combos = parse_combos(*pj, json_child(sp, "parameters"), combos);
+      er.finish();
+    }
+    if (!file->is_string())
+      throw ConfigError(fp, json_brief(*file), "a scenario file path (relative to the sweep file), or {\"file\": path, \"parameters\": ..., \"localizers\": ...}");
+    fs::path p = file->get<std::string>();
+    if (p.is_relative()) p = base / p;
+    if (!fs::exists(p)) throw ConfigError(fp, json_brief(*file), "an existing scenario file (looked for " + p.string() + ")");
+    sc.json = read_json_file(p.string(), fp);
+    sc.name = sc.json.is_object() && sc.json.contains("name") && sc.json["name"].is_string() ? sc.json["name"].get<std::string>() : p.stem().string();
+    scenarios.push_back(std::move(sc));
   }
 
   std::vector<std::uint64_t> seeds;
@@ -219,8 +261,8 @@ SweepSpec load_sweep(const std::string& path) {
 
   std::set<std::string> ids;
   for (const auto& sc : scenarios)
-    for (const auto& [llabel, lj] : locs)
-      for (const auto& combo : combos) {
+    for (const auto& [llabel, lj] : sc.locs)
+      for (const auto& combo : sc.combos) {
         Json patched = sc.json;
         std::string plabel;
         for (const auto& [ptr, v] : combo) {
@@ -347,6 +389,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
   std::vector<Group> groups;
   std::map<std::string, std::size_t> gindex;
   std::string runs_csv = "index,id,scenario,localizer,params,seed,status\n";
+  std::map<std::string, std::size_t> run_versions;  // which builds made the finished runs (a resume may mix them)
   for (const auto& r : spec.runs) {
     auto [it, inserted] = gindex.try_emplace(r.group(), groups.size());
     if (inserted) {
@@ -363,6 +406,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
       ++g.finished;
       const Json s = Json::parse(read_file((dir / "runs" / r.id / "summary.json").string()));
       for (const auto& [k, v] : run_metrics(s)) g.values[k].push_back(v);
+      ++run_versions[s.contains("omniloc") ? s["omniloc"].value("version", std::string("unknown")) : std::string("unrecorded")];
     } else if (fs::exists(dir / "failed" / (r.id + ".json"))) {
       status = "failed";
       ++g.failed;
@@ -371,11 +415,11 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
       ++g.missing;
       ++out.missing;
     }
-    runs_csv += std::to_string(r.index) + "," + r.id + "," + r.scenario_name + "," + r.localizer_label + ",\"" + r.params_label + "\"," +
-                std::to_string(r.seed) + "," + status + "\n";
+    runs_csv += csv_row({std::to_string(r.index), r.id, r.scenario_name, r.localizer_label, r.params_label, std::to_string(r.seed), status});
   }
   std::string csv = "scenario,localizer,params,metric,n,mean,ci95_low,ci95_high\n";
-  Json agg{{"sweep", spec.name}, {"runs", spec.runs.size()}, {"groups", Json::array()}};
+  Json agg{{"sweep", spec.name}, {"runs", spec.runs.size()}, {"omniloc", build_info_json()}, {"run_versions", run_versions},
+           {"groups", Json::array()}};
   char line[512];
   std::snprintf(line, sizeof line, "%-44s %4s %4s | %9s %9s %9s | %-26s\n", "scenario / localizer / params", "ok", "fail", "mean x cm",
                 "mean y cm", "mean th", "position RMSE m (95 % CI)");
@@ -388,8 +432,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
       const Interval iv = mean_ci95(v);
       ivs[k] = iv;
       gj["metrics"][k] = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}};
-      csv += g.scenario + "," + g.localizer + ",\"" + g.params + "\"," + k + "," + std::to_string(iv.n) + "," + fmt(iv.mean) + "," +
-             fmt(iv.low) + "," + fmt(iv.high) + "\n";
+      csv += csv_row({g.scenario, g.localizer, g.params, k, std::to_string(iv.n), fmt(iv.mean), fmt(iv.low), fmt(iv.high)});
     }
     agg["groups"].push_back(gj);
     auto m = [&](const char* k) { return ivs.count(k) ? ivs[k].mean : NAN; };

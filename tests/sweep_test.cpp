@@ -122,3 +122,74 @@ TEST(Sweep, ConfidenceInterval) {
   EXPECT_NEAR(iv.high - iv.mean, 2.05397, 1e-4);
   EXPECT_EQ(mean_ci95({5.0}).low, 5.0);
 }
+
+namespace {
+// RFC 4180 reader (quoted fields, doubled quotes, commas and line breaks inside quotes).
+std::vector<std::vector<std::string>> parse_csv(const std::string& s) {
+  std::vector<std::vector<std::string>> rows(1, std::vector<std::string>(1));
+  bool quoted = false;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const char c = s[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < s.size() && s[i + 1] == '"') rows.back().back() += '"', ++i;
+      else if (c == '"') quoted = false;
+      else rows.back().back() += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      rows.back().emplace_back();
+    } else if (c == '\n') {
+      rows.emplace_back(1);
+    } else {
+      rows.back().back() += c;
+    }
+  }
+  if (rows.back().size() == 1 && rows.back()[0].empty()) rows.pop_back();
+  return rows;
+}
+}  // namespace
+
+TEST(Sweep, CsvFilesAreValidWithJsonObjectParameters) {
+  fs::remove_all(test_dir());
+  const SweepSpec spec = load_sweep(make_sweep());
+  sweep_into(spec, "csv", 2, false, 6);  // a few finished runs are enough for aggregate rows
+  for (const char* f : {"runs.csv", "aggregate.csv"}) {
+    const auto rows = parse_csv(read_file((test_dir() / "csv" / f).string()));
+    ASSERT_GT(rows.size(), 1u) << f;
+    for (const auto& r : rows) EXPECT_EQ(r.size(), rows[0].size()) << f << ": a row with another column count";
+  }
+  // The params column carries the label unchanged, inner quotes and commas included.
+  const auto runs = parse_csv(read_file((test_dir() / "csv" / "runs.csv").string()));
+  EXPECT_EQ(runs[1][4], spec.runs[0].params_label);
+  EXPECT_NE(runs[1][4].find("odometry={\"trans_sigma\":0.01}"), std::string::npos) << runs[1][4];
+}
+
+TEST(Sweep, ScenarioEntriesCarryTheirOwnParametersAndLocalizers) {
+  fs::remove_all(test_dir());
+  make_sweep();
+  const std::string f = (test_dir() / "entries.json").string();
+  write_file_atomic(f, R"({"name": "entries", "scenarios": [
+      "short.json",
+      {"file": "short.json", "parameters": {"/robots/0/motion/speed": [0.5, 1.5]}},
+      {"file": "short.json", "localizers": [{"type": "odometry_only", "label": "dead_reckoning"}]}],
+    "parameters": {"/duration": [2.0]}, "seeds": [1, 2]})");
+  const SweepSpec spec = load_sweep(f);
+  // (1 + 2 + 1) conditions x 2 seeds; the sweep's own parameters apply to every entry.
+  ASSERT_EQ(spec.runs.size(), 8u);
+  EXPECT_EQ(spec.runs[0].params_label, "duration=2.0");
+  EXPECT_EQ(spec.runs[2].params_label, "duration=2.0,speed=0.5");
+  EXPECT_EQ(spec.runs[4].params_label, "duration=2.0,speed=1.5");
+  EXPECT_EQ(spec.runs[6].localizer_label, "dead_reckoning");
+  EXPECT_DOUBLE_EQ(spec.runs[4].scenario["robots"][0]["motion"]["speed"].get<double>(), 1.5);
+
+  const std::string bad = (test_dir() / "bad_entry.json").string();
+  write_file_atomic(bad, R"({"scenarios": [{"file": "short.json", "parameters": {"speed": [1]}}]})");
+  try {
+    load_sweep(bad);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "/scenarios/0/parameters/speed") << e.what();
+  }
+  write_file_atomic(bad, R"({"scenarios": [{"path": "short.json"}]})");
+  EXPECT_THROW(load_sweep(bad), ConfigError);
+}
