@@ -245,4 +245,14 @@ Field Field::preset(const std::string& name, const std::string& path) {
   return f;
 }
 
+Json Field::markings_json() const {
+  Json j{{"name", name}, {"length", length}, {"width", width}, {"margin", margin}, {"line_width", line_width},
+         {"segments", Json::array()}, {"arcs", Json::array()}, {"spots", Json::array()}, {"goals", Json::array()}};
+  for (const auto& s : segments) j["segments"].push_back({s.a.x(), s.a.y(), s.b.x(), s.b.y()});
+  for (const auto& a : arcs) j["arcs"].push_back({a.centre.x(), a.centre.y(), a.radius, a.start, a.sweep});
+  for (const auto& s : spots) j["spots"].push_back({s.centre.x(), s.centre.y(), s.radius});
+  for (const auto& g : goals) j["goals"].push_back({g.goal_line_x, g.width, g.depth});
+  return j;
+}
+
 }  // namespace omniloc

@@ -78,6 +78,11 @@ class Field {
   /// Stable fingerprint of the geometry: caches (distance maps, colour tables) are tagged with it.
   std::string fingerprint() const;
 
+  /// The painted markings as explicit geometry, world frame, metres: {"name", "length", "width",
+  /// "margin", "segments": [[ax, ay, bx, by]...], "arcs": [[cx, cy, r, start, sweep]...], "spots":
+  /// [[cx, cy, r]...], "goals": [[goal_line_x, width, depth]...]}. Written beside each run
+  /// (field.json) so plots can draw the field under trajectories without knowing the presets.
+  Json markings_json() const;
   /// Builds a field from JSON (see docs/scenario.md, "field"). Errors name the JSON path.
   static Field from_json(const Json& j, const std::string& path);
   /// Loads a named preset from data/fields/<name>.json.

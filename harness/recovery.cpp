@@ -57,6 +57,24 @@ EpisodeResult score_episode(const std::vector<ScoredFrame>& frames, const Episod
   return r;
 }
 
+PhaseSplit split_tracking_phase(const std::vector<ScoredFrame>& frames, const std::vector<Episode>& disruptions, const RecoveryCriteria& c) {
+  PhaseSplit p;
+  for (const auto& e : disruptions) {
+    const EpisodeResult r = score_episode(frames, e, c);
+    const double to = r.recovered ? e.t_uncover + r.recovery_time : e.t_end;
+    p.excluded.emplace_back(e.t_kidnap, to);
+    // An episode never recovered reaches past the run's end (t_end); count only the time it covers.
+    const double end = frames.empty() ? to : std::min(to, frames.back().t);
+    p.excluded_s += std::max(0.0, end - e.t_kidnap);
+  }
+  for (const auto& f : frames) {
+    if (!f.valid) continue;
+    const bool out = std::any_of(p.excluded.begin(), p.excluded.end(), [&](const auto& iv) { return f.t >= iv.first - 1e-9 && f.t < iv.second - 1e-9; });
+    if (!out) p.tracking.push_back({f.t, f.est.x - f.truth.x, f.est.y - f.truth.y, angle_diff(f.est.theta, f.truth.theta)});
+  }
+  return p;
+}
+
 Json recovery_summary(const std::vector<EpisodeResult>& results) {
   std::size_t rec = 0, fals = 0, mir = 0;
   std::vector<double> times;

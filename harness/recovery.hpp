@@ -43,6 +43,18 @@ struct EpisodeResult {
 
 EpisodeResult score_episode(const std::vector<ScoredFrame>& frames, const Episode& e, const RecoveryCriteria& c = {});
 
+/// The tracking phase of a run with disruptions (kidnaps, covered camera): every valid frame outside
+/// [disruption start, recovery), where recovery is that of score_episode (the episode end when the
+/// localizer never recovered). These are the frames the papers' error tables describe; the frames
+/// while the robot was carried or blind, and until it found itself again, are the recovery metrics'.
+struct PhaseSplit {
+  std::vector<FrameError> tracking;                  ///< errors of the valid frames kept
+  std::vector<std::pair<double, double>> excluded;   ///< [from, to) seconds, one per disruption ("to" past the run's end: never recovered)
+  double excluded_s = 0.0;                           ///< total excluded time within the run, seconds
+};
+PhaseSplit split_tracking_phase(const std::vector<ScoredFrame>& frames, const std::vector<Episode>& disruptions,
+                                const RecoveryCriteria& c = {});
+
 /// Summary over all episodes: {"episodes", "recovered", "recovered_fraction", "recovery_time_s":
 /// {"median", "mean", "max"}, "false_recoveries", "mirrored", "after_recovery": ErrorSummary}.
 Json recovery_summary(const std::vector<EpisodeResult>& results);

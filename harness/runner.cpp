@@ -5,10 +5,12 @@
 #include <deque>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <sstream>
 
+#include "core/version.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/perception.hpp"
 #include "harness/recovery.hpp"
@@ -240,6 +242,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   summary["noise_profile"] = sc.noise.name;
   summary["duration_s"] = sc.duration;
   summary["camera_rate_hz"] = sc.camera_rate;
+  summary["omniloc"] = build_info_json();  // provenance; the regression gates compare everything else
   std::vector<TableRow> rows;
   std::string csv = "t,robot,gt_x,gt_y,gt_theta,est_x,est_y,est_theta,err_x,err_y,err_theta,err_pos,valid,mode,camera_ok,line_points,match_error,contact";
   std::set<std::string> extra_keys;
@@ -319,14 +322,34 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
                        {"false_recovery", res[k].false_recovery}, {"mirrored", res[k].mirrored}});
       rj["recovery"]["per_kidnap"] = per;
     }
+    // With kidnaps or covers, the papers' tables describe only the tracking phase: the frames
+    // before each disruption and after the recovery from it (see split_tracking_phase).
+    std::vector<Episode> disruptions;
+    std::optional<TableRow> phase_row;
+    for (const auto& e : sc.events)
+      if ((e.type == "kidnap" || e.type == "cover") && e.robot == tr.id) disruptions.push_back({e.t, e.t + e.duration, sc.duration + 1.0});
+    for (std::size_t k = 0; k + 1 < disruptions.size(); ++k) disruptions[k].t_end = disruptions[k + 1].t_kidnap;
+    if (!disruptions.empty()) {
+      const PhaseSplit split = split_tracking_phase(tr.scored, disruptions);
+      const ErrorSummary tracking = summarize(split.tracking);
+      Json tp = to_json(tracking);
+      tp["excluded_s"] = split.excluded_s;
+      Json iv = Json::array();
+      for (const auto& [a, b] : split.excluded) iv.push_back({a, b});
+      tp["excluded"] = iv;
+      rj["tracking_phase"] = tp;
+      phase_row = TableRow{sc.name + " r" + std::to_string(tr.id) + " " + info.type + " (tracking phase)", tracking};
+    }
     summary["robots"].push_back(rj);
-    rows.push_back({sc.name + " r" + std::to_string(tr.id) + " " + info.type, rr.all});
+    rows.push_back({sc.name + " r" + std::to_string(tr.id) + " " + info.type + (phase_row ? " (all frames)" : ""), rr.all});
+    if (phase_row) rows.push_back(*phase_row);
   }
   dir.write("frames.csv", csv);
   dir.write("timing.csv", timing);
   dir.write("events.jsonl", events_log);
   dir.write("summary.json", summary.dump(2) + "\n");
   dir.write("config.json", effective.dump(2) + "\n");
+  dir.write("field.json", sc.field.markings_json().dump() + "\n");
   dir.commit();
 
   result.out_dir = dir.final_dir();

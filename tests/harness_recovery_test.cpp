@@ -56,3 +56,50 @@ TEST(Recovery, InvalidEstimatesAreNeitherRecoveryNorFalseRecovery) {
   EXPECT_FALSE(r.recovered);
   EXPECT_FALSE(r.false_recovery);
 }
+
+TEST(Recovery, TrackingPhaseLeavesOutTheCarriedPeriodAndTheTimeToRecovery) {
+  // 2 cm off before the kidnap at 2 s, 3 m off (carried, then searching) until 5 s, 4 cm off after:
+  // uncovered at 3 s, recovered at 5 s -> [2, 5) is left out; the tracking phase sees only 2 and 4 cm.
+  auto fr = frames([](double t, const Pose2& truth) {
+    if (t < 2.0) return Pose2(truth.x + 0.02, truth.y, truth.theta);
+    if (t < 5.0) return Pose2(truth.x + 3.0, truth.y, truth.theta);
+    return Pose2(truth.x + 0.04, truth.y, truth.theta);
+  });
+  const PhaseSplit p = split_tracking_phase(fr, {{2.0, 3.0, 100.0}});
+  ASSERT_EQ(p.excluded.size(), 1u);
+  EXPECT_NEAR(p.excluded[0].first, 2.0, 1e-9);
+  EXPECT_NEAR(p.excluded[0].second, 5.0, 1.0 / 30 + 1e-9);
+  EXPECT_NEAR(p.excluded_s, 3.0, 1.0 / 30 + 1e-9);
+  const ErrorSummary s = summarize(p.tracking);
+  EXPECT_EQ(s.frames, 60u + 150u);  // [0, 2) and [5, 10) at 30 Hz
+  EXPECT_NEAR(s.x_cm.max, 4.0, 1e-9);
+  EXPECT_NEAR(s.x_cm.mean, (60 * 2.0 + 150 * 4.0) / 210.0, 1e-9);
+  // All frames would include the 3 m: the headline must not.
+  EXPECT_GT(summarize([&] {
+              std::vector<FrameError> all;
+              for (const auto& f : fr) all.push_back({f.t, f.est.x - f.truth.x, 0.0, 0.0});
+              return all;
+            }()).x_cm.max, 299.0);
+}
+
+TEST(Recovery, TrackingPhaseOfAnEpisodeNeverRecoveredEndsAtTheNextDisruption) {
+  // Lost from the kidnap at 2 s to the next kidnap at 6 s; recovered 1 s after the second (uncover 7 s).
+  auto fr = frames([](double t, const Pose2& truth) {
+    return (t >= 2.0 && t < 8.0) ? Pose2(truth.x + 2.0, truth.y, truth.theta) : truth;
+  });
+  const PhaseSplit p = split_tracking_phase(fr, {{2.0, 3.0, 6.0}, {6.0, 7.0, 100.0}});
+  ASSERT_EQ(p.excluded.size(), 2u);
+  EXPECT_NEAR(p.excluded[0].second, 6.0, 1e-9);  // never recovered: up to the episode's end
+  EXPECT_NEAR(p.excluded[1].second, 8.0, 1.0 / 30 + 1e-9);
+  EXPECT_NEAR(summarize(p.tracking).x_cm.max, 0.0, 1e-12);
+  EXPECT_EQ(summarize(p.tracking).frames, 60u + 60u);  // [0, 2) and [8, 10)
+}
+
+TEST(Recovery, ExcludedTimeOfAnEpisodeNeverRecoveredEndsWithTheRun) {
+  // Lost from the kidnap at 8 s to the end of the frames (9.967 s); the episode's t_end lies past it.
+  auto fr = frames([](double t, const Pose2& truth) { return t >= 8.0 ? Pose2(truth.x + 2.0, truth.y, truth.theta) : truth; });
+  const PhaseSplit p = split_tracking_phase(fr, {{8.0, 9.0, 11.0}});
+  EXPECT_NEAR(p.excluded[0].second, 11.0, 1e-9);
+  EXPECT_NEAR(p.excluded_s, 299.0 / 30.0 - 8.0, 1e-9);
+  EXPECT_EQ(summarize(p.tracking).frames, 240u);
+}
