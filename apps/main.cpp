@@ -7,8 +7,11 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "core/error.hpp"
 #include "core/field.hpp"
+#include "core/version.hpp"
 #include "harness/experiment.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/render_frame.hpp"
@@ -44,6 +47,11 @@ commands:
   experiment NAME [--seed N] [-o DIR] [--quick] [--config FILE]
                          run a named experiment (solver maps, cooperative simulation, ...);
                          --config: its description file instead of scenarios/experiments/NAME.json
+  compare A B [--markdown] [--alpha P]
+                         two result sets (runs, sweeps or folders of them, e.g. two commits) side by
+                         side per metric: difference and whether it exceeds the seed-to-seed spread
+                         (Welch's t); runs scripts/compare.py
+  --version              the build: git describe, compiler, build type (also in every summary.json)
 )";
 
 struct Args {
@@ -230,6 +238,19 @@ int cmd_list() {
   return 0;
 }
 
+// The comparison is statistics over result files, written in Python beside the report
+// (scripts/compare.py); the CLI only forwards, so both entry points give the same table.
+int cmd_compare(int argc, char** argv) {
+  const std::string script = std::string(OMNILOC_SOURCE_DIR) + "/scripts/compare.py";
+  const char* py = ::access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+  std::vector<char*> args{const_cast<char*>(py), const_cast<char*>(script.c_str())};
+  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  ::execvp(py, args.data());
+  std::cerr << "failed: cannot run " << py << " " << script << "\n";
+  return 1;
+}
+
 int cmd_experiment(const Args& a) {
   if (a.positional.size() != 1) throw UsageError("experiment takes one name (see omniloc list)");
   for (const auto& e : harness::experiments()) {
@@ -252,6 +273,11 @@ int main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   const std::string cmd = argv[1];
+  if (cmd == "--version" || cmd == "version") {
+    std::cout << version_line() << "\n";
+    return 0;
+  }
+  if (cmd == "compare") return cmd_compare(argc, argv);
   try {
     if (cmd == "validate") return cmd_validate(parse(argc, argv, 2, {}, {}));
     if (cmd == "run") return cmd_run(parse(argc, argv, 2, {"--seed", "-o", "--frames", "--frames-every"}, {"--quiet"}));

@@ -1,65 +1,63 @@
 #!/usr/bin/env python3
-"""Prints omniloc results in the papers' table layout next to the published rows.
+"""Prints omniloc results in a paper's table layout, each published row beside the runs that reproduce it.
 
-usage: paper_table.py RESULT --paper KEY [--rows LABEL=PUBLISHED_ROW ...] [--markdown]
+usage: paper_table.py RESULTS... --paper KEY [--rows LABEL ...] [--markdown]
 
-RESULT is a run folder (summary.json) or a sweep folder (aggregate.json; one row per group, in the
-sweep's order). KEY names a table in results/reference/papers.json (e.g. 002_table1_occlusion).
---rows maps our rows, in order, to the published row names (default: the paper's rows in order).
-Only the published numbers come from papers.json; every other number is read from the results.
+RESULTS are run or sweep folders, or folders holding them (e.g. results/sweeps/paper_suite). KEY
+names an error table of results/reference/papers.json: 002_table1_occlusion, 002_table2_lighting
+or 000_tracking. Rows pair BY KEY: each published row in papers.json names its scenario,
+localizer and configuration values ("reproduced_by"), and our runs are found by those, never by
+their position in a sweep. --rows keeps only the named rows (published or extra). A row without
+runs says "not run" and prints the command that runs it. Ours: mean over seeds (n shown); runs with
+kidnaps or covers use their tracking phase. Only the published numbers come from papers.json.
 """
 import argparse
-import json
 import pathlib
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-KEYS = [("x_cm", "mean"), ("y_cm", "mean"), ("theta_rad", "mean"), ("x_cm", "std"), ("y_cm", "std"), ("theta_rad", "std"),
-        ("x_cm", "max"), ("y_cm", "max"), ("theta_rad", "max")]
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import omniloc_results as R  # noqa: E402
+import paper_claims as C  # noqa: E402
 
-
-def ours(folder):
-    folder = pathlib.Path(folder)
-    if (folder / "aggregate.json").exists():
-        agg = json.loads((folder / "aggregate.json").read_text())
-        rows = []
-        for g in agg["groups"]:
-            m = g["metrics"]
-            vals = [m.get(f"r0/{a}/{s}", {}).get("mean", float("nan")) for a, s in KEYS]
-            pts = m.get("r0/line_points/mean", {}).get("mean", float("nan"))
-            rows.append((g["params"], vals, pts))
-        return rows
-    s = json.loads((folder / "summary.json").read_text())
-    r = s["robots"][0]
-    return [(s["scenario"], [r[a][st] for a, st in KEYS], r.get("line_points", {}).get("mean", float("nan")))]
+SHORT = ["mean x", "mean y", "mean th", "std x", "std y", "std th", "max x", "max y", "max th"]
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("result")
-    ap.add_argument("--paper", required=True)
-    ap.add_argument("--labels", nargs="*", help="published row names for our rows, in order")
+    ap.add_argument("results", nargs="+")
+    ap.add_argument("--paper", required=True, help="a table key of results/reference/papers.json")
+    ap.add_argument("--rows", nargs="+", metavar="LABEL", help="only these rows (published or extra row labels)")
     ap.add_argument("--markdown", action="store_true")
     a = ap.parse_args()
-    papers = json.loads((ROOT / "results/reference/papers.json").read_text())
-    if a.paper not in papers:
-        print(f"error: no table {a.paper} in papers.json", file=sys.stderr)
+    papers = R.load_papers()
+    tables = [k for k, v in papers.items() if isinstance(v, dict) and "columns" in v and "reproduced_by" in v and isinstance(v.get("rows"), dict)]
+    if a.paper not in tables:
+        print(f"error: no error table \"{a.paper}\" in papers.json; tables: {', '.join(tables)}", file=sys.stderr)
         return 2
-    pub = papers[a.paper]["rows"]
     try:
-        rows = ours(a.result)
-    except (OSError, KeyError, json.JSONDecodeError) as e:
-        print(f"error: cannot read results in {a.result}: {e}", file=sys.stderr)
+        runs, _, _ = R.discover(a.results)
+        rows = C.pair_table(papers, a.paper, runs, a.rows)
+    except KeyError as e:
+        print(f"error: {e.args[0]}", file=sys.stderr)
         return 2
-    labels = a.labels or list(pub.keys())
-    head = ["case", "source"] + [f"{s} {c}" for c, s in [("x", "mean"), ("y", "mean"), ("th", "mean"), ("x", "std"), ("y", "std"),
-                                                          ("th", "std"), ("x", "max"), ("y", "max"), ("th", "max")]] + ["line points / frame"]
-    lines = []
-    for i, (name, vals, pts) in enumerate(rows):
-        label = labels[i] if i < len(labels) else name
-        lines.append([label, "omniloc"] + [f"{v:.3f}" for v in vals] + [f"{pts:.0f}"])
-        if label in pub:
-            lines.append([label, "paper"] + [f"{v:.3f}" for v in pub[label]] + ["-"])
+    except SystemExit as e:
+        print(f"error: cannot read results: {e}", file=sys.stderr)
+        return 2
+    head = ["row", "source"] + SHORT + ["line points / frame", "seeds"]
+    lines, notes = [], []
+    for p in rows:
+        st = p["stats"]
+        if p["runs"]:
+            lines.append([p["label"] + (" (tracking phase)" if p["phased"] else ""), "omniloc"] +
+                         [f"{st[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] + [f"{st['line_points/mean']['mean']:.0f}", str(st["x_cm/mean"]["n"])])
+        else:
+            lines.append([p["label"], "not run"] + ["-"] * 9 + ["-", "0"])
+            notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {p['command']}")
+        if p["published"]:
+            lines.append([p["label"], "paper"] + [f"{v:.3f}" for v in p["published"]] + ["-", "-"])
+            if p["runs"]:
+                lines.append([p["label"], "ours/paper"] + [f"{st[f'{c}/{s}']['mean'] / v:.2f}" if v else "-"
+                                                            for (c, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
     if a.markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
@@ -68,7 +66,9 @@ def main():
     else:
         w = [max(len(x[i]) for x in [head] + lines) for i in range(len(head))]
         for l in [head] + lines:
-            print("  ".join(x.rjust(w[i]) for i, x in enumerate(l)))
+            print("  ".join(x.ljust(w[i]) if i < 2 else x.rjust(w[i]) for i, x in enumerate(l)))
+    for n in notes:
+        print(n)
     print(f"\nunits: x, y in cm, th in rad; paper: {papers[a.paper]['source']}")
     return 0
 

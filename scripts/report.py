@@ -1,22 +1,28 @@
 #!/usr/bin/env python3
 """Comparison report of omniloc results: report.md and a self-contained report.html.
 
-usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N]
+usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N] [--baseline RESULTS]
 
 RESULTS are folders: a run (summary.json), a sweep (aggregate.json with runs/ inside), an
 experiment (PNG / JSON / markdown files written by `omniloc experiment`), or any folder holding
-such folders (searched recursively). The report shows
-  - the papers' tables beside ours (published numbers come only from results/reference/papers.json),
-  - every sweep's aggregate (mean and 95 % interval over seeds) and every run's error table,
-  - trajectory plots (truth vs estimate) and error over time with the events marked,
-  - error CDFs per localizer, timing per stage (render, vision, localize),
-  - the pictures the experiments produced.
+such folders (searched recursively). The report shows, in this order:
+  - provenance: which omniloc builds (git describe, compiler, build type) made the results;
+  - the reproduction scorecard: every claim of results/reference/papers.json with our figure, the
+    paper's, the ratio and the verdict computed by the rule written next to the claim;
+  - every published table beside the runs that reproduce it, paired BY KEY (scenario, localizer,
+    configuration values; scripts/omniloc_results.py), never by position; a row whose runs are
+    missing says "not run" and prints the command that runs it;
+  - with --baseline: our metrics against another result set (e.g. another commit), per metric
+    with the difference and Welch's t-test over seeds (scripts/compare.py);
+  - every sweep's aggregate and every run's error table (headings carry the swept parameters,
+    in the aggregate's order), trajectory plots over the field, position and heading error over
+    time with the events marked, error CDFs, timing per stage;
+  - every experiment's tables (as HTML tables) and pictures.
 Everything except the published numbers is read from the result files. Needs Python 3 and
 Debian's python3-matplotlib (no PyPI).
 """
 import argparse
 import base64
-import csv
 import html
 import json
 import math
@@ -30,93 +36,92 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-PAPER_KEYS = [("x_cm", "mean"), ("y_cm", "mean"), ("theta_rad", "mean"), ("x_cm", "std"), ("y_cm", "std"), ("theta_rad", "std"),
-              ("x_cm", "max"), ("y_cm", "max"), ("theta_rad", "max")]
-PAPER_COLS = ["mean x cm", "mean y cm", "mean th rad", "std x", "std y", "std th", "max x", "max y", "max th"]
-# Which published table a sweep or scenario reproduces, and how our rows map to its rows.
-SWEEP_TABLES = {
-    "occlusion_002": ("002_table1_occlusion", None),
-    "lighting_002": ("002_table2_lighting", None),
-}
-SCENARIO_TABLES = {"tracking": ("000_tracking", "tracking")}
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import omniloc_results as R  # noqa: E402
+import paper_claims as C  # noqa: E402
+
 EVENT_COLOURS = {"kidnap": "red", "cover": "black", "teleport": "red", "occlude": "grey", "lights": "orange", "camera": "purple"}
-
-
-def find(paths):
-    runs, sweeps, experiments = [], [], []
-    for p in paths:
-        p = pathlib.Path(p)
-        if not p.is_dir():
-            sys.exit(f"report.py: {p}: not a folder")
-        for d, subdirs, files in os.walk(p):
-            d = pathlib.Path(d)
-            if d.name.startswith(".") or ".staging" in d.name or d.name.endswith(".tmp"):
-                subdirs[:] = []
-                continue
-            if "aggregate.json" in files:
-                sweeps.append(d)
-                subdirs[:] = []  # its runs are reported through the sweep
-            elif "summary.json" in files:
-                runs.append(d)
-                subdirs[:] = []
-            elif any(f.endswith(".png") for f in files) and d.name != "img":
-                experiments.append(d)
-    return sorted(set(runs)), sorted(set(sweeps)), sorted(set(experiments))
-
-
-def load_frames(run):
-    f = run / "frames.csv"
-    if not f.exists():
-        return []
-    with f.open() as fh:
-        return list(csv.DictReader(fh))
-
-
-def load_events(run):
-    f = run / "events.jsonl"
-    if not f.exists():
-        return []
-    return [json.loads(line) for line in f.read_text().splitlines() if line.strip()]
-
-
-def fnum(v, digits=3):
-    if v is None or (isinstance(v, float) and math.isnan(v)):
-        return "-"
-    return f"{v:.{digits}f}"
+VERDICT_CLASS = {"holds": "ok", "partly": "partly", "does not": "no", "not run": "notrun", "n/a": "notrun"}
+fnum = R.fnum
 
 
 class Report:
     def __init__(self, out, title):
         self.out = pathlib.Path(out)
         (self.out / "img").mkdir(parents=True, exist_ok=True)
+        for old in (self.out / "img").glob("*.png"):  # pictures of an earlier report in the same folder
+            old.unlink()
         self.md = [f"# {title}", ""]
         self.html = []
         self.n_img = 0
         self.title = title
 
-    def heading(self, text, level=2):
+    def heading(self, text, level=2, anchor=None):
         self.md += ["#" * level + " " + text, ""]
-        self.html.append(f"<h{level}>{html.escape(text)}</h{level}>")
+        a = f' id="{html.escape(anchor)}"' if anchor else ""
+        self.html.append(f"<h{level}{a}>{html.escape(text)}</h{level}>")
 
-    def para(self, text):
+    def para(self, text, cls=None):
         self.md += [text, ""]
-        self.html.append(f"<p>{html.escape(text)}</p>")
+        c = f' class="{cls}"' if cls else ""
+        self.html.append(f"<p{c}>{html.escape(text)}</p>")
 
-    def table(self, header, rows, caption=None):
+    def table(self, header, rows, caption=None, row_classes=None):
+        """rows: lists of cells; row_classes: one CSS class per row (e.g. "paper" for published rows)."""
         if caption:
-            self.para(caption)
+            self.para(caption, "caption")
         self.md.append("| " + " | ".join(header) + " |")
         self.md.append("|" + "|".join("---" for _ in header) + "|")
-        for r in rows:
-            self.md.append("| " + " | ".join(str(c) for c in r) + " |")
+        for k, r in enumerate(rows):
+            cells = [str(c) for c in r]
+            if row_classes and row_classes[k] == "paper":
+                cells = [f"*{c}*" if c not in ("", "-") else c for c in cells]
+            self.md.append("| " + " | ".join(cells) + " |")
         self.md.append("")
-        h = "<table><tr>" + "".join(f"<th>{html.escape(str(c))}</th>" for c in header) + "</tr>"
-        for r in rows:
-            cls = ' class="paper"' if r and str(r[0]).startswith("paper") else ""
-            h += f"<tr{cls}>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
-        self.html.append(h + "</table>")
+        h = "<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(str(c))}</th>" for c in header) + "</tr>"
+        for k, r in enumerate(rows):
+            cls = row_classes[k] if row_classes and row_classes[k] else ""
+            h += (f"<tr class='{cls}'>" if cls else "<tr>") + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
+        self.html.append(h + "</table></div>")
+
+    def markdown(self, text):
+        """An experiment's markdown: headings, paragraphs and pipe tables as real HTML."""
+        self.md += [text, ""]
+        lines = text.splitlines()
+        i, para = 0, []
+
+        def flush():
+            if para:
+                self.html.append("<p>" + html.escape(" ".join(para)) + "</p>")
+                para.clear()
+        while i < len(lines):
+            ln = lines[i].rstrip()
+            if ln.startswith("#"):
+                flush()
+                level = min(6, len(ln) - len(ln.lstrip("#")) + 2)
+                self.html.append(f"<h{level}>{html.escape(ln.lstrip('#').strip())}</h{level}>")
+            elif ln.startswith("|"):
+                flush()
+                rows = []
+                while i < len(lines) and lines[i].strip().startswith("|"):
+                    cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
+                    if not all(set(c) <= set("-: ") for c in cells):
+                        rows.append(cells)
+                    i += 1
+                if rows:
+                    h = "<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(c.replace('**', ''))}</th>" for c in rows[0]) + "</tr>"
+                    for r in rows[1:]:
+                        h += "<tr>" + "".join(f"<td>{html.escape(c.replace('**', ''))}</td>" for c in r) + "</tr>"
+                    self.html.append(h + "</table></div>")
+                continue
+            elif not ln.strip():
+                flush()
+            else:
+                para.append(ln.replace("**", ""))
+            i += 1
+        flush()
 
     def figure(self, fig, name, caption):
         self.n_img += 1
@@ -138,11 +143,17 @@ class Report:
         self.html.append(f'<figure><img src="data:image/png;base64,{b64}" alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}</figcaption></figure>')
 
     def write(self):
-        (self.out / "report.md").write_text("\n".join(self.md) + "\n")
-        style = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em;color:#222}"
-                 "table{border-collapse:collapse;margin:0.5em 0 1.2em;font-size:13px}td,th{border:1px solid #bbb;padding:3px 7px;text-align:right}"
-                 "th{background:#eee}tr.paper td{background:#fff6dc;font-style:italic}figure{margin:1em 0}img{max-width:100%}"
-                 "figcaption{font-size:13px;color:#555}h2{border-bottom:1px solid #ccc;padding-top:0.6em}")
+        tmp = self.out / "report.md.tmp"
+        tmp.write_text("\n".join(self.md) + "\n")
+        tmp.replace(self.out / "report.md")
+        style = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;color:#222}"
+                 ".scroll{overflow-x:auto}table{border-collapse:collapse;margin:0.5em 0 1.2em;font-size:13px}"
+                 "td,th{border:1px solid #bbb;padding:3px 7px;text-align:right}td:first-child,th:first-child{text-align:left}"
+                 "th{background:#eee}tr.paper td{background:#fff6dc;font-style:italic}tr.ratio td{color:#555;font-size:12px}"
+                 "tr.missing td{color:#999}tr.ok td:nth-last-child(2){background:#d8f5d8}tr.partly td:nth-last-child(2){background:#fff0b3}"
+                 "tr.no td:nth-last-child(2){background:#f8d0d0}tr.notrun td:nth-last-child(2){background:#e8e8e8}"
+                 "figure{margin:1em 0}img{max-width:100%}p.caption{font-size:13px;color:#444;margin-bottom:0.2em}"
+                 "figcaption{font-size:13px;color:#555}h2{border-bottom:1px solid #ccc;padding-top:0.6em}code{background:#f3f3f3}")
         doc = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(self.title)}</title><style>{style}</style></head>"
                f"<body><h1>{html.escape(self.title)}</h1>" + "\n".join(self.html) + "</body></html>\n")
         tmp = self.out / "report.html.tmp"
@@ -150,27 +161,253 @@ class Report:
         tmp.replace(self.out / "report.html")
 
 
-def summary_row(robot):
-    return [fnum(robot[a][s], 3) for a, s in PAPER_KEYS]
+# ---- provenance ---------------------------------------------------------------------------
+
+def provenance(rep, runs, sweeps):
+    versions = {}
+    for r in runs:
+        o = r.summary.get("omniloc") or {}
+        k = (o.get("version", "unrecorded"), o.get("compiler", "-"), o.get("build_type", "-"))
+        versions[k] = versions.get(k, 0) + 1
+    rep.heading("Provenance", 2, "provenance")
+    rows = [[v, c, b, n] for (v, c, b), n in sorted(versions.items())]
+    rep.table(["omniloc version (git describe)", "compiler", "build type", "runs"], rows,
+              f"Builds that made these results; machine of this report: {platform.node()}, {os.cpu_count()} cores, {platform.platform()}.")
+    if len(versions) > 1:
+        rep.para("Warning: the results come from more than one build; compare like with like (scripts/compare.py).")
 
 
-def paper_rows(papers, key, labels=None):
-    t = papers.get(key)
-    if not t:
-        return []
-    names = labels or list(t["rows"].keys())
-    return [[f"paper: {n}"] + [fnum(v, 3) for v in t["rows"][n]] for n in names if n in t["rows"]]
+# ---- scorecard and published tables ----------------------------------------------------------
+
+def scorecard(rep, ctx):
+    rep.heading("Reproduction scorecard", 2, "scorecard")
+    rep.para("One line per published claim. The verdict is computed by the rule written next to the claim in "
+             "results/reference/papers.json (claims); claims that do not hold stay visible, and no model is tuned to turn one. "
+             "Timings compare our machine with the papers' 1.66 GHz CPU.")
+    rows, classes = [], []
+    claims = C.evaluate_claims(ctx)
+    for c in claims:
+        pub = c["published"]
+        pub_text = (fnum(pub, 3) + ("" if c["unit"] in ("x", "", "recovered") else f" {c['unit']}")) if isinstance(pub, (int, float)) else (pub or "-")
+        rows.append([c["paper"], c["claim"], c["ours_text"], pub_text, fnum(c["ratio"], 2) if c["ratio"] is not None else "-", c["verdict"], c["rule_text"]])
+        classes.append(VERDICT_CLASS.get(c["verdict"], ""))
+    rep.table(["paper", "claim", "ours", "paper's", "ours / paper", "verdict", "rule"], rows, row_classes=classes)
+    counts = {}
+    for c in claims:
+        counts[c["verdict"]] = counts.get(c["verdict"], 0) + 1
+    rep.para("Verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + ".")
+    return claims
 
 
-def plot_run(rep, run, summary, frames, events):
-    name = f"{summary['scenario']} / {summary['localizer']} / seed {summary['seed']}"
+def error_table(rep, papers, table, runs):
+    t = papers[table]
+    rep.heading(f"{t.get('source', table)}", 3, table)
+    rep.para(f"papers.json key: {table}. Ours: mean over seeds of each run's statistic (robot 0), with n; "
+             "runs with kidnaps or covers use their tracking phase (see docs/results.md). Paper rows in italics, then ours / paper.")
+    header = ["row", "source"] + R.TABLE_COLS + ["line points / frame", "seeds"]
+    rows, classes = [], []
+    for p in C.pair_table(papers, table, runs):
+        st = p["stats"]
+        if p["runs"]:
+            label = p["label"] + (" (tracking phase)" if p["phased"] else "")
+            rows.append([label, "omniloc"] + [fnum(st[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
+                        [fnum(st["line_points/mean"]["mean"], 0), st["x_cm/mean"]["n"]])
+            classes.append("")
+        else:
+            rows.append([p["label"], "not run"] + ["-"] * 9 + ["-", 0])
+            classes.append("missing")
+        if p["published"]:
+            rows.append([p["label"], "paper"] + [fnum(v, 3) for v in p["published"]] + ["-", "-"])
+            classes.append("paper")
+            if p["runs"]:
+                rows.append([p["label"], "ours / paper"] + [fnum(st[f"{a}/{s}"]["mean"] / v, 2) if v else "-" for (a, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
+                classes.append("ratio")
+    rep.table(header, rows, row_classes=classes)
+    missing = [p for p in C.pair_table(papers, table, runs) if not p["runs"]]
+    for p in missing:
+        rep.para(f"Not run: \"{p['label']}\" ({R.describe_key(p['key'])}). Run: {p['command']}")
+    # Intervals where there are at least two seeds.
+    ci = []
+    for p in C.pair_table(papers, table, runs):
+        if p["runs"]:
+            ci.append([p["label"], R.fstat(p["stats"]["x_cm/mean"], 3), R.fstat(p["stats"]["y_cm/mean"], 3), R.fstat(p["stats"]["theta_rad/mean"], 4)])
+    if ci:
+        rep.table(["row", "mean x cm [95 % interval]", "mean y cm", "mean th rad"], ci, "Seed-to-seed spread: Student-t 95 % interval over seeds, only where n >= 2.")
+
+
+def kidnap_table(rep, papers, runs):
+    rep.heading("Kidnap recovery (papers 002 and 000)", 3, "kidnapping")
+    rows, classes = [], []
+    for table in ("002_kidnapping", "000_kidnapping"):
+        t = papers[table]
+        for label, key in t["reproduced_by"]["rows"].items():
+            sel = R.select(runs, key)
+            if sel:
+                ep = sum(r.metric("recovery/episodes", "all") or 0 for r in sel)
+                rec = sum(r.metric("recovery/recovered", "all") or 0 for r in sel)
+                fal = sum(r.metric("recovery/false_recoveries", "all") or 0 for r in sel)
+                med = R.stats([r.metric("recovery/recovery_time_s/median", "all") for r in sel])
+                after = R.stats([r.metric("recovery/after_recovery/x_cm/mean", "all") for r in sel])
+                phase = R.stats([r.metric("x_cm/mean", "tracking") for r in sel])
+                allf = R.stats([r.metric("x_cm/mean", "all") for r in sel])
+                rows.append([f"{table}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}", fnum(med["mean"], 2), fnum(after["mean"], 2),
+                             fnum(phase["mean"], 2), fnum(allf["mean"], 1), len(sel)])
+                classes.append("")
+            else:
+                rows.append([f"{table}: {label}", "not run", "-", "-", "-", "-", "-", "-", 0])
+                classes.append("missing")
+            rows.append([f"{table}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-"])
+            classes.append("paper")
+    rep.table(["case", "source", "recovered / kidnaps", "false recoveries", "median recovery s", "after recovery: mean x cm",
+               "tracking phase: mean x cm", "all frames: mean x cm", "seeds"], rows,
+              "Over all seeds. Recovered: error under 0.3 m and 0.2 rad for 1 s. The tracking phase leaves out the carried period and the time to recovery; "
+              "'all frames' includes them (that is why it is large).", classes)
+
+
+def timing_table(rep, papers, runs):
+    t = papers["timings_ms"]
+    rep.heading("Timings (papers 002 and 000)", 3, "timings_ms")
+    rows, classes = [], []
+    for row, key in t["reproduced_by"]["rows"].items():
+        med, frames, sel = C.timing_ms(papers, row, runs)
+        lo, hi = t[row]
+        rows.append([row, key["what"], fnum(med, 2) if med is not None else "not run", f"{lo}-{hi}", fnum(med / hi, 2) if med is not None else "-", frames])
+        classes.append("" if med is not None else "missing")
+    rep.table(["papers.json row", "what", "ours: median ms", "paper ms", "ours / paper's upper bound", "frames"], rows,
+              f"Ours: wall time on {platform.node()} ({os.cpu_count()} cores, {platform.machine()}), runs of a sweep share the cores; paper: {t['cpu']}.", classes)
+
+
+def experiment_tables(rep, papers, ctx):
+    # 001: equal vs 1/L weights.
+    t = papers["001_cooperative_mean_error_mm"]
+    rb = t["reproduced_by"]
+    j = ctx.experiment_json(rb["experiment"], rb["file"])
+    rep.heading("Paper 001: cooperative ball localisation, equal vs 1/L weights", 3, "001_cooperative_mean_error_mm")
+    if j is None:
+        rep.para(f"Not run: {rb['command']}")
+    else:
+        eq, w = R.pointer(j, rb["equal_weights"])[1], R.pointer(j, rb["weighted"])[1]
+        rows = [["omniloc", fnum(eq, 1), fnum(w, 1), fnum(w / eq, 3) if eq else "-", (j.get("trials") or {}).get("path", "-")],
+                ["paper", fnum(t["equal_weights"], 1), fnum(t["weighted"], 1), fnum(t["weighted"] / t["equal_weights"], 3), "-"],
+                ["ours / paper", fnum(eq / t["equal_weights"], 2), fnum(w / t["weighted"], 2), "", ""]]
+        rep.table(["source", "equal weights mm", "1/L weights mm", "1/L / equal", "trials"], rows,
+                  "papers.json key 001_cooperative_mean_error_mm; ours from results/experiments/cooperative_001/cooperative_001.json (headline).",
+                  ["", "paper", "ratio"])
+    g = (j or {}).get("growth_model") or {}
+    rep.heading("Paper 001: FBPF vs MFBPF on the growth model", 3, "001_growth_model")
+    if g:
+        rows = [[k, fnum(v.get("mean"), 3), fnum(v.get("std"), 3), fnum(v.get("median"), 3)] for k, v in g.items() if isinstance(v, dict) and "std" in v]
+        rep.table(["filter", "mean RMSE", "std", "median"], rows, f"paper: {papers['001_growth_model']['claim']} ({papers['001_growth_model']['setup']}); "
+                  f"ours: {g.get('verdict', '')}")
+    else:
+        rep.para(f"Not run: {papers['001_growth_model']['reproduced_by']['command']}")
+    rv = (j or {}).get("robots_vs_error") or []
+    rep.heading("Paper 001: error against the number of robots (fig. 10)", 3, "001_simulation_setup")
+    if rv:
+        rep.table(["robots", "equal, all subsets mm", "1/L, all subsets mm", "1/L median mm"],
+                  [[r["robots"], fnum(r["equal_all_mm"], 1), fnum(r["weighted_all_mm"], 1), fnum(r["weighted_median_all_mm"], 1)] for r in rv],
+                  f"paper: {papers['001_simulation_setup']['robots_vs_error']}")
+        fig, ax = plt.subplots(figsize=(6.5, 3.6))
+        ks = [r["robots"] for r in rv]
+        ax.plot(ks, [r["equal_all_mm"] for r in rv], "o-", label="equal weights")
+        ax.plot(ks, [r["weighted_all_mm"] for r in rv], "s-", label="1/L weights")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("number of robots")
+        ax.set_ylabel("mean ball error (mm)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        rep.figure(fig, "robots_vs_error", "paper 001 fig. 10 reproduced: mean ball error against the number of robots (all subsets)")
+    else:
+        rep.para(f"Not run: {papers['001_simulation_setup']['reproduced_by']['command']}")
+    rep.para("Paper 001's real-robot result (001_real_mean_error_cm: 8.6 -> 4.5 cm) needs real robots and is not reproduced.")
+
+    # 004 table 1.
+    t = papers["004_table1_cm"]
+    rb = t["reproduced_by"]
+    j = ctx.experiment_json(rb["experiment"], rb["file"])
+    rep.heading("Paper 004 table 1: two-circle and three-point fixes (cm)", 3, "004_table1_cm")
+    if j is None:
+        rep.para(f"Not run: {rb['command']}")
+    else:
+        tab = (j.get("tables") or [{}])[0]
+        rows, classes = [], []
+        for k, r in enumerate(tab.get("rows", [])):
+            ours = r.get("ours", {})
+            tc, tp = ours.get("two_circle", {}), ours.get("three_point", {})
+            pub = t["rows"][k] if k < len(t["rows"]) else None
+            rows.append([f"({r['true_cm'][0]:.0f}, {r['true_cm'][1]:.0f})", "omniloc", fnum(tc.get("mean_err_cm"), 2), fnum(tp.get("mean_err_cm"), 2)])
+            classes.append("")
+            if pub:
+                rows.append(["", "paper", fnum(pub[4], 2), fnum(pub[7], 2)])
+                classes.append("paper")
+                rows.append(["", "ours / paper", fnum((tc.get("mean_err_cm") or math.nan) / pub[4], 2), fnum((tp.get("mean_err_cm") or math.nan) / pub[7], 2)])
+                classes.append("ratio")
+        rep.table(["true position", "source", "two-circle error", "three-point error"], rows,
+                  f"bearing noise N(0, {tab.get('bearing_sigma_deg', '-')} deg), {tab.get('trials', '-')} trials per position; {tab.get('trend', '')}", classes)
+
+    # 003 simulation.
+    t = papers["003_simulation"]
+    rb = t["reproduced_by"]
+    j = ctx.experiment_json(rb["experiment"], rb["file"])
+    rep.heading("Paper 003: landmark groups with voting (simulation)", 3, "003_simulation")
+    if j is None:
+        rep.para(f"Not run: {rb['command']}")
+    else:
+        rows = []
+        for case, v in j.items():
+            s = v.get("all_paths") if isinstance(v, dict) else None
+            if s:
+                rows.append([case, s.get("frames"), s.get("group_fixes"), fnum(s.get("fixes_max_m"), 2), fnum(s.get("no_voting_mean_m"), 3),
+                             fnum(s.get("no_voting_max_m"), 2), fnum(s.get("voting_mean_m"), 3), fnum(s.get("voting_max_m"), 2)])
+        rep.table(["case", "frames", "group fixes", "worst fix m", "no voting: mean m", "max m", "voting: mean m", "max m"], rows,
+                  f"paper: {t['source']}; max error after voting about {t['max_error_m_after_voting']} m")
+
+
+def published_tables(rep, papers, ctx):
+    rep.heading("Published tables beside ours", 2, "published")
+    for table in ("002_table1_occlusion", "002_table2_lighting", "000_tracking"):
+        error_table(rep, papers, table, ctx.runs)
+    kidnap_table(rep, papers, ctx.runs)
+    timing_table(rep, papers, ctx.runs)
+    rep.para(f"mcl_only_mean_position_error_cm: MCL-only teams' {papers['mcl_only_mean_position_error_cm']} cm, beside our MCL-alone row of the "
+             "000_tracking table above and the scorecard's mcl_alone claim.")
+    experiment_tables(rep, papers, ctx)
+
+
+# ---- sweeps, runs, plots -------------------------------------------------------------------------
+
+def field_lines(ax, run):
+    f = run.folder / "field.json"
+    if not f.exists():
+        return
+    fj = json.loads(f.read_text())
+    kw = dict(color="#9a9a9a", lw=0.8, zorder=0)
+    for ax_, ay, bx, by in fj.get("segments", []):
+        ax.plot([ax_, bx], [ay, by], **kw)
+    for cx, cy, r, start, sweep in fj.get("arcs", []):
+        n = max(8, int(abs(sweep) / 0.05))
+        ts = [start + sweep * i / n for i in range(n + 1)]
+        ax.plot([cx + r * math.cos(t) for t in ts], [cy + r * math.sin(t) for t in ts], **kw)
+    for gx, gw, gd in fj.get("goals", []):
+        s = 1 if gx >= 0 else -1
+        ax.plot([gx, gx + s * gd, gx + s * gd, gx], [-gw / 2, -gw / 2, gw / 2, gw / 2], color="#6a6a6a", lw=0.8, zorder=0)
+    hx, hy = fj["length"] / 2 + fj["margin"], fj["width"] / 2 + fj["margin"]
+    ax.set_xlim(-hx, hx)
+    ax.set_ylim(-hy, hy)
+
+
+def plot_run(rep, run, title):
+    frames = run.frames()
     if not frames:
         return
+    events = [json.loads(l) for l in (run.folder / "events.jsonl").read_text().splitlines() if l.strip()] if (run.folder / "events.jsonl").exists() else []
     by_robot = {}
     for f in frames:
         by_robot.setdefault(f["robot"], []).append(f)
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), gridspec_kw={"width_ratios": [1.3, 1, 1]})
     ax = axes[0]
+    field_lines(ax, run)
     for rid, fr in sorted(by_robot.items()):
         gx, gy = [], []
         for f in fr:  # a break where the truth jumps (teleport / kidnap), not a line across the field
@@ -186,34 +423,44 @@ def plot_run(rep, run, summary, frames, events):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title("trajectory")
-    ax.legend(fontsize=7)
-    ax = axes[1]
-    for rid, fr in sorted(by_robot.items()):
-        t = [float(f["t"]) for f in fr if f["valid"] == "1"]
-        e = [max(1e-4, float(f["err_pos"])) for f in fr if f["valid"] == "1"]
-        ax.semilogy(t, e, lw=0.8, label=f"position error r{rid}")
-    for e in events:
-        c = EVENT_COLOURS.get(e.get("type"))
-        if c:
-            ax.axvline(e["t"], color=c, lw=0.8, alpha=0.7)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("position error (m)")
+    ax.set_title("trajectory on the field", fontsize=10)
+    ax.legend(fontsize=7, loc="upper right")
     kinds = sorted({e["type"] for e in events if e.get("type") in EVENT_COLOURS})
-    ax.set_title("error over time" + (" (lines: " + ", ".join(f"{k} {EVENT_COLOURS[k]}" for k in kinds) + ")" if kinds else ""), fontsize=9)
-    rep.figure(fig, "run", f"{name}: trajectory and error over time")
+    for k, (col, label, unit, scale) in enumerate([("err_pos", "position error", "cm", 100.0), ("err_theta", "heading error", "deg", 180.0 / math.pi)]):
+        ax = axes[1 + k]
+        for rid, fr in sorted(by_robot.items()):
+            v = [f for f in fr if f["valid"] == "1"]
+            ax.plot([float(f["t"]) for f in v], [abs(float(f[col])) * scale for f in v], lw=0.8, label=f"r{rid}")
+        for e in events:
+            c = EVENT_COLOURS.get(e.get("type"))
+            if c:
+                ax.axvline(e["t"], color=c, lw=0.8, alpha=0.7)
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel(f"{label} ({unit})")
+        ax.grid(alpha=0.3)
+        ax.set_title(label + (" (lines: " + ", ".join(f"{k} {EVENT_COLOURS[k]}" for k in kinds) + ")" if kinds else ""), fontsize=9)
+    rep.figure(fig, "run", f"{title}: trajectory over the field, position and heading error over time")
 
 
-def report_run(rep, run, papers, plots):
-    s = json.loads((run / "summary.json").read_text())
-    rep.heading(f"Run {s['scenario']} / {s['localizer']} / seed {s['seed']}", 3)
+def run_title(run, params=None):
+    s = run.summary
+    parts = [s["scenario"], s["localizer"]] + ([params] if params and params != "default" else []) + [f"seed {s['seed']}"]
+    return " / ".join(str(p) for p in parts)
+
+
+def report_run(rep, run, plots, params=None):
+    s = run.summary
+    title = run_title(run, params)
+    rep.heading(f"Run {title}", 3)
     rows = []
     for r in s.get("robots", []):
-        rows.append([f"r{r['robot']}"] + summary_row(r) + [r.get("frames", "-")])
-    key = SCENARIO_TABLES.get(s["scenario"])
-    if key:
-        rows += [p + ["-"] for p in paper_rows(papers, key[0], [key[1]])]
-    rep.table(["robot"] + PAPER_COLS + ["frames"], rows, f"noise profile {s.get('noise_profile')}, {s.get('duration_s')} s at {s.get('camera_rate_hz')} Hz")
+        rows.append([f"r{r['robot']}" + (" all frames" if "tracking_phase" in r else "")] + [fnum(r[a][st], 3) for a, st in R.TABLE_KEYS] + [r.get("frames", "-")])
+        if "tracking_phase" in r:
+            tp = r["tracking_phase"]
+            rows.append([f"r{r['robot']} tracking phase"] + [fnum(tp[a][st], 3) for a, st in R.TABLE_KEYS] + [tp.get("frames", "-")])
+    rep.table(["robot"] + R.TABLE_COLS + ["frames"], rows,
+              f"noise profile {s.get('noise_profile')}, {s.get('duration_s')} s at {s.get('camera_rate_hz')} Hz; omniloc {(s.get('omniloc') or {}).get('version', 'unrecorded')}")
     for r in s.get("robots", []):
         rec = r.get("recovery")
         if rec:
@@ -223,75 +470,96 @@ def report_run(rep, run, papers, plots):
                         fnum(rt.get("max"), 2), fnum(rec["after_recovery"]["x_cm"]["mean"], 2), fnum(rec["after_recovery"]["y_cm"]["mean"], 2)]],
                       "kidnap recovery (error under 0.3 m and 0.2 rad for 1 s)")
     if plots:
-        plot_run(rep, run, s, load_frames(run), load_events(run))
-    return s
+        plot_run(rep, run, title)
 
 
-def report_sweep(rep, sweep, papers):
+def sweep_runs(sweep, all_runs):
+    """The sweep's runs in the aggregate's order (group by group, seeds in run order), with their params."""
+    by_folder = {r.folder: r for r in all_runs}
+    order = {}
+    for row in R.read_csv(sweep / "runs.csv"):
+        order[row["id"]] = (int(row["index"]), row["params"])
     agg = json.loads((sweep / "aggregate.json").read_text())
-    name = agg.get("name", sweep.name)
+    group_rank = {(g.get("scenario"), g.get("localizer"), g.get("params")): k for k, g in enumerate(agg["groups"])}
+    out = []
+    for folder, run in by_folder.items():
+        if folder.parent != sweep / "runs":
+            continue
+        idx, params = order.get(folder.name, (10 ** 9, "default"))
+        rank = group_rank.get((run.scenario, folder.name.split("__")[1] if "__" in folder.name else run.localizer, params), 10 ** 9)
+        out.append((rank, idx, run, params))
+    return [(r, p) for _, _, r, p in sorted(out, key=lambda x: (x[0], x[1]))]
+
+
+def report_sweep(rep, sweep, all_runs, max_runs):
+    agg = json.loads((sweep / "aggregate.json").read_text())
+    name = agg.get("sweep", agg.get("name", sweep.name))
     rep.heading(f"Sweep {name}", 2)
+    o = agg.get("omniloc") or {}
+    rep.para(f"{sweep}: {agg.get('runs')} runs; aggregated by omniloc {o.get('version', 'unrecorded')}; runs made by "
+             + ", ".join(f"{v} ({n})" for v, n in (agg.get("run_versions") or {}).items()) + ".")
     rows = []
     for g in agg["groups"]:
         m = g["metrics"]
-        label = f"{g.get('scenario', '')} / {g.get('localizer', '')} / {g.get('params', '')}"
-        rows.append([label] + [fnum(m.get(f"r0/{a}/{s}", {}).get("mean"), 3) for a, s in PAPER_KEYS] +
-                    [f"{g.get('finished', '-')}/{g.get('failed', 0)}"])
-    key = SWEEP_TABLES.get(name)
-    if key:
-        rows += [p + ["-"] for p in paper_rows(papers, key[0], key[1])]
-    rep.table(["group"] + PAPER_COLS + ["runs ok/failed"], rows, "mean over seeds of each run's statistics (robot 0); papers' rows in italics")
-    # Recovery and position RMSE with 95 % intervals, where present.
-    rrows = []
-    for g in agg["groups"]:
-        m = g["metrics"]
-        if "r0/recovery/episodes" in m:
-            def tot(k):
-                v = m.get(k)
-                return v["mean"] * v["n"] if v else float("nan")
-            rrows.append([f"{g.get('scenario')} / {g.get('localizer')}", f"{tot('r0/recovery/episodes'):.0f}", f"{tot('r0/recovery/recovered'):.0f}",
-                          f"{tot('r0/recovery/false_recoveries'):.0f}", f"{tot('r0/recovery/mirrored'):.0f}",
-                          fnum(m.get("r0/recovery/recovery_time_s/median", {}).get("mean"), 2)])
-    if rrows:
-        rep.table(["group", "kidnaps", "recovered", "false", "mirrored", "mean of run medians s"], rrows, "kidnap recovery over all runs")
+        phase = "r0/tracking_phase/x_cm/mean" in m
+        val = lambda a, s: m.get(f"r0/tracking_phase/{a}/{s}" if phase else f"r0/{a}/{s}", {}).get("mean")
+        n = m.get("r0/x_cm/mean", {}).get("n", 0)
+        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')} / {g.get('params', '')}" + (" (tracking phase)" if phase else "")] +
+                    [fnum(val(a, s), 3) for a, s in R.TABLE_KEYS] + [f"{g.get('finished', '-')}/{g.get('failed', 0)}", n])
+    rep.table(["group"] + R.TABLE_COLS + ["runs ok/failed", "n"], rows,
+              "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'.")
     ci = []
     for g in agg["groups"]:
         v = g["metrics"].get("r0/position_m/rmse")
-        if v:
+        if v and v["n"] >= 2:
             ci.append([f"{g.get('scenario')} / {g.get('localizer')} / {g.get('params')}", fnum(v["mean"], 4), f"[{fnum(v['ci95'][0], 4)}, {fnum(v['ci95'][1], 4)}]", v["n"]])
     if ci:
-        rep.table(["group", "position RMSE m", "95 % interval", "seeds"], ci)
-    runs = sorted(p.parent for p in (sweep / "runs").glob("*/summary.json")) if (sweep / "runs").exists() else []
-    return runs
+        rep.table(["group", "position RMSE m (all frames)", "95 % interval", "n"], ci, "intervals only where n >= 2")
+    runs = sweep_runs(sweep, all_runs)
+    for k, (run, params) in enumerate(runs):
+        report_run(rep, run, plots=k < max_runs, params=params)
+    return [r for r, _ in runs]
+
+
+def tracking_errors(run):
+    """Position errors (m) of the valid frames of the tracking phase (outside the excluded intervals)."""
+    excl = {}
+    for r in run.summary.get("robots", []):
+        excl[str(r.get("robot"))] = (r.get("tracking_phase") or {}).get("excluded", [])
+    out = []
+    for f in run.frames():
+        if f["valid"] != "1":
+            continue
+        t = float(f["t"])
+        if any(a - 1e-9 <= t < b - 1e-9 for a, b in excl.get(f["robot"], [])):
+            continue
+        out.append(float(f["err_pos"]))
+    return out
 
 
 def cdf_and_timing(rep, runs):
     errs, timing = {}, {}
     for run in runs:
-        s = json.loads((run / "summary.json").read_text())
-        loc = s["localizer"]
-        for f in load_frames(run):
-            if f["valid"] == "1":
-                errs.setdefault(loc, []).append(float(f["err_pos"]))
-        t = run / "timing.csv"
-        if t.exists():
-            with t.open() as fh:
-                for r in csv.DictReader(fh):
-                    d = timing.setdefault(loc, {"render_ms": [], "vision_ms": [], "localize_ms": []})
-                    for k in d:
-                        d[k].append(float(r[k]))
+        loc = run.localizer
+        errs.setdefault(loc, []).extend(tracking_errors(run))
+        for r in run.timing():
+            d = timing.setdefault(loc, {"render_ms": [], "vision_ms": [], "localize_ms": []})
+            for k in d:
+                d[k].append(float(r[k]))
+    errs = {k: v for k, v in errs.items() if v}
     if errs:
-        rep.heading("Error CDF per localizer", 2)
+        rep.heading("Error CDF per localizer (tracking phase)", 2)
         fig, ax = plt.subplots(figsize=(7, 4))
         for loc, e in sorted(errs.items()):
-            e = sorted(e)
+            e = sorted(max(x, 1e-4) for x in e)
             ax.plot(e, [(i + 1) / len(e) for i in range(len(e))], label=f"{loc} ({len(e)} frames)")
         ax.set_xscale("log")
-        ax.set_xlabel("position error (m)")
+        ax.set_ylim(0, 1)
+        ax.set_xlabel("position error (m, log scale)")
         ax.set_ylabel("fraction of valid frames")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-        rep.figure(fig, "cdf", "position error CDF over all reported runs, per localizer")
+        rep.figure(fig, "cdf", "position error CDF over the reported runs' tracking phases (carried periods and recoveries left out), per localizer")
         rep.table(["localizer", "frames", "median m", "p90 m", "p99 m"],
                   [[loc, len(e), fnum(statistics.median(e), 4), fnum(sorted(e)[int(0.9 * (len(e) - 1))], 4), fnum(sorted(e)[int(0.99 * (len(e) - 1))], 4)]
                    for loc, e in sorted(errs.items())])
@@ -309,17 +577,22 @@ def cdf_and_timing(rep, runs):
             vals = [statistics.median(timing[l][k]) if timing[l][k] else 0 for l in locs]
             ax.bar(locs, vals, bottom=bottom, label=k.replace("_ms", ""))
             bottom = [b + v for b, v in zip(bottom, vals)]
+        ax.set_ylim(bottom=0)
         ax.set_ylabel("ms per frame (median)")
         ax.legend(fontsize=8)
         rep.figure(fig, "timing", "median time per frame and stage")
 
 
+def picture_order(p):
+    # Before / after pairs in that order (alphabetically "after" would come first).
+    return str(p).replace("_before", "_0before").replace("_after", "_1after")
+
+
 def report_experiment(rep, exp):
     rep.heading(f"Experiment {exp.name}", 2)
     for md in sorted(exp.glob("*.md")):
-        rep.md += [md.read_text(), ""]
-        rep.html.append("<pre>" + html.escape(md.read_text()) + "</pre>")
-    for png in sorted(exp.glob("*.png")):
+        rep.markdown(md.read_text())
+    for png in sorted(exp.glob("*.png"), key=picture_order):
         rep.image(png, f"{exp.name}: {png.stem}")
 
 
@@ -329,26 +602,36 @@ def main():
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--title", default="omniloc report")
     ap.add_argument("--max-runs", type=int, default=12, help="trajectory plots for at most this many runs per sweep (default 12)")
+    ap.add_argument("--baseline", nargs="+", help="result folders to compare with (e.g. another commit's), per metric with Welch's t")
     a = ap.parse_args()
-    papers = json.loads((ROOT / "results/reference/papers.json").read_text())
-    runs, sweeps, experiments = find(a.results)
+    papers = R.load_papers()
+    runs, sweeps, experiments = R.discover(a.results)
     if not (runs or sweeps or experiments):
         sys.exit("report.py: no results (summary.json, aggregate.json or experiment pictures) under " + " ".join(a.results))
     rep = Report(a.out, a.title)
     rep.para(f"{len(sweeps)} sweep(s), {len(runs)} run(s), {len(experiments)} experiment(s). Published numbers: results/reference/papers.json; "
-             f"everything else is read from the result files. Machine: {platform.node()}, {os.cpu_count()} cores, {platform.platform()}.")
-    all_runs = []
+             f"everything else is read from the result files.")
+    provenance(rep, runs, sweeps)
+    ctx = C.Context(papers, runs, experiments)
+    scorecard(rep, ctx)
+    published_tables(rep, papers, ctx)
+    if a.baseline:
+        import compare
+        base_runs, _, _ = R.discover(a.baseline)
+        rep.heading("Comparison with the baseline", 2, "baseline")
+        header, rows = compare.compare_rows(base_runs, runs)
+        rep.table(header, rows, f"baseline: {' '.join(a.baseline)}; this report's results as 'new'. "
+                  + compare.EXPLANATION)
+    in_sweeps = set()
     for sw in sweeps:
-        sub = report_sweep(rep, sw, papers)
-        all_runs += sub
-        for k, run in enumerate(sub):
-            report_run(rep, run, papers, plots=k < a.max_runs)
-    if runs:
+        for r in report_sweep(rep, sw, runs, a.max_runs):
+            in_sweeps.add(r.folder)
+    loose = [r for r in runs if r.folder not in in_sweeps]
+    if loose:
         rep.heading("Runs", 2)
-        for run in runs:
-            report_run(rep, run, papers, plots=True)
-        all_runs += runs
-    cdf_and_timing(rep, all_runs)
+        for run in loose:
+            report_run(rep, run, plots=True)
+    cdf_and_timing(rep, runs)
     for exp in experiments:
         report_experiment(rep, exp)
     rep.write()

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "core/error.hpp"
 #include "core/json_reader.hpp"
@@ -43,4 +44,19 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
     ++n;
   }
   EXPECT_GE(n, 4);
+}
+
+// The default main job runs scenarios/sweeps/paper_suite.json: every paper scenario must be in it,
+// and every published row's variant (occlusion fractions, auto-adjust off, other localizers) with it.
+TEST(ShippedFiles, PaperSuiteRunsEveryPaperScenario) {
+  const auto spec = omniloc::harness::load_sweep(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/sweeps/paper_suite.json");
+  std::set<std::string> in_suite;
+  for (const auto& r : spec.runs) in_suite.insert(r.scenario_name);
+  for (const auto& e : fs::directory_iterator(fs::path(OMNILOC_SOURCE_DIR) / "scenarios" / "paper")) {
+    if (e.path().extension() != ".json") continue;
+    EXPECT_TRUE(in_suite.count(e.path().stem().string())) << e.path() << " is not in the paper suite";
+  }
+  std::set<std::string> seeds;
+  for (const auto& r : spec.runs) seeds.insert(std::to_string(r.seed));
+  EXPECT_GE(seeds.size(), 3u) << "intervals need at least two seeds; the suite promises three";
 }

@@ -1,0 +1,311 @@
+"""Reading omniloc result folders and pairing them with the papers' published rows BY KEY.
+
+Used by report.py, paper_table.py and compare.py (one implementation of loading, pairing and
+statistics). A published row in results/reference/papers.json names the runs that reproduce it:
+
+    "reproduced_by": {"rows": {"12.5 %": {"scenario": "tracking", "localizer": "matching",
+                                          "config": {"/occlusion/fraction": 0.125}}, ...},
+                      "config_defaults": {"/occlusion/fraction": 0.0}, "command": "..."}
+
+A run matches a key when its summary's scenario and localizer are the key's and every JSON pointer
+of "config" has that value in the run's effective configuration (config.json); a pointer absent
+from the configuration takes its value from "config_defaults" (absent and no default: no match).
+"scenario" may be a list of names: the first name that has matching runs is taken (the same
+condition may be run under two names, e.g. the 50 % row as occlusion_002 or as tracking with a
+swept occlusion; taking one avoids counting a seed twice). Where a run comes from (which sweep, its
+position in it) never matters.
+
+Statistics: mean over runs (seeds), Student-t 95 % interval only where n >= 2; Welch's t-test for
+two result sets. No SciPy: Debian's python3 and python3-matplotlib are the only dependencies.
+"""
+import csv
+import json
+import math
+import os
+import pathlib
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+PAPERS = ROOT / "results" / "reference" / "papers.json"
+
+# The papers' error-table layout: (summary field, statistic), in the published column order.
+TABLE_KEYS = [("x_cm", "mean"), ("y_cm", "mean"), ("theta_rad", "mean"), ("x_cm", "std"), ("y_cm", "std"), ("theta_rad", "std"),
+              ("x_cm", "max"), ("y_cm", "max"), ("theta_rad", "max")]
+TABLE_COLS = ["mean x cm", "mean y cm", "mean th rad", "std x cm", "std y cm", "std th rad", "max x cm", "max y cm", "max th rad"]
+
+
+def load_papers():
+    return json.loads(PAPERS.read_text())
+
+
+def _skip_dir(d):
+    return d.name.startswith(".") or ".staging" in d.name or d.name.endswith(".tmp") or ".partial" in d.name
+
+
+def discover(paths):
+    """(runs, sweeps, experiments) under the given folders: run folders (summary.json, including those
+    inside sweeps), sweep folders (aggregate.json) and experiment folders (PNG / JSON pictures)."""
+    runs, sweeps, experiments = [], [], []
+    stale = set()
+    for p in paths:
+        p = pathlib.Path(p)
+        if not p.is_dir():
+            raise SystemExit(f"{p}: not a folder")
+        for d, subdirs, files in os.walk(p):
+            d = pathlib.Path(d)
+            if _skip_dir(d):
+                subdirs[:] = []
+                continue
+            subdirs.sort()
+            if "aggregate.json" in files:
+                sweeps.append(d)
+                # Only the runs this sweep lists: a folder reused with another spec keeps old runs.
+                listed = {row["id"] for row in read_csv(d / "runs.csv")}
+                if listed and (d / "runs").is_dir():
+                    stale.update(str(x) for x in (d / "runs").iterdir() if x.name not in listed)
+            if str(d) in stale:
+                subdirs[:] = []
+                continue
+            if "summary.json" in files:
+                runs.append(d)
+                subdirs[:] = []
+            elif "aggregate.json" not in files and d.name != "img" and (any(f.endswith(".png") for f in files) or d.name + ".json" in files):
+                experiments.append(d)  # an experiment's folder: its pictures, or its JSON named after it
+    uniq = lambda xs: sorted(set(xs))
+    return [Run(r) for r in uniq(runs)], uniq(sweeps), uniq(experiments)
+
+
+class Run:
+    """One run folder: summary.json (+ config.json, frames.csv, timing.csv on demand)."""
+
+    def __init__(self, folder):
+        self.folder = pathlib.Path(folder)
+        self.summary = json.loads((self.folder / "summary.json").read_text())
+        self._config = None
+
+    scenario = property(lambda self: self.summary.get("scenario"))
+    localizer = property(lambda self: self.summary.get("localizer"))
+    seed = property(lambda self: self.summary.get("seed"))
+    version = property(lambda self: (self.summary.get("omniloc") or {}).get("version", "unrecorded"))
+
+    @property
+    def config(self):
+        if self._config is None:
+            f = self.folder / "config.json"
+            self._config = json.loads(f.read_text()) if f.exists() else {}
+        return self._config
+
+    def robot(self, index=0):
+        robots = self.summary.get("robots") or []
+        return robots[index] if index < len(robots) else None
+
+    def metric(self, path, phase="tracking", robot=0):
+        """A number of robot `robot`'s summary, e.g. "x_cm/mean" or "recovery/recovered". With
+        phase "tracking" it is read from the tracking-phase block where the run has one (kidnaps,
+        covers) and the block has it; otherwise from the all-frames figures. None when absent."""
+        r = self.robot(robot)
+        if r is None:
+            return None
+        if phase == "tracking" and "tracking_phase" in r:
+            v = dig(r["tracking_phase"], path)
+            if v is not None:
+                return v
+        return dig(r, path)
+
+    def frames(self):
+        return read_csv(self.folder / "frames.csv")
+
+    def timing(self):
+        return read_csv(self.folder / "timing.csv")
+
+
+def read_csv(path):
+    path = pathlib.Path(path)
+    if not path.exists():
+        return []
+    with path.open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def dig(obj, path):
+    """obj["a"]["b"] for path "a/b" (numbers only); None when absent."""
+    for part in path.strip("/").split("/"):
+        if isinstance(obj, dict) and part in obj:
+            obj = obj[part]
+        elif isinstance(obj, list) and part.isdigit() and int(part) < len(obj):
+            obj = obj[int(part)]
+        else:
+            return None
+    return obj if isinstance(obj, (int, float)) and not isinstance(obj, bool) else (obj if isinstance(obj, (dict, list, str, bool)) else None)
+
+
+def pointer(obj, ptr):
+    """(found, value) of a JSON pointer (RFC 6901) in obj."""
+    if ptr in ("", "/"):
+        return True, obj
+    for raw in ptr[1:].split("/"):
+        part = raw.replace("~1", "/").replace("~0", "~")
+        if isinstance(obj, dict) and part in obj:
+            obj = obj[part]
+        elif isinstance(obj, list) and part.isdigit() and int(part) < len(obj):
+            obj = obj[int(part)]
+        else:
+            return False, None
+    return True, obj
+
+
+def same_value(a, b):
+    if isinstance(a, bool) or isinstance(b, bool):
+        return a is b or a == b and type(a) is type(b)
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return abs(a - b) <= 1e-9 * max(1.0, abs(a), abs(b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_value(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b))
+    return a == b
+
+
+def key_matches(run, key, defaults=None, scenario=None):
+    defaults = defaults or {}
+    if run.scenario != (scenario or key.get("scenario")):
+        return False
+    if "localizer" in key and run.localizer != key["localizer"]:
+        return False
+    for ptr, want in (key.get("config") or {}).items():
+        found, have = pointer(run.config, ptr)
+        if not found:
+            if ptr not in defaults:
+                return False
+            have = defaults[ptr]
+        if not same_value(have, want):
+            return False
+    return True
+
+
+def select(runs, key, defaults=None):
+    """The runs that reproduce one published row (see the module's docstring), sorted by seed."""
+    names = key["scenario"] if isinstance(key["scenario"], list) else [key["scenario"]]
+    for name in names:
+        hit = [r for r in runs if key_matches(r, key, defaults, scenario=name)]
+        if hit:
+            # One run per seed: the same run reported from two folders (a sweep and a copy) counts once.
+            by_seed = {}
+            for r in sorted(hit, key=lambda r: str(r.folder)):
+                by_seed.setdefault(r.seed, r)
+            return [by_seed[s] for s in sorted(by_seed)]
+    return []
+
+
+def describe_key(key):
+    names = key["scenario"] if isinstance(key["scenario"], list) else [key["scenario"]]
+    parts = [" or ".join(names)]
+    if "localizer" in key:
+        parts.append(key["localizer"])
+    parts += [f"{p}={json.dumps(v)}" for p, v in (key.get("config") or {}).items()]
+    return " / ".join(parts)
+
+
+# ---- statistics -----------------------------------------------------------------------------
+
+def stats(values):
+    """{"n", "mean", "sd", "lo", "hi"}: lo / hi is the Student-t 95 % interval, None where n < 2."""
+    v = [x for x in values if x is not None and not (isinstance(x, float) and math.isnan(x))]
+    n = len(v)
+    if n == 0:
+        return {"n": 0, "mean": None, "sd": None, "lo": None, "hi": None}
+    m = sum(v) / n
+    if n < 2:
+        return {"n": 1, "mean": m, "sd": None, "lo": None, "hi": None}
+    sd = math.sqrt(sum((x - m) ** 2 for x in v) / (n - 1))
+    half = t_quantile_975(n - 1) * sd / math.sqrt(n)
+    return {"n": n, "mean": m, "sd": sd, "lo": m - half, "hi": m + half}
+
+
+def _betacf(a, b, x):
+    # Continued fraction of the incomplete beta function (modified Lentz), as in Numerical Recipes' derivation.
+    tiny, qab, qap, qam = 1e-300, a + b, a + 1.0, a - 1.0
+    c, d = 1.0, 1.0 - qab * x / qap
+    d = 1.0 / (d if abs(d) > tiny else tiny)
+    h = d
+    for m in range(1, 300):
+        m2 = 2 * m
+        aa = m * (b - m) * x / ((qam + m2) * (a + m2))
+        d = 1.0 + aa * d
+        d = 1.0 / (d if abs(d) > tiny else tiny)
+        c = 1.0 + aa / c
+        c = c if abs(c) > tiny else tiny
+        h *= d * c
+        aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2))
+        d = 1.0 + aa * d
+        d = 1.0 / (d if abs(d) > tiny else tiny)
+        c = 1.0 + aa / c
+        c = c if abs(c) > tiny else tiny
+        de = d * c
+        h *= de
+        if abs(de - 1.0) < 1e-14:
+            break
+    return h
+
+
+def betainc(a, b, x):
+    """Regularised incomplete beta I_x(a, b)."""
+    if x <= 0:
+        return 0.0
+    if x >= 1:
+        return 1.0
+    lbt = math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log(1 - x)
+    if x < (a + 1) / (a + b + 2):
+        return math.exp(lbt) * _betacf(a, b, x) / a
+    return 1.0 - math.exp(lbt) * _betacf(b, a, 1 - x) / b
+
+
+def t_two_sided_p(t, df):
+    """P(|T| >= |t|) for Student's t with df degrees of freedom (df may be fractional: Welch)."""
+    if df <= 0 or math.isnan(t):
+        return float("nan")
+    return betainc(df / 2.0, 0.5, df / (df + t * t))
+
+
+def t_quantile_975(df):
+    """The 0.975 quantile of Student's t by bisection on t_two_sided_p (exact enough for intervals)."""
+    lo, hi = 0.0, 1000.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if t_two_sided_p(mid, df) > 0.05:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def welch(a, b):
+    """Welch's unequal-variance t-test of mean(b) - mean(a): {"diff", "t", "df", "p"}; t, df and p are
+    None when either side has fewer than two values (no seed-to-seed spread to compare with)."""
+    sa, sb = stats(a), stats(b)
+    out = {"diff": None if sa["mean"] is None or sb["mean"] is None else sb["mean"] - sa["mean"], "t": None, "df": None, "p": None}
+    if sa["n"] < 2 or sb["n"] < 2:
+        return out
+    va, vb = sa["sd"] ** 2 / sa["n"], sb["sd"] ** 2 / sb["n"]
+    if va + vb == 0:
+        # No spread on either side (deterministic metric): any difference is exact.
+        out.update(t=math.inf if out["diff"] else 0.0, df=float(sa["n"] + sb["n"] - 2), p=0.0 if out["diff"] else 1.0)
+        return out
+    t = out["diff"] / math.sqrt(va + vb)
+    df = (va + vb) ** 2 / (va ** 2 / (sa["n"] - 1) + vb ** 2 / (sb["n"] - 1))
+    out.update(t=t, df=df, p=t_two_sided_p(t, df))
+    return out
+
+
+def fnum(v, digits=3):
+    if v is None or (isinstance(v, float) and (math.isnan(v) or math.isinf(v))):
+        return "-"
+    return f"{v:.{digits}f}"
+
+
+def fstat(s, digits=3):
+    """'mean [lo, hi] (n=3)', or 'mean (n=1)' without an interval."""
+    if s["n"] == 0:
+        return "-"
+    if s["lo"] is None:
+        return f"{fnum(s['mean'], digits)} (n=1)"
+    return f"{fnum(s['mean'], digits)} [{fnum(s['lo'], digits)}, {fnum(s['hi'], digits)}] (n={s['n']})"

@@ -1,0 +1,187 @@
+"""The papers' published tables and claims, evaluated against our results by key.
+
+- pair_table(): a published error table's rows beside the runs that reproduce them (by key).
+- timing_ms(): our median time per cycle / frame for a "timings_ms" row.
+- evaluate_claims(): the reproduction scorecard: for each claim in papers.json, our figure, the
+  paper's, the ratio, and the verdict (holds / partly / does not / not run) computed by the rule
+  written next to the claim in papers.json. The rules are data: "range" (the value, or for
+  "ratio_to_published" ours / paper, lies in "holds" or "partly"), and "checks" (every check
+  holds: holds; some: partly; none: does not).
+"""
+import json
+import math
+import pathlib
+import statistics
+
+import omniloc_results as R
+
+
+def row_key(papers, table, label):
+    """(key, defaults, command) of one published or extra row of a table."""
+    rb = papers[table]["reproduced_by"]
+    key = (rb.get("rows") or {}).get(label) or (rb.get("extra_rows") or {}).get(label)
+    if key is None:
+        raise KeyError(f"{table} has no row \"{label}\" (rows: {', '.join(list(rb.get('rows', {})) + list(rb.get('extra_rows', {})))})")
+    return key, rb.get("config_defaults", {}), rb.get("command", "")
+
+
+def row_stats(runs, key, defaults, metrics, phase="tracking"):
+    """Per metric path: stats over the matched runs (one value per run = seed)."""
+    sel = R.select(runs, key, defaults)
+    out = {}
+    for m in metrics:
+        out[m] = R.stats([r.metric(m, phase) for r in sel])
+    return sel, out
+
+
+def pair_table(papers, table, runs, labels=None, include_extra=True):
+    """Rows of a 9-column error table: [{"label", "published" (list or None), "runs", "stats" (per
+    column), "key", "command"}], published rows first in the paper's order, then our extra rows."""
+    t = papers[table]
+    rb = t["reproduced_by"]
+    metrics = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
+    wanted = list(rb["rows"]) + (list(rb.get("extra_rows", {})) if include_extra else [])
+    if labels:
+        unknown = [l for l in labels if l not in wanted]
+        if unknown:
+            raise KeyError(f"{table} has no row {', '.join(repr(u) for u in unknown)}; its rows: {', '.join(repr(w) for w in wanted)}")
+        wanted = [w for w in wanted if w in labels]
+    rows = []
+    for label in wanted:
+        key, defaults, command = row_key(papers, table, label)
+        sel, st = row_stats(runs, key, defaults, metrics + ["line_points/mean", "frames"])
+        rows.append({"label": label, "published": t["rows"].get(label) if label in rb["rows"] else None, "runs": sel, "stats": st,
+                     "key": key, "command": command, "phased": any("tracking_phase" in (r.robot() or {}) for r in sel)})
+    return rows
+
+
+def timing_ms(papers, row, runs):
+    """Median ms per cycle over the matched runs' timing.csv (stages summed per frame), filtered by
+    the localizer's mode in frames.csv ("modes": only these; "modes_not": all but these). Returns
+    (median or None, frames, runs)."""
+    key = papers["timings_ms"]["reproduced_by"]["rows"][row]
+    sel = R.select(runs, key)
+    vals = []
+    for r in sel:
+        timing, frames = r.timing(), r.frames()
+        for k, t in enumerate(timing):
+            mode = frames[k]["mode"] if k < len(frames) else ""
+            if "modes" in key and mode not in key["modes"]:
+                continue
+            if "modes_not" in key and mode in key["modes_not"]:
+                continue
+            vals.append(sum(float(t[s]) for s in key["stages"]))
+    return (statistics.median(vals) if vals else None), len(vals), sel
+
+
+class Context:
+    def __init__(self, papers, runs, experiments):
+        self.papers, self.runs = papers, runs
+        self.experiments = {}
+        for e in experiments:  # by name; the last one given wins (they are sorted)
+            self.experiments[pathlib.Path(e).name] = pathlib.Path(e)
+        self._json = {}
+
+    def experiment_json(self, name, file):
+        k = (name, file)
+        if k not in self._json:
+            d = self.experiments.get(name)
+            f = d / file if d else None
+            self._json[k] = json.loads(f.read_text()) if f and f.exists() else None
+        return self._json[k]
+
+
+def quantity(q, ctx):
+    """(value or None, note) of a quantity selector of papers.json's claims."""
+    if q is None:
+        return None, "not reproducible here"
+    if "ratio" in q or "fraction" in q:
+        a, na = quantity((q.get("ratio") or q.get("fraction"))[0], ctx)
+        b, nb = quantity((q.get("ratio") or q.get("fraction"))[1], ctx)
+        if a is None or b is None:
+            return None, na if a is None else nb
+        if b == 0:
+            return (math.inf if a > 0 else None), f"{R.fnum(a)} / 0"
+        return a / b, f"{R.fnum(a)} / {R.fnum(b)}" + (f" ({na})" if na == nb and na else "")
+    if "row" in q:
+        try:
+            key, defaults, command = row_key(ctx.papers, *q["row"])
+        except KeyError as e:
+            return None, str(e)
+        sel = R.select(ctx.runs, key, defaults)
+        if not sel:
+            return None, f"not run: {command}"
+        metrics = q["metric"] if isinstance(q["metric"], list) else [q["metric"]]
+        per_run = []
+        for r in sel:
+            vals = [r.metric(m, q.get("phase", "tracking")) for m in metrics]
+            per_run.append(None if any(v is None for v in vals) else sum(vals))
+        per_run = [v for v in per_run if v is not None]
+        if not per_run:
+            return None, f"{'+'.join(metrics)} absent in {len(sel)} run(s)"
+        if q.get("sum"):
+            return sum(per_run), f"n={len(per_run)}"
+        return sum(per_run) / len(per_run), f"n={len(per_run)}"
+    if "experiment" in q:
+        j = ctx.experiment_json(q["experiment"], q["file"])
+        if j is None:
+            return None, f"not run: build/omniloc experiment {q['experiment']}"
+        found, v = R.pointer(j, q["pointer"])
+        if not found or not isinstance(v, (int, float)) or isinstance(v, bool):
+            return None, f"{q['file']}{q['pointer']} absent"
+        return float(v), q["experiment"]
+    if "timing" in q:
+        med, frames, sel = timing_ms(ctx.papers, q["timing"][1], ctx.runs)
+        if not sel:
+            return None, f"not run: {ctx.papers['timings_ms']['reproduced_by']['command']}"
+        return med, f"median of {frames} frames, {len(sel)} run(s)"
+    raise ValueError(f"unknown quantity {q}")
+
+
+def judge(value, rule, published=None):
+    if rule is None:
+        return "n/a"
+    if value is None:
+        return "not run"
+    v = value / published if rule["kind"] == "ratio_to_published" else value
+    inside = lambda iv: iv is not None and iv[0] - 1e-12 <= v <= iv[1] + 1e-12
+    if inside(rule.get("holds")):
+        return "holds"
+    if inside(rule.get("partly")):
+        return "partly"
+    return "does not"
+
+
+def evaluate_claims(ctx):
+    """One dict per claim: id, paper, claim, ours (number or None), ours_text, published, ratio,
+    verdict, rule_text, checks (for claims made of several checks)."""
+    out = []
+    for c in ctx.papers.get("claims", []):
+        row = {"id": c["id"], "paper": c["paper"], "claim": c["claim"], "published": c.get("published"), "unit": c.get("unit", ""),
+               "rule_text": c.get("rule_text", ""), "checks": [], "ratio": None}
+        if "checks" in c:
+            verdicts = []
+            for ch in c["checks"]:
+                v, note = quantity(ch["ours"], ctx)
+                verdict = judge(v, ch["rule"])
+                verdicts.append(verdict)
+                row["checks"].append({"label": ch["label"], "ours": v, "note": note, "verdict": verdict})
+            if any(v == "not run" for v in verdicts):
+                row["verdict"] = "not run"
+            elif all(v == "holds" for v in verdicts):
+                row["verdict"] = "holds"
+            elif any(v in ("holds", "partly") for v in verdicts):
+                row["verdict"] = "partly"
+            else:
+                row["verdict"] = "does not"
+            row["ours"] = None
+            row["ours_text"] = "; ".join(f"{ch['label']}: {R.fnum(ch['ours'], 2)} ({ch['verdict']})" for ch in row["checks"])
+        else:
+            v, note = quantity(c.get("ours"), ctx)
+            row["ours"] = v
+            row["ours_text"] = (R.fnum(v, 3) + (f" {row['unit']}" if row["unit"] not in ("x", "") else "") + (f" ({note})" if note else "")) if v is not None else note
+            if isinstance(c.get("published"), (int, float)) and v is not None and c["published"]:
+                row["ratio"] = v / c["published"]
+            row["verdict"] = judge(v, c.get("rule"), c.get("published") if isinstance(c.get("published"), (int, float)) else None)
+        out.append(row)
+    return out

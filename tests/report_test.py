@@ -1,0 +1,266 @@
+"""Tests of the comparison side (scripts/omniloc_results.py, paper_claims.py, compare.py, report.py,
+paper_table.py): pairing by key under a shuffled sweep, valid CSV of real sweep specs, the phase
+split used by the tables, `compare` on result sets that differ by a known amount, and the
+statistics. Run by ctest (tests/CMakeLists.txt) with OMNILOC_BIN = the built omniloc."""
+import csv
+import io
+import json
+import os
+import pathlib
+import random
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+import compare  # noqa: E402
+import omniloc_results as R  # noqa: E402
+import paper_claims as C  # noqa: E402
+
+PY = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+OMNILOC = os.environ.get("OMNILOC_BIN", str(ROOT / "build" / "omniloc"))
+
+
+def robot(x_mean, y_mean=1.0, th=0.01, extra=None):
+    axis = lambda m: {"mean": m, "std": m / 2, "max": 3 * m}
+    r = {"robot": 0, "frames": 100, "x_cm": axis(x_mean), "y_cm": axis(y_mean), "theta_rad": axis(th),
+         "position_m": {"rmse": x_mean / 100, "p50": 0, "p90": 0, "p95": 0, "max": 0}, "line_points": {"mean": 80, "min": 50},
+         "wrong_frames": 0, "coasting_frames": 0}
+    r.update(extra or {})
+    return r
+
+
+def write_run(folder, scenario, localizer, seed, config, rob, version="abc123"):
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "summary.json").write_text(json.dumps({"scenario": scenario, "localizer": localizer, "seed": seed, "robots": [rob],
+                                                     "omniloc": {"version": version, "compiler": "GNU", "build_type": "Release"}}))
+    (folder / "config.json").write_text(json.dumps(dict(config, seed=seed, name=scenario)))
+
+
+OCCLUSION = {0.0: 2.0, 0.125: 2.5, 0.25: 3.0, 0.5: 4.0}  # mean x cm per fraction (+ seed / 100)
+
+
+def write_occlusion_sweep(folder, order, seeds=(1, 2, 3)):
+    """A sweep folder like scenarios/sweeps/occlusion_002.json's, its runs written in `order`."""
+    folder = pathlib.Path(folder)
+    lines = ["index,id,scenario,localizer,params,seed,status"]
+    k = 0
+    for frac in order:
+        for s in seeds:
+            rid = f"tracking__matching__occ{frac}__s{s}"
+            cfg = {} if frac == 0.0 else {"occlusion": {"fraction": frac, "sectors": 2}}
+            write_run(folder / "runs" / rid, "tracking", "matching", s, cfg, robot(OCCLUSION[frac] + s / 100))
+            params = json.dumps({"fraction": frac}, separators=(",", ":"))
+            lines.append(",".join([str(k), rid, "tracking", "matching", '"occlusion=' + params.replace('"', '""') + '"', str(s), "ok"]))
+            k += 1
+    (folder / "runs.csv").write_text("\n".join(lines) + "\n")
+    (folder / "aggregate.json").write_text(json.dumps({"sweep": "occ", "runs": k, "groups": []}))
+
+
+class Pairing(unittest.TestCase):
+    def test_rows_pair_by_key_whatever_the_order_of_the_sweep(self):
+        papers = R.load_papers()
+        orders = [[0.0, 0.125, 0.25, 0.5], [0.5, 0.0, 0.25, 0.125]]
+        random.Random(7).shuffle(orders[1])
+        tables = []
+        with tempfile.TemporaryDirectory() as tmp:
+            for i, order in enumerate(orders):
+                write_occlusion_sweep(pathlib.Path(tmp) / f"s{i}", order)
+                runs, sweeps, _ = R.discover([pathlib.Path(tmp) / f"s{i}"])
+                self.assertEqual(len(sweeps), 1)
+                self.assertEqual(len(runs), 12)
+                rows = C.pair_table(papers, "002_table1_occlusion", runs, include_extra=False)
+                tables.append([(p["label"], p["stats"]["x_cm/mean"]["mean"], p["stats"]["x_cm/mean"]["n"]) for p in rows])
+        self.assertEqual(tables[0], tables[1])
+        got = {label: (m, n) for label, m, n in tables[0]}
+        for label, frac in (("0 %", 0.0), ("12.5 %", 0.125), ("25 %", 0.25), ("50 %", 0.5)):
+            self.assertAlmostEqual(got[label][0], OCCLUSION[frac] + 0.02, places=9, msg=label)  # mean of seeds 1..3: +0.02
+            self.assertEqual(got[label][1], 3)
+
+    def test_missing_rows_say_not_run_with_the_command(self):
+        papers = R.load_papers()
+        with tempfile.TemporaryDirectory() as tmp:
+            write_occlusion_sweep(pathlib.Path(tmp) / "s", [0.0])
+            out = subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), tmp, "--paper", "002_table1_occlusion"], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            self.assertIn("not run: 50 %", out.stdout)
+            self.assertIn(papers["002_table1_occlusion"]["reproduced_by"]["command"], out.stdout)
+            bad = subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), tmp, "--paper", "002_table1_occlusion", "--rows", "strong sun"],
+                                 capture_output=True, text=True)
+            self.assertEqual(bad.returncode, 2)
+            self.assertIn("'12.5 %'", bad.stderr)  # the valid rows are listed
+            bad = subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), tmp, "--paper", "nope"], capture_output=True, text=True)
+            self.assertEqual(bad.returncode, 2)
+            self.assertIn("002_table2_lighting", bad.stderr)
+
+    def test_stale_runs_of_an_older_spec_are_not_reported(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_occlusion_sweep(pathlib.Path(tmp) / "s", [0.0])
+            write_run(pathlib.Path(tmp) / "s" / "runs" / "old_run", "tracking", "matching", 1, {}, robot(99.0))
+            runs, _, _ = R.discover([tmp])
+            self.assertEqual(len(runs), 3)
+            self.assertNotIn(99.0, [r.metric("x_cm/mean") for r in runs])
+
+    def test_every_published_row_is_run_by_the_paper_suite(self):
+        # Each reproduced_by key must name a condition the default suite runs (scenario name,
+        # localizer type and configuration values applied as the sweep applies them).
+        papers = R.load_papers()
+        suite = json.loads((ROOT / "scenarios/sweeps/paper_suite.json").read_text())
+        conditions = []
+        for e in suite["scenarios"]:
+            e = e if isinstance(e, dict) else {"file": e}
+            scen = json.loads((ROOT / "scenarios/sweeps" / e["file"]).read_text())
+            name = scen.get("name", pathlib.Path(e["file"]).stem)
+            locs = [l["type"] for l in e.get("localizers", [])] or [scen.get("localizer", {}).get("type")]
+            combos = [scen]
+            for ptr, values in (e.get("parameters") or {}).items():
+                nxt = []
+                for c in combos:
+                    for v in values:
+                        c2 = json.loads(json.dumps(c))
+                        parts = ptr.strip("/").split("/")
+                        d = c2
+                        for p in parts[:-1]:
+                            d = d.setdefault(p, {})
+                        d[parts[-1]] = v
+                        nxt.append(c2)
+                combos = nxt
+            for c in combos:
+                for l in locs:
+                    conditions.append((name, l, c))
+        for table, t in papers.items():
+            rb = t.get("reproduced_by") if isinstance(t, dict) else None
+            if not rb or "rows" not in rb:
+                continue
+            for label, key in list(rb["rows"].items()) + list(rb.get("extra_rows", {}).items()):
+                names = key["scenario"] if isinstance(key["scenario"], list) else [key["scenario"]]
+                ok = False
+                for name, loc, cfg in conditions:
+                    if name not in names or ("localizer" in key and loc != key["localizer"]):
+                        continue
+                    good = True
+                    for ptr, want in (key.get("config") or {}).items():
+                        found, have = R.pointer(cfg, ptr)
+                        if not found:
+                            found, have = ptr in rb.get("config_defaults", {}), rb.get("config_defaults", {}).get(ptr)
+                        good = good and found and R.same_value(have, want)
+                    ok = ok or good
+                self.assertTrue(ok, f"{table} / {label}: no condition of the paper suite matches {R.describe_key(key)}")
+
+
+class ValidCsv(unittest.TestCase):
+    def test_real_sweep_specs_write_rfc4180_csv(self):
+        for spec in ("occlusion_002", "lighting_002", "paper_suite"):
+            with tempfile.TemporaryDirectory() as tmp:
+                out = subprocess.run([OMNILOC, "sweep", str(ROOT / "scenarios/sweeps" / f"{spec}.json"), "--aggregate-only", "-o", tmp],
+                                     capture_output=True, text=True)
+                self.assertEqual(out.returncode, 0, out.stderr)
+                for f in ("runs.csv", "aggregate.csv"):
+                    rows = list(csv.reader(io.StringIO((pathlib.Path(tmp) / f).read_text(), newline="")))
+                    self.assertGreaterEqual(len(rows), 1)
+                    for r in rows:
+                        self.assertEqual(len(r), len(rows[0]), f"{spec}/{f}: {r}")
+                rows = list(csv.DictReader(io.StringIO((pathlib.Path(tmp) / "runs.csv").read_text(), newline="")))
+                if spec == "occlusion_002":
+                    self.assertEqual(rows[1]["params"], 'occlusion={"fraction":0.125,"sectors":2}')
+
+
+class Statistics(unittest.TestCase):
+    def test_student_t(self):
+        self.assertAlmostEqual(R.t_quantile_975(1), 12.706, places=3)
+        self.assertAlmostEqual(R.t_quantile_975(10), 2.228, places=3)
+        self.assertAlmostEqual(R.t_two_sided_p(2.228, 10), 0.05, places=4)
+
+    def test_intervals_only_with_two_values(self):
+        self.assertIsNone(R.stats([4.75])["lo"])
+        self.assertEqual(R.fstat(R.stats([4.75])), "4.750 (n=1)")
+        s = R.stats([1.0, 2.0, 3.0, 4.0])
+        self.assertAlmostEqual(s["hi"] - s["mean"], 2.05426, places=4)  # t(3) = 3.18245 exactly
+
+    def test_welch(self):
+        # Known case: a = 1..5, b = 3..7 (equal spread): t = 2 / sqrt(2.5/5 * 2) = 2, df = 8, p = 0.0805.
+        w = R.welch([1, 2, 3, 4, 5], [3, 4, 5, 6, 7])
+        self.assertAlmostEqual(w["diff"], 2.0)
+        self.assertAlmostEqual(w["t"], 2.0)
+        self.assertAlmostEqual(w["df"], 8.0)
+        self.assertAlmostEqual(w["p"], 0.0805, places=4)
+
+
+class Compare(unittest.TestCase):
+    def test_known_difference_is_found_and_equal_sets_are_same(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            for s, (xa, xb) in enumerate([(2.00, 3.01), (2.10, 3.12), (1.90, 2.93)], start=1):
+                cfg = {"duration": 60}
+                write_run(tmp / "A" / f"r{s}", "tracking", "matching", s, cfg, robot(xa), "commitA")
+                write_run(tmp / "B" / f"other_folder_{4 - s}", "tracking", "matching", s, cfg, robot(xb), "commitB")
+                write_run(tmp / "C" / f"r{s}", "tracking", "matching", s, cfg, robot(xa), "commitC")
+            ra, _, _ = R.discover([tmp / "A"])
+            rb, _, _ = R.discover([tmp / "B"])
+            rc, _, _ = R.discover([tmp / "C"])
+            header, rows = compare.compare_rows(ra, rb)
+            x = [r for r in rows if r[1] == "x_cm/mean"][0]
+            self.assertEqual(x[0], "tracking / matching")
+            self.assertAlmostEqual(float(x[header.index("B - A")]), 1.02, places=4)
+            self.assertEqual(x[header.index("exceeds spread")], "yes")
+            y = [r for r in rows if r[1] == "y_cm/mean"][0]
+            self.assertEqual(y[header.index("exceeds spread")], "same")
+            _, rows = compare.compare_rows(ra, rc)
+            self.assertTrue(all(r[-1] == "same" for r in rows if r[1] != "(only in A)"))
+            # A single seed per side: the difference alone, no verdict on spread.
+            _, rows = compare.compare_rows(ra[:1], rb[:1])
+            self.assertEqual([r for r in rows if r[1] == "x_cm/mean"][0][-1], "n < 2")
+            # The CLI, through omniloc itself.
+            out = subprocess.run([OMNILOC, "compare", str(tmp / "A"), str(tmp / "B")], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            self.assertIn("commitA", out.stdout)
+            self.assertIn("commitB", out.stdout)
+            self.assertIn("yes", out.stdout)
+            out = subprocess.run([OMNILOC, "compare", str(tmp / "A"), str(tmp / "nothing_here")], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 2)
+
+
+class Claims(unittest.TestCase):
+    def test_rules_and_missing_results(self):
+        self.assertEqual(C.judge(1.2, {"kind": "range", "holds": [1, 2], "partly": [0.8, 3]}), "holds")
+        self.assertEqual(C.judge(0.9, {"kind": "range", "holds": [1, 2], "partly": [0.8, 3]}), "partly")
+        self.assertEqual(C.judge(5.0, {"kind": "range", "holds": [1, 2], "partly": [0.8, 3]}), "does not")
+        self.assertEqual(C.judge(2.4, {"kind": "ratio_to_published", "holds": [0.5, 2]}, 5.9), "does not")
+        self.assertEqual(C.judge(None, {"kind": "range", "holds": [1, 2]}), "not run")
+        ctx = C.Context(R.load_papers(), [], [])
+        claims = C.evaluate_claims(ctx)
+        self.assertGreaterEqual(len(claims), 12)
+        self.assertTrue(all(c["verdict"] in ("not run", "n/a") for c in claims))
+        self.assertTrue(any("not run: build/omniloc sweep" in c["ours_text"] for c in claims))
+
+    def test_occlusion_claim_from_keyed_rows(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_occlusion_sweep(pathlib.Path(tmp) / "s", [0.5, 0.25, 0.125, 0.0])
+            runs, _, _ = R.discover([tmp])
+            ctx = C.Context(R.load_papers(), runs, [])
+            c = [c for c in C.evaluate_claims(ctx) if c["id"] == "occlusion_mild"][0]
+            self.assertAlmostEqual(c["ours"], 4.02 / 2.02, places=9)
+            self.assertEqual(c["verdict"], "holds")
+
+
+class ReportEndToEnd(unittest.TestCase):
+    def test_report_has_scorecard_and_every_table_key(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_occlusion_sweep(pathlib.Path(tmp) / "s", [0.0, 0.5])
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(pathlib.Path(tmp) / "s"), "-o", str(pathlib.Path(tmp) / "rep")],
+                                 capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            doc = (pathlib.Path(tmp) / "rep" / "report.html").read_text()
+            self.assertIn('id="scorecard"', doc)
+            for k in R.load_papers():
+                if k not in ("comment", "claims"):
+                    self.assertTrue(k in doc, f"{k} is not in the report")
+            self.assertIn("not run", doc)
+            self.assertIn("abc123", doc)  # provenance
+
+
+if __name__ == "__main__":
+    unittest.main()
