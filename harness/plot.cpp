@@ -37,20 +37,35 @@ cv::Mat line_plot(const std::vector<Series>& series, const std::string& title, c
       ymax = std::max(ymax, ty(s.y[i]));
     }
   if (xmin > xmax) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
+  // Integer data (robot counts, iterations) get integer ticks: at most 5 divisions of a whole step.
+  bool integer_x = true;
+  for (const auto& s : series)
+    for (double x : s.x) integer_x = integer_x && std::fabs(x - std::round(x)) < 1e-9;
+  int x_divisions = 5;
+  if (integer_x) {
+    const double step = std::max(1.0, std::ceil((xmax - xmin) / 5.0));
+    x_divisions = std::max(1, static_cast<int>(std::ceil((xmax - xmin) / step)));
+    xmax = xmin + x_divisions * step;
+  }
   if (xmax - xmin < 1e-12) xmax = xmin + 1;
   if (ymax - ymin < 1e-12) ymax = ymin + 1;
   const double pad = 0.05 * (ymax - ymin);
-  ymin -= pad;
+  // Quantities that cannot be negative (errors, entropy, counts) start at zero, never below it.
+  ymin = (!log_y && ymin >= 0.0) ? 0.0 : ymin - pad;
   ymax += pad;
   auto P = [&](double x, double y) {
     return cv::Point(static_cast<int>(l + (x - xmin) / (xmax - xmin) * (r - l)), static_cast<int>(b - (ty(y) - ymin) / (ymax - ymin) * (b - t)));
   };
   cv::rectangle(m, {l, t}, {r, b}, {0, 0, 0}, 1);
-  for (int k = 0; k <= 5; ++k) {
-    const double xv = xmin + k * (xmax - xmin) / 5, yv = ymin + k * (ymax - ymin) / 5;
-    const int xp = l + k * (r - l) / 5, yp = b - k * (b - t) / 5;
+  for (int k = 0; k <= x_divisions; ++k) {
+    const double xv = xmin + k * (xmax - xmin) / x_divisions;
+    const int xp = l + k * (r - l) / x_divisions;
     cv::line(m, {xp, b}, {xp, b + 4}, {0, 0, 0});
     text(m, num(xv), {xp - 12, b + 18});
+  }
+  for (int k = 0; k <= 5; ++k) {
+    const double yv = ymin + k * (ymax - ymin) / 5;
+    const int yp = b - k * (b - t) / 5;
     cv::line(m, {l - 4, yp}, {l, yp}, {0, 0, 0});
     cv::line(m, {l, yp}, {r, yp}, {230, 230, 230});
     text(m, num(log_y ? std::pow(10.0, yv) : yv), {4, yp + 4});

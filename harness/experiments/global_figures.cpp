@@ -66,6 +66,20 @@ int run_global_figures(const ExperimentArgs& args, std::ostream& out) {
   cv::drawMarker(f7, pic.px(truth.x, truth.y), cv::Scalar(255, 80, 0), cv::MARKER_TILTED_CROSS, 22, 3);
   const auto& chosen = rec.candidates[static_cast<std::size_t>(rec.chosen)];
   cv::drawMarker(f7, pic.px(chosen.result.x, chosen.result.y), cv::Scalar(0, 0, 255), cv::MARKER_CROSS, 22, 2);
+  {
+    // Colour bar: the grey level of a sample against its E_k (dark = small, as the samples).
+    cv::Mat bar(f7.rows, 110, CV_8UC3, cv::Scalar(255, 255, 255));
+    const int top = 30, bottom = f7.rows - 30;
+    for (int y = top; y <= bottom; ++y) {
+      const int g = static_cast<int>(255.0 * (bottom - y) / std::max(1, bottom - top));
+      cv::line(bar, {10, y}, {34, y}, cv::Scalar(g, g, g));
+    }
+    cv::rectangle(bar, {10, top}, {34, bottom}, cv::Scalar(0, 0, 0));
+    cv::putText(bar, fmt("%.3f", hi), {40, top + 10}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {20, 20, 20}, 1, cv::LINE_AA);
+    cv::putText(bar, fmt("%.3f", lo), {40, bottom}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {20, 20, 20}, 1, cv::LINE_AA);
+    cv::putText(bar, "E_k", {40, (top + bottom) / 2}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {20, 20, 20}, 1, cv::LINE_AA);
+    cv::hconcat(f7, bar, f7);
+  }
   cv::Mat head(34, f7.cols, CV_8UC3, cv::Scalar(255, 255, 255));
   cv::putText(head, "Paper 000 fig. 7: E_k per grid sample (dark = small); red: best 5 and their RPROP paths; blue x: truth", {6, 22},
               cv::FONT_HERSHEY_SIMPLEX, 0.42, {20, 20, 20}, 1, cv::LINE_AA);

@@ -585,7 +585,9 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
                                   }());
     out << trend << "\n";
     md += "\n" + trend + ".\n";
-    table_json.push_back({{"bearing_sigma_deg", sd}, {"trials", table_trials}, {"rows", jrows}, {"trend", trend}});
+    // The trend as numbers too, for the report's scorecard (scripts/paper_claims.py).
+    table_json.push_back({{"bearing_sigma_deg", sd}, {"trials", table_trials}, {"rows", jrows}, {"trend", trend},
+                          {"edge_centre_ratio", {{"two_circle", num_or_null(ratio(TC))}, {"three_point", num_or_null(ratio(TP))}}}});
   }
   dir.write("table1_004.json", Json{{"seed", args.seed},
                                     {"field_cm", {100 * field.length, 100 * field.width}},
