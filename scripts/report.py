@@ -47,6 +47,15 @@ VERDICT_CLASS = {"holds": "ok", "partly": "partly", "does not": "no", "not run":
 fnum = R.fnum
 
 
+def numeric_class(cell):
+    """Numbers right-aligned, text left-aligned."""
+    try:
+        float(str(cell).split(" ")[0])
+        return " class='num'"
+    except ValueError:
+        return ""
+
+
 class Report:
     def __init__(self, out, title):
         self.out = pathlib.Path(out)
@@ -83,7 +92,7 @@ class Report:
         h = "<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(str(c))}</th>" for c in header) + "</tr>"
         for k, r in enumerate(rows):
             cls = row_classes[k] if row_classes and row_classes[k] else ""
-            h += (f"<tr class='{cls}'>" if cls else "<tr>") + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
+            h += (f"<tr class='{cls}'>" if cls else "<tr>") + "".join(f"<td{numeric_class(c)}>{html.escape(str(c))}</td>" for c in r) + "</tr>"
         self.html.append(h + "</table></div>")
 
     def markdown(self, text):
@@ -148,7 +157,7 @@ class Report:
         tmp.replace(self.out / "report.md")
         style = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;color:#222}"
                  ".scroll{overflow-x:auto}table{border-collapse:collapse;margin:0.5em 0 1.2em;font-size:13px}"
-                 "td,th{border:1px solid #bbb;padding:3px 7px;text-align:right}td:first-child,th:first-child{text-align:left}"
+                 "td,th{border:1px solid #bbb;padding:3px 7px;text-align:left;vertical-align:top}td.num{text-align:right}"
                  "th{background:#eee}tr.paper td{background:#fff6dc;font-style:italic}tr.ratio td{color:#555;font-size:12px}"
                  "tr.missing td{color:#999}tr.ok td:nth-last-child(2){background:#d8f5d8}tr.partly td:nth-last-child(2){background:#fff0b3}"
                  "tr.no td:nth-last-child(2){background:#f8d0d0}tr.notrun td:nth-last-child(2){background:#e8e8e8}"
@@ -277,15 +286,22 @@ def timing_table(rep, papers, runs):
               f"Ours: wall time on {platform.node()} ({os.cpu_count()} cores, {platform.machine()}), runs of a sweep share the cores; paper: {t['cpu']}.", classes)
 
 
-def experiment_tables(rep, papers, ctx):
-    # 001: equal vs 1/L weights.
-    t = papers["001_cooperative_mean_error_mm"]
+def experiment_section(rep, ctx, key, title):
+    """Heading of a published table reproduced by an experiment; (table, the experiment's JSON or None)."""
+    t = ctx.papers[key]
     rb = t["reproduced_by"]
     j = ctx.experiment_json(rb["experiment"], rb["file"])
-    rep.heading("Paper 001: cooperative ball localisation, equal vs 1/L weights", 3, "001_cooperative_mean_error_mm")
+    rep.heading(title, 3, key)
     if j is None:
         rep.para(f"Not run: {rb['command']}")
-    else:
+    return t, j
+
+
+def experiment_tables(rep, papers, ctx):
+    # 001: equal vs 1/L weights.
+    t, j = experiment_section(rep, ctx, "001_cooperative_mean_error_mm", "Paper 001: cooperative ball localisation, equal vs 1/L weights")
+    rb = t["reproduced_by"]
+    if j is not None:
         eq, w = R.pointer(j, rb["equal_weights"])[1], R.pointer(j, rb["weighted"])[1]
         rows = [["omniloc", fnum(eq, 1), fnum(w, 1), fnum(w / eq, 3) if eq else "-", (j.get("trials") or {}).get("path", "-")],
                 ["paper", fnum(t["equal_weights"], 1), fnum(t["weighted"], 1), fnum(t["weighted"] / t["equal_weights"], 3), "-"],
@@ -323,37 +339,30 @@ def experiment_tables(rep, papers, ctx):
     rep.para("Paper 001's real-robot result (001_real_mean_error_cm: 8.6 -> 4.5 cm) needs real robots and is not reproduced.")
 
     # 004 table 1.
-    t = papers["004_table1_cm"]
-    rb = t["reproduced_by"]
-    j = ctx.experiment_json(rb["experiment"], rb["file"])
-    rep.heading("Paper 004 table 1: two-circle and three-point fixes (cm)", 3, "004_table1_cm")
-    if j is None:
-        rep.para(f"Not run: {rb['command']}")
-    else:
+    t, j = experiment_section(rep, ctx, "004_table1_cm", "Paper 004 table 1: two-circle and three-point fixes (cm)")
+    if j is not None:
         tab = (j.get("tables") or [{}])[0]
         rows, classes = [], []
         for k, r in enumerate(tab.get("rows", [])):
             ours = r.get("ours", {})
-            tc, tp = ours.get("two_circle", {}), ours.get("three_point", {})
+            err = lambda solver: (ours.get(solver) or {}).get("mean_err_cm")
+            tc, tp = err("two_circle_004"), err("three_point_004")
             pub = t["rows"][k] if k < len(t["rows"]) else None
-            rows.append([f"({r['true_cm'][0]:.0f}, {r['true_cm'][1]:.0f})", "omniloc", fnum(tc.get("mean_err_cm"), 2), fnum(tp.get("mean_err_cm"), 2)])
+            rows.append([f"({r['true_cm'][0]:.0f}, {r['true_cm'][1]:.0f})", "omniloc", fnum(tc, 2), fnum(tp, 2),
+                         fnum(err("two_circle_eq8_literal"), 1), fnum(err("two_circle_eq9_literal"), 1)])
             classes.append("")
             if pub:
-                rows.append(["", "paper", fnum(pub[4], 2), fnum(pub[7], 2)])
+                rows.append(["", "paper", fnum(pub[4], 2), fnum(pub[7], 2), "", ""])
                 classes.append("paper")
-                rows.append(["", "ours / paper", fnum((tc.get("mean_err_cm") or math.nan) / pub[4], 2), fnum((tp.get("mean_err_cm") or math.nan) / pub[7], 2)])
+                rows.append(["", "ours / paper", fnum(tc / pub[4], 2) if tc is not None else "-", fnum(tp / pub[7], 2) if tp is not None else "-", "", ""])
                 classes.append("ratio")
-        rep.table(["true position", "source", "two-circle error", "three-point error"], rows,
-                  f"bearing noise N(0, {tab.get('bearing_sigma_deg', '-')} deg), {tab.get('trials', '-')} trials per position; {tab.get('trend', '')}", classes)
+        rep.table(["true position", "source", "two-circle error", "three-point error", "eq. (8) as printed", "eq. (9) as printed"], rows,
+                  f"mean error (cm) over {tab.get('trials', '-')} trials per position, bearing noise N(0, {tab.get('bearing_sigma_deg', '-')} deg); "
+                  f"the last two columns evaluate paper 004's two-circle equations literally (diagnostic, see docs/landmarks.md); {tab.get('trend', '')}", classes)
 
     # 003 simulation.
-    t = papers["003_simulation"]
-    rb = t["reproduced_by"]
-    j = ctx.experiment_json(rb["experiment"], rb["file"])
-    rep.heading("Paper 003: landmark groups with voting (simulation)", 3, "003_simulation")
-    if j is None:
-        rep.para(f"Not run: {rb['command']}")
-    else:
+    t, j = experiment_section(rep, ctx, "003_simulation", "Paper 003: landmark groups with voting (simulation)")
+    if j is not None:
         rows = []
         for case, v in j.items():
             s = v.get("all_paths") if isinstance(v, dict) else None
