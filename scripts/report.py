@@ -444,12 +444,17 @@ def plot_run(rep, run, title):
             c = EVENT_COLOURS.get(e.get("type"))
             if c:
                 ax.axvline(e["t"], color=c, lw=0.8, alpha=0.7)
+        t_end = max(float(f["t"]) for f in frames)
+        for r in run.summary.get("robots", []):  # left out of the tracking phase: shaded
+            for a, b in (r.get("tracking_phase") or {}).get("excluded", []):
+                ax.axvspan(a, min(b, t_end), color="#999999", alpha=0.15, lw=0)
         ax.set_ylim(bottom=0)
         ax.set_xlabel("t (s)")
         ax.set_ylabel(f"{label} ({unit})")
         ax.grid(alpha=0.3)
         ax.set_title(label + (" (lines: " + ", ".join(f"{k} {EVENT_COLOURS[k]}" for k in kinds) + ")" if kinds else ""), fontsize=9)
-    rep.figure(fig, "run", f"{title}: trajectory over the field, position and heading error over time")
+    rep.figure(fig, "run", f"{title}: trajectory over the field, position and heading error over time"
+               + (" (shaded: carried, blind or recovering, left out of the tracking phase)" if any("tracking_phase" in r for r in run.summary.get("robots", [])) else ""))
 
 
 def run_title(run, params=None):
@@ -525,8 +530,13 @@ def report_sweep(rep, sweep, all_runs, max_runs):
     if ci:
         rep.table(["group", "position RMSE m (all frames)", "95 % interval", "n"], ci, "intervals only where n >= 2")
     runs = sweep_runs(sweep, all_runs)
-    for k, (run, params) in enumerate(runs):
-        report_run(rep, run, plots=k < max_runs, params=params)
+    # Plots for the first seed of each group (every condition shown once), at most max_runs.
+    plotted, seen = 0, set()
+    for run, params in runs:
+        first = (run.scenario, run.localizer, params) not in seen
+        seen.add((run.scenario, run.localizer, params))
+        report_run(rep, run, plots=first and plotted < max_runs, params=params)
+        plotted += first
     return [r for r, _ in runs]
 
 
@@ -610,7 +620,7 @@ def main():
     ap.add_argument("results", nargs="+")
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--title", default="omniloc report")
-    ap.add_argument("--max-runs", type=int, default=12, help="trajectory plots for at most this many runs per sweep (default 12)")
+    ap.add_argument("--max-runs", type=int, default=24, help="trajectory plots for at most this many conditions per sweep, first seed of each (default 24)")
     ap.add_argument("--baseline", nargs="+", help="result folders to compare with (e.g. another commit's), per metric with Welch's t")
     a = ap.parse_args()
     papers = R.load_papers()
