@@ -35,6 +35,34 @@ def group_key(run):
     return (run.scenario, run.localizer, json.dumps(cfg, sort_keys=True))
 
 
+def flatten(obj, prefix=""):
+    out = {}
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            out.update(flatten(v, f"{prefix}/{k}"))
+    elif isinstance(obj, list) and obj and all(isinstance(v, dict) for v in obj):
+        for i, v in enumerate(obj):
+            out.update(flatten(v, f"{prefix}/{i}"))
+    else:
+        out[prefix] = json.dumps(obj, separators=(",", ":"))
+    return out
+
+
+def labels(keys):
+    """'scenario / localizer', plus the configuration values that tell apart conditions sharing both."""
+    by = {}
+    for k in keys:
+        by.setdefault(k[:2], []).append(k)
+    out = {}
+    for sl, ks in by.items():
+        flat = {k: flatten(json.loads(k[2])) for k in ks}
+        ptrs = sorted({p for f in flat.values() for p in f if len({f.get(p) for f in flat.values()}) > 1})
+        for k in ks:
+            extra = ", ".join(f"{p}={flat[k].get(p, '-')}" for p in ptrs[:3]) + (" ..." if len(ptrs) > 3 else "")
+            out[k] = f"{sl[0]} / {sl[1]}" + (f" / {extra}" if extra else "")
+    return out
+
+
 def groups(runs):
     g = {}
     for r in runs:
@@ -63,10 +91,11 @@ def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
     for sl, ka in loose_a.items():
         if sl in loose_b and sum(1 for k in ga if k[:2] == sl) == 1 and sum(1 for k in gb if k[:2] == sl) == 1:
             pairs.append((ka, loose_b[sl], " (config differs)"))
-    header = ["scenario / localizer", "metric", "A mean", "n", "B mean", "n", "B - A", "p (Welch)", "exceeds spread"]
+    names = labels(set(ga) | set(gb))
+    header = ["scenario / localizer / differing configuration", "metric", "A mean", "n", "B mean", "n", "B - A", "p (Welch)", "exceeds spread"]
     rows = []
     for ka, kb, note in sorted(pairs, key=lambda p: p[0][:2]):
-        label = f"{ka[0]} / {ka[1]}{note}"
+        label = names[ka] + note
         for m in metrics:
             a = [r.metric(m) for r in ga[ka]]
             b = [r.metric(m) for r in gb[kb]]
@@ -80,9 +109,9 @@ def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
     only_a = sorted(set(ga) - {p[0] for p in pairs})
     only_b = sorted(set(gb) - {p[1] for p in pairs})
     for k in only_a:
-        rows.append([f"{k[0]} / {k[1]}", "(only in A)", "", len(ga[k]), "", "", "", "", ""])
+        rows.append([names[k], "(only in A)", "", len(ga[k]), "", "", "", "", ""])
     for k in only_b:
-        rows.append([f"{k[0]} / {k[1]}", "(only in B)", "", "", "", len(gb[k]), "", "", ""])
+        rows.append([names[k], "(only in B)", "", "", "", len(gb[k]), "", "", ""])
     return header, rows
 
 
