@@ -1,6 +1,7 @@
 // Localizer steps on synthetic line points (targets: matching + Kalman <= 0.1 ms with 200 points).
 #include <benchmark/benchmark.h>
 
+#include "bench/bench_scenes.hpp"
 #include "core/field.hpp"
 #include "core/rng.hpp"
 #include "localization/grid_global.hpp"
@@ -8,17 +9,8 @@
 #include "localization/mcl.hpp"
 
 using namespace omniloc;
+using bench_scenes::line_points;
 
-namespace {
-std::vector<Eigen::Vector2d> points(const Field& f, const Pose2& pose, int n, Rng& rng) {
-  std::vector<Eigen::Vector2d> pts;
-  while (static_cast<int>(pts.size()) < n) {
-    const Eigen::Vector2d w(pose.x + rng.uniform(-6, 6), pose.y + rng.uniform(-6, 6));
-    if (f.distance_to_marking(w) < 0.004) pts.push_back(pose.inverse_transform(w) + Eigen::Vector2d(rng.normal(0, 0.03), rng.normal(0, 0.03)));
-  }
-  return pts;
-}
-}  // namespace
 
 static void BM_MatchingUpdate(benchmark::State& state) {
   const Field f = Field::preset("msl2012");
@@ -26,7 +18,7 @@ static void BM_MatchingUpdate(benchmark::State& state) {
   Rng rng(1);
   const Pose2 truth(-3.0, 1.0, 0.4);
   Observations obs;
-  obs.line_points = points(f, truth, static_cast<int>(state.range(0)), rng);
+  obs.line_points = line_points(f, truth, static_cast<int>(state.range(0)), rng);
   Odometry odo;
   for (auto _ : state) {
     state.PauseTiming();
@@ -57,7 +49,7 @@ static void BM_McLUpdate(benchmark::State& state) {
   Rng rng(3);
   const Pose2 truth(2.0, -1.0, 0.7);
   Observations obs;
-  obs.line_points = points(f, truth, 200, rng);
+  obs.line_points = line_points(f, truth, 200, rng);
   Odometry odo;
   odo.delta = Pose2(0.03, 0.0, 0.01);
   mcl.reset(std::nullopt);
@@ -72,7 +64,7 @@ static void BM_GridGlobalAttempt(benchmark::State& state) {
   const FieldMap map(f, 0.05, "");
   Rng rng(5);
   const Pose2 truth(-3.2, 2.1, -0.4);
-  const auto pts = points(f, truth, 200, rng);
+  const auto pts = line_points(f, truth, 200, rng);
   GridGlobalParams p;
   p.accept_error = 0.0;
   for (auto _ : state) benchmark::DoNotOptimize(grid_search(f, map, pts, truth.theta, p));

@@ -10,6 +10,7 @@ PKGS=(
   libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
   libbenchmark-dev libgtest-dev libgmock-dev
   python3 python3-matplotlib
+  valgrind
 )
 missing=()
 for p in "${PKGS[@]}"; do
