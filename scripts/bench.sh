@@ -21,4 +21,20 @@ for b in build/bench_*; do
     --benchmark_out="$out/$name.json.tmp" --benchmark_out_format=json "$@" \
     && mv "$out/$name.json.tmp" "$out/$name.json"
 done
+# History: the medians of this run with the commit, one line appended to results/history/bench.jsonl
+# (scripts/report.py draws them over commits; compare only records measured in the same minutes).
+/usr/bin/python3 - "$out" "$commit$dirty" <<'EOF'
+import datetime, glob, json, os, sys
+out, commit = sys.argv[1:]
+medians = {}
+for f in sorted(glob.glob(os.path.join(out, "bench_*.json"))):
+    for b in json.load(open(f)).get("benchmarks", []):
+        if b.get("aggregate_name") == "median":
+            scale = {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b.get("time_unit", "ns")]
+            medians[b["run_name"]] = b["real_time"] * scale
+os.makedirs("results/history", exist_ok=True)
+with open("results/history/bench.jsonl", "a") as h:
+    h.write(json.dumps({"commit": commit, "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                        "real_time_ns": medians}, sort_keys=True) + "\n")
+EOF
 echo "benchmark JSON in $out"

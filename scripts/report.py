@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Comparison report of omniloc results: report.md and a self-contained report.html.
 
-usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N] [--baseline RESULTS]
+usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N] [--baseline RESULTS] [--history DIR]
 
 RESULTS are folders: a run (summary.json), a sweep (aggregate.json with runs/ inside), an
 experiment (PNG / JSON / markdown files written by `omniloc experiment`), or any folder holding
@@ -17,7 +17,10 @@ such folders (searched recursively). The report shows, in this order:
   - every sweep's aggregate and every run's error table (headings carry the swept parameters,
     in the aggregate's order), trajectory plots over the field, position and heading error over
     time with the events marked, error CDFs, timing per stage;
-  - every experiment's tables (as HTML tables) and pictures.
+  - every experiment's tables (as HTML tables) and pictures;
+  - with --history DIR (default results/history when it exists): instruction counts
+    (scripts/icount.sh, icount.jsonl) and benchmark wall times (scripts/bench.sh, bench.jsonl)
+    per workload over the commits that were measured.
 Everything except the published numbers is read from the result files. Needs Python 3 and
 Debian's python3-matplotlib (no PyPI).
 """
@@ -602,6 +605,67 @@ def cdf_and_timing(rep, runs):
         rep.figure(fig, "timing", "median time per frame and stage")
 
 
+def load_jsonl(path):
+    out = []
+    if path.exists():
+        for line in path.read_text().splitlines():
+            if line.strip():
+                try:
+                    out.append(json.loads(line))
+                except json.JSONDecodeError:
+                    pass  # a line cut by an interrupted append: the others still count
+    return out
+
+
+def history_plot(rep, records, field, key, ylabel, caption):
+    """One line per workload: `field` of every record, relative to the workload's first record, in
+    the order the records were appended (one point per measured commit)."""
+    series = {}
+    for i, rec in enumerate(records):
+        for w, v in rec.get(field, {}).items():
+            if isinstance(v, (int, float)) and v > 0:
+                series.setdefault(w, []).append((i, v))
+    if not series:
+        return
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for w, pts in sorted(series.items()):
+        base = pts[0][1]
+        ax.plot([i for i, _ in pts], [v / base for _, v in pts], marker="o", ms=3, label=w)
+    ax.axhline(1.0, color="grey", lw=0.8)
+    ax.set_xticks(range(len(records)))
+    ax.set_xticklabels([r.get("commit", "?") for r in records], rotation=60, ha="right", fontsize=7)
+    ax.set_ylim(bottom=0)
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=6, ncol=2)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    rep.figure(fig, key, caption)
+    first, last = records[0], records[-1]
+    rows = []
+    for w, pts in sorted(series.items()):
+        rows.append([w, fnum(pts[0][1], 6), fnum(pts[-1][1], 6), fnum(pts[-1][1] / pts[0][1], 3)])
+    rep.table(["workload", f"first ({first.get('commit', '?')})", f"last ({last.get('commit', '?')})", "last / first"], rows)
+
+
+def report_history(rep, folder):
+    # The committed baseline history (one record per baseline change) first, then this machine's runs.
+    reference = pathlib.Path(__file__).resolve().parent.parent / "results" / "reference" / "icount_history.jsonl"
+    icount = load_jsonl(reference) + load_jsonl(folder / "icount.jsonl")
+    bench = load_jsonl(folder / "bench.jsonl")
+    if not (icount or bench):
+        return
+    rep.heading("Speed over commits", 2, "history")
+    rep.para(f"From {reference.relative_to(reference.parents[2])} (committed baselines) and {folder} (this machine): every run of scripts/icount.sh and scripts/bench.sh appends its figures with the commit. "
+             "Instruction counts (callgrind, fixed work) do not depend on the machine's load; wall times do, so compare "
+             "wall times only between records measured in the same minutes.")
+    if icount:
+        history_plot(rep, icount, "instructions", "history_icount", "instructions / first record",
+                     "instructions per workload (scripts/icount.sh), relative to each workload's first record")
+    if bench:
+        history_plot(rep, bench, "real_time_ns", "history_bench", "median wall time / first record",
+                     "Google Benchmark median wall time per benchmark (scripts/bench.sh), relative to its first record")
+
+
 def picture_order(p):
     # Before / after pairs in that order (alphabetically "after" would come first).
     return str(p).replace("_before", "_0before").replace("_after", "_1after")
@@ -622,6 +686,7 @@ def main():
     ap.add_argument("--title", default="omniloc report")
     ap.add_argument("--max-runs", type=int, default=24, help="trajectory plots for at most this many conditions per sweep, first seed of each (default 24)")
     ap.add_argument("--baseline", nargs="+", help="result folders to compare with (e.g. another commit's), per metric with Welch's t")
+    ap.add_argument("--history", help="folder with icount.jsonl / bench.jsonl (default results/history if it exists; 'none' to leave out)")
     a = ap.parse_args()
     papers = R.load_papers()
     runs, sweeps, experiments = R.discover(a.results)
@@ -653,6 +718,9 @@ def main():
     cdf_and_timing(rep, runs)
     for exp in experiments:
         report_experiment(rep, exp)
+    history = a.history or str(pathlib.Path(__file__).resolve().parent.parent / "results" / "history")
+    if history != "none":
+        report_history(rep, pathlib.Path(history))
     rep.write()
     print(f"report: {rep.out / 'report.md'} and {rep.out / 'report.html'} ({rep.n_img} pictures)")
 

@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Compares instruction counts with the committed baseline (the logic of scripts/icount.sh).
+
+usage: icount_compare.py COUNTS --baseline FILE [--threshold PCT] [--commit C] [--out FILE] [--update]
+
+COUNTS holds lines "workload instructions milliseconds". Exit 1 when a workload needs more than
+PCT % more instructions than the baseline or is missing from it; with --update the counts become the
+baseline (merged over it) and are appended to icount_history.jsonl beside it. Every call appends its
+record to results/history/icount.jsonl.
+"""
+import argparse
+import datetime
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+
+def compare(counts, base, threshold):
+    """Rows (workload, baseline or None, now, percent or None, verdict) and the failures."""
+    rows, failed = [], []
+    for w in sorted(counts):
+        b = base.get(w)
+        if b is None:
+            rows.append((w, None, counts[w], None, "no baseline"))
+            failed.append(f"{w}: not in the baseline (scripts/icount.sh --update adds it)")
+            continue
+        pct = 100.0 * (counts[w] - b) / b
+        verdict = ""
+        if pct > threshold:
+            verdict = f"SLOWER than +{threshold:g}%"
+            failed.append(f"{w}: {pct:+.2f}% instructions ({b} -> {counts[w]})")
+        elif pct < -threshold:
+            verdict = "faster: update the baseline (scripts/icount.sh --update)"
+        rows.append((w, b, counts[w], pct, verdict))
+    return rows, failed
+
+
+def write_atomic(path, text):
+    folder = os.path.dirname(path) or "."
+    os.makedirs(folder, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp")
+    with os.fdopen(fd, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("counts")
+    ap.add_argument("--baseline", required=True)
+    ap.add_argument("--threshold", type=float, default=3.0)
+    ap.add_argument("--commit", default="unknown")
+    ap.add_argument("--out")
+    ap.add_argument("--update", action="store_true")
+    ap.add_argument("--history", default="results/history/icount.jsonl")
+    a = ap.parse_args()
+    counts, ms = {}, {}
+    for line in open(a.counts):
+        w, ir, t = line.split()
+        counts[w], ms[w] = int(ir), int(t)
+    try:
+        valgrind = subprocess.run(["valgrind", "--version"], capture_output=True, text=True).stdout.strip()
+    except OSError:
+        valgrind = "valgrind (unknown version)"
+    record = {"commit": a.commit, "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+              "tool": valgrind + " callgrind", "instructions": dict(sorted(counts.items())),
+              "valgrind_seconds": {w: ms[w] / 1000.0 for w in sorted(ms)}}
+    if a.history:
+        os.makedirs(os.path.dirname(a.history) or ".", exist_ok=True)
+        with open(a.history, "a") as f:
+            f.write(json.dumps(record, sort_keys=True) + "\n")
+    if a.out:
+        write_atomic(a.out, json.dumps(record, indent=2, sort_keys=True) + "\n")
+    base = json.load(open(a.baseline))["instructions"] if os.path.exists(a.baseline) else {}
+    rows, failed = compare(counts, base, a.threshold)
+    print(f"{'workload':28s} {'baseline':>15s} {'now':>15s} {'change':>8s} {'valgrind s':>10s}")
+    for w, b, now, pct, verdict in rows:
+        print(f"{w:28s} {b if b is not None else '-':>15} {now:>15d} {'' if pct is None else f'{pct:+.2f}%':>8s} "
+              f"{ms[w] / 1000.0:10.1f}  {verdict}")
+    if a.update:
+        merged = dict(base)
+        merged.update(counts)
+        rec = {k: v for k, v in record.items() if k != "valgrind_seconds"}
+        rec["instructions"] = dict(sorted(merged.items()))
+        rec["threshold_percent"] = a.threshold
+        write_atomic(a.baseline, json.dumps(rec, indent=2, sort_keys=True) + "\n")
+        # The committed history: one record per baseline change, drawn by scripts/report.py.
+        with open(os.path.join(os.path.dirname(a.baseline) or ".", "icount_history.jsonl"), "a") as f:
+            f.write(json.dumps({k: v for k, v in record.items() if k != "valgrind_seconds"}, sort_keys=True) + "\n")
+        print(f"baseline written: {a.baseline} (commit {a.commit}); commit it with a message that says why")
+        return 0
+    if failed:
+        print("icount gate FAILED:\n  " + "\n  ".join(failed), file=sys.stderr)
+        return 1
+    print(f"icount gate passed: every workload within +{a.threshold:g}% of {a.baseline}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
