@@ -430,7 +430,9 @@ SlurmSubmission submit_slurm(const SweepSpec& spec, const std::string& spec_path
 
   // The scripts. Options go in #SBATCH lines so that `sbatch array.sbatch` by hand is the same job.
   const std::string shard_cmd_tail = " --resume -j " + std::to_string(o.cpus_per_task) + " -o " + shq(dir.string());
-  std::string common;
+  // Tasks work in the folder omniloc was called from, whoever submits the scripts and from where:
+  // relative paths (results/cache of calibration maps and colour tables) then mean the same thing.
+  std::string common = "#SBATCH --chdir=" + fs::current_path().string() + "\n";
   if (!o.partition.empty()) common += "#SBATCH --partition=" + o.partition + "\n";
   if (!o.time_limit.empty()) common += "#SBATCH --time=" + o.time_limit + "\n";
   for (const auto& a : o.sbatch_args) common += "#SBATCH " + a + "\n";

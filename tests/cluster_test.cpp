@@ -57,10 +57,12 @@ std::string why_no_cluster() {
     return "sbatch is not installed (Slurm cannot be installed here, or scripts/slurm-local.sh up was not run)";
   if (!std::getenv("SLURM_CONF")) {
     const char* d = std::getenv("OMNILOC_SLURM_DIR");
-    const fs::path conf = fs::path(d ? d : "/tmp/omniloc-slurm") / "slurm.conf";
-    if (fs::exists(conf)) ::setenv("SLURM_CONF", conf.c_str(), 1);
+    const fs::path dir = d ? d : "/tmp/omniloc-slurm";
+    // Only a running local cluster: sinfo spends seconds retrying a controller that is not there.
+    if (!fs::exists(dir / "run" / "slurmctld.daemon.pid")) return "no SLURM_CONF and no local cluster running in " + dir.string();
+    ::setenv("SLURM_CONF", (dir / "slurm.conf").c_str(), 1);
   }
-  const Out s = sh("sinfo -h -o %t");
+  const Out s = sh("timeout 20 sinfo -h -o %t");
   if (s.code != 0 || s.text.empty())
     return "no Slurm controller answers (sinfo: " + s.text.substr(0, 200) + ")";
   if (s.text.find("idle") == std::string::npos && s.text.find("mix") == std::string::npos && s.text.find("alloc") == std::string::npos)
