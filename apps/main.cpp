@@ -189,6 +189,10 @@ int cmd_sweep(const Args& a) {
   if (a.positional.size() != 1) throw UsageError("sweep takes one sweep file");
   const auto spec = harness::load_sweep(a.positional[0]);
   if (flag(a, "--slurm") || flag(a, "--status")) return cmd_sweep_slurm(a, spec);
+  for (const char* o : {"--tasks", "--partition", "--time", "--cpus-per-task", "--sbatch-arg"})
+    if (!opt(a, o).empty()) throw UsageError(std::string(o) + " needs --slurm");
+  for (const char* f : {"--dry-run", "--resubmit-missing"})
+    if (flag(a, f)) throw UsageError(std::string(f) + " needs --slurm");
   harness::SweepOptions o;
   const std::string j = opt(a, "-j", "1");
   o.jobs = std::atoi(j.c_str());
