@@ -17,6 +17,7 @@
 #include "harness/render_frame.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "harness/slurm.hpp"
 #include "harness/sweep.hpp"
 #include "harness/vision_setup.hpp"
 #include "sim/render/camera_config.hpp"
@@ -44,6 +45,13 @@ commands:
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
+  sweep SWEEP.json --slurm [--tasks N] [--partition P] [--time HH:MM:SS] [--cpus-per-task C]
+        [--sbatch-arg ARG]... [--dry-run] [--resubmit-missing] [-o DIR]
+                         a Slurm job array of N shards and a merge job (docs/cluster.md);
+                         --dry-run only writes DIR/slurm/
+  sweep SWEEP.json --status [--tasks N] [-o DIR]
+                         runs done / failed / missing per shard, and the Slurm jobs' states;
+                         exit 0 when every run is done, 1 otherwise
   experiment NAME [--seed N] [-o DIR] [--quick] [--config FILE]
                          run a named experiment (solver maps, cooperative simulation, ...);
                          --config: its description file instead of scenarios/experiments/NAME.json
@@ -147,9 +155,44 @@ int cmd_run(const Args& a) {
   return 0;
 }
 
+// Slurm submission and status (harness/slurm.hpp); every option is checked before anything is written.
+int cmd_sweep_slurm(const Args& a, const harness::SweepSpec& spec) {
+  auto count = [&](const std::string& name, int def) {
+    const std::string v = opt(a, name);
+    if (v.empty()) return def;
+    if (v.find_first_not_of("0123456789") != std::string::npos || v.size() > 6) throw UsageError(name + " needs a positive integer, got \"" + v + "\"");
+    return std::atoi(v.c_str());
+  };
+  if (flag(a, "--slurm") && flag(a, "--status")) throw UsageError("--status and --slurm are separate commands");
+  if (flag(a, "--status")) {
+    const auto st = harness::sweep_status(spec, opt(a, "-o"), count("--tasks", 0));
+    std::cout << st.text;
+    return st.complete() ? 0 : 1;
+  }
+  harness::SlurmOptions so;
+  so.tasks = count("--tasks", 0);
+  if (!opt(a, "--tasks").empty() && so.tasks == 0) throw UsageError("--tasks needs a positive integer, got \"0\"");
+  so.partition = opt(a, "--partition");
+  so.time_limit = opt(a, "--time");
+  so.cpus_per_task = count("--cpus-per-task", 1);
+  for (const auto& [k, v] : a.options)
+    if (k == "--sbatch-arg") so.sbatch_args.push_back(v);
+  so.dry_run = flag(a, "--dry-run");
+  so.resubmit_missing = flag(a, "--resubmit-missing");
+  so.out_dir = opt(a, "-o");
+  const auto r = harness::submit_slurm(spec, a.positional[0], so);
+  std::cout << r.message;
+  return 0;
+}
+
 int cmd_sweep(const Args& a) {
   if (a.positional.size() != 1) throw UsageError("sweep takes one sweep file");
   const auto spec = harness::load_sweep(a.positional[0]);
+  if (flag(a, "--slurm") || flag(a, "--status")) return cmd_sweep_slurm(a, spec);
+  for (const char* o : {"--tasks", "--partition", "--time", "--cpus-per-task", "--sbatch-arg"})
+    if (!opt(a, o).empty()) throw UsageError(std::string(o) + " needs --slurm");
+  for (const char* f : {"--dry-run", "--resubmit-missing"})
+    if (flag(a, f)) throw UsageError(std::string(f) + " needs --slurm");
   harness::SweepOptions o;
   const std::string j = opt(a, "-j", "1");
   o.jobs = std::atoi(j.c_str());
@@ -286,7 +329,8 @@ int main(int argc, char** argv) {
     if (cmd == "colour-calibrate") return cmd_colour_calibrate(parse(argc, argv, 2, {"-o", "--seed"}, {}));
     if (cmd == "render") return cmd_render(parse(argc, argv, 2, {"--t", "--robot", "--seed", "-o"}, {"--labels", "--points"}));
     if (cmd == "sweep")
-      return cmd_sweep(parse(argc, argv, 2, {"-j", "--shard", "-o", "--stop-after"}, {"--resume", "--aggregate-only"}));
+      return cmd_sweep(parse(argc, argv, 2, {"-j", "--shard", "-o", "--stop-after", "--tasks", "--partition", "--time", "--cpus-per-task", "--sbatch-arg"},
+                             {"--resume", "--aggregate-only", "--slurm", "--dry-run", "--status", "--resubmit-missing"}));
     if (cmd == "experiment") return cmd_experiment(parse(argc, argv, 2, {"--seed", "-o", "--config"}, {"--quick"}));
     throw UsageError("unknown command \"" + cmd + "\"");
   } catch (const ConfigError& e) {

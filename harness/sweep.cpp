@@ -312,9 +312,16 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
   fs::create_directories(dir / "failed");
   const std::string exe = o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe").string() : o.omniloc_exe;
   auto finished = [&](const SweepRun& r) { return fs::exists(dir / "runs" / r.id / "summary.json"); };
-  // Staging folders of runs killed mid-write are hidden (".<id>.partial-<pid>"); clear them.
-  for (const auto& e : fs::directory_iterator(dir / "runs"))
-    if (e.path().filename().string().find(".partial-") != std::string::npos) fs::remove_all(e.path());
+  // Staging folders of runs killed mid-write are hidden (".<id>.partial-<pid>"); clear this shard's
+  // only: other shards (Slurm array tasks) may be writing theirs into the same folder right now.
+  std::set<std::string> mine;
+  for (const auto& r : spec.runs)
+    if (static_cast<int>(r.index % o.shard_count) == o.shard_index) mine.insert("." + r.id + ".partial-");
+  for (const auto& e : fs::directory_iterator(dir / "runs")) {
+    const std::string f = e.path().filename().string();
+    const auto at = f.find(".partial-");
+    if (at != std::string::npos && mine.count(f.substr(0, at + 9))) fs::remove_all(e.path());
+  }
 
   // This shard's runs that still need doing.
   std::vector<const SweepRun*> todo;

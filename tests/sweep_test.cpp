@@ -193,3 +193,20 @@ TEST(Sweep, ScenarioEntriesCarryTheirOwnParametersAndLocalizers) {
   write_file_atomic(bad, R"({"scenarios": [{"path": "short.json"}]})");
   EXPECT_THROW(load_sweep(bad), ConfigError);
 }
+
+// Shards share one results folder (Slurm array tasks): a shard starting must not delete the staging
+// folder another shard is writing, only the leftovers of its own runs.
+TEST(Sweep, ShardClearsOnlyItsOwnStagingFolders) {
+  fs::remove_all(test_dir());
+  const SweepSpec spec = load_sweep(make_sweep());
+  const fs::path runs = test_dir() / "shared" / "runs";
+  const fs::path other = runs / ("." + spec.runs[1].id + ".partial-4242");  // run 1: shard 1 of 2
+  const fs::path mine = runs / ("." + spec.runs[2].id + ".partial-4242");   // run 2: shard 0 of 2
+  fs::create_directories(other);
+  fs::create_directories(mine);
+  sweep_into(spec, "shared", 1, true, 1, 0, 2);
+  EXPECT_TRUE(fs::exists(other));
+  EXPECT_FALSE(fs::exists(mine));
+  sweep_into(spec, "shared", 1, true, 1, 1, 2);
+  EXPECT_FALSE(fs::exists(other));
+}
