@@ -37,6 +37,22 @@ def compare(counts, base, threshold):
     return rows, failed
 
 
+def cpu_signature():
+    """The CPU model and the instruction-set extensions that libm, OpenCV and llvmpipe choose code
+    paths by: counts are comparable only between machines that agree on these."""
+    model, flags = "unknown", set()
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name") and model == "unknown":
+                model = line.split(":", 1)[1].strip()
+            elif line.startswith("flags") and not flags:
+                flags = set(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    isa = [f for f in ("sse4_2", "avx", "avx2", "fma", "avx512f") if f in flags]
+    return {"model": model, "isa": isa}
+
+
 def write_atomic(path, text):
     folder = os.path.dirname(path) or "."
     os.makedirs(folder, exist_ok=True)
@@ -65,7 +81,7 @@ def main():
     except OSError:
         valgrind = "valgrind (unknown version)"
     record = {"commit": a.commit, "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-              "tool": valgrind + " callgrind", "instructions": dict(sorted(counts.items())),
+              "tool": valgrind + " callgrind", "cpu": cpu_signature(), "instructions": dict(sorted(counts.items())),
               "valgrind_seconds": {w: ms[w] / 1000.0 for w in sorted(ms)}}
     if a.history:
         os.makedirs(os.path.dirname(a.history) or ".", exist_ok=True)
@@ -73,7 +89,11 @@ def main():
             f.write(json.dumps(record, sort_keys=True) + "\n")
     if a.out:
         write_atomic(a.out, json.dumps(record, indent=2, sort_keys=True) + "\n")
-    base = json.load(open(a.baseline))["instructions"] if os.path.exists(a.baseline) else {}
+    base_record = json.load(open(a.baseline)) if os.path.exists(a.baseline) else {}
+    base = base_record.get("instructions", {})
+    if "cpu" in base_record and base_record["cpu"].get("isa") != record["cpu"]["isa"]:
+        print(f"note: the baseline was counted on a CPU with {base_record['cpu']} and this one has {record['cpu']}; "
+              "libm, OpenCV and llvmpipe pick other code paths by instruction set, so counts may differ for that reason")
     rows, failed = compare(counts, base, a.threshold)
     print(f"{'workload':28s} {'baseline':>15s} {'now':>15s} {'change':>8s} {'valgrind s':>10s}")
     for w, b, now, pct, verdict in rows:
