@@ -35,6 +35,7 @@ class StrictBuilder : public nlohmann::json_sax<Json> {
     Frame& f = stack_.back();
     if (f.node->contains(k)) {
       f.key = k;
+      f.has_key = true;
       fail("a second \"" + k + "\" in the same object", "each key at most once per object (the later one would silently win)");
     }
     f.key = std::move(k);
@@ -86,8 +87,14 @@ class StrictBuilder : public nlohmann::json_sax<Json> {
     }
     return &((*f.node)[f.key] = std::move(v));
   }
+  // After a complete member the object waits for its next key: a later syntax error is reported
+  // at the object, not at the member before it.
+  void member_done() {
+    if (!stack_.empty() && stack_.back().node->is_object()) stack_.back().has_key = false;
+  }
   bool put(Json&& v) {
     place(std::move(v));
+    member_done();
     return true;
   }
   bool open(Json&& container) {
@@ -100,6 +107,7 @@ class StrictBuilder : public nlohmann::json_sax<Json> {
   }
   bool close() {
     stack_.pop_back();
+    member_done();
     return true;
   }
 
