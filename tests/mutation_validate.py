@@ -134,6 +134,8 @@ def main():
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--keep", default=None, help="folder for the inputs that misbehaved")
     a = ap.parse_args()
+    if os.sep in a.omniloc:  # the mutants run in their own folder: a relative path would not resolve there
+        a.omniloc = str(pathlib.Path(a.omniloc).resolve())
     rng = random.Random(a.seed)
     seeds = corpus()
     work = pathlib.Path(tempfile.mkdtemp(prefix="omniloc_mutation_"))
