@@ -10,6 +10,9 @@ namespace omniloc {
 /// Throws RuntimeFailure naming the path on any I/O error.
 void write_file_atomic(const std::string& path, std::string_view content);
 
+/// fsyncs a folder, so renames and new entries in it survive a crash; throws RuntimeFailure.
+void fsync_dir(const std::string& dir);
+
 /// Reads a whole file; throws RuntimeFailure naming the path when it cannot.
 std::string read_file(const std::string& path);
 

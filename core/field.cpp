@@ -1,5 +1,7 @@
 #include "core/field.hpp"
 
+#include "core/json_parse.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -229,17 +231,13 @@ std::vector<std::string> Field::preset_names() {
 Field Field::preset(const std::string& name, const std::string& path) {
   const auto file = std::filesystem::path(data_dir()) / "fields" / (name + ".json");
   std::ifstream in(file);
-  if (!in) {
+  // A name with a folder part would read any JSON file on the machine as a field.
+  if (!in || name.empty() || name.find('/') != std::string::npos || name[0] == '.') {
     std::string known;
     for (const auto& n : preset_names()) known += (known.empty() ? "" : ", ") + n;
     throw ConfigError(path, "\"" + name + "\"", "a field preset name (" + known + ")");
   }
-  Json j;
-  try {
-    j = Json::parse(in);
-  } catch (const std::exception& e) {
-    throw ConfigError(file.string(), "unparsable JSON", std::string("valid JSON: ") + e.what());
-  }
+  const Json j = read_json_strict(file.string(), path);
   Field f = from_json(j, file.string());
   f.name = name;
   return f;

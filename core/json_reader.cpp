@@ -1,7 +1,9 @@
 #include "core/json_reader.hpp"
 
 #include <cmath>
+#include <iterator>
 #include <sstream>
+#include <vector>
 
 namespace omniloc {
 
@@ -27,9 +29,54 @@ ConfigError::ConfigError(std::string path, std::string value, std::string expect
       value_(std::move(value)),
       expected_(std::move(expected)) {}
 
+// Renders at most ~60 characters without recursion and without serialising the whole value: an
+// error message about a 16 MiB array must not cost a 16 MiB dump, and a value built in code may be
+// nested deeper than the parser allows. Invalid UTF-8 is replaced rather than thrown on (dump()
+// would throw type_error 316 and turn a bad input into a crash-like exit 1).
 std::string json_brief(const Json& v) {
-  std::string s = v.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  constexpr std::size_t kMax = 60;
+  std::string s;
+  struct Item {
+    const Json* node;
+    std::size_t next;  // index of the next child to render
+  };
+  std::vector<Item> stack;
+  auto scalar = [&](const Json& x) {
+    if (x.is_string() && x.get_ref<const std::string&>().size() > kMax) {
+      const std::string& str = x.get_ref<const std::string&>();
+      s += Json(str.substr(0, kMax)).dump(-1, ' ', false, Json::error_handler_t::replace);
+    } else {
+      s += x.dump(-1, ' ', false, Json::error_handler_t::replace);
+    }
+  };
+  auto begin = [&](const Json& x) {
+    if (x.is_object()) s += '{', stack.push_back({&x, 0});
+    else if (x.is_array()) s += '[', stack.push_back({&x, 0});
+    else scalar(x);
+  };
+  begin(v);
+  while (!stack.empty() && s.size() <= kMax) {
+    Item& it = stack.back();
+    const Json& node = *it.node;
+    if (it.next >= node.size()) {
+      s += node.is_object() ? '}' : ']';
+      stack.pop_back();
+      continue;
+    }
+    if (it.next > 0) s += ',';
+    if (node.is_object()) {
+      auto e = node.begin();
+      std::advance(e, static_cast<std::ptrdiff_t>(it.next));  // linear, but only while s is short
+      ++it.next;
+      s += Json(e.key()).dump(-1, ' ', false, Json::error_handler_t::replace) + ':';
+      begin(e.value());
+    } else {
+      const Json& child = node[it.next];
+      ++it.next;
+      begin(child);
+    }
+  }
+  if (s.size() > kMax) s = s.substr(0, kMax - 3) + "...";
   return s;
 }
 

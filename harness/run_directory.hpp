@@ -7,6 +7,10 @@
 
 namespace omniloc::harness {
 
+/// Removes hidden staging folders (".<name>.partial-<host>-<pid>") in `parent` left by processes of
+/// this host that no longer exist (a run killed with kill -9). Live ones are left alone.
+void remove_stale_partials(const std::string& parent);
+
 class RunDirectory {
  public:
   explicit RunDirectory(std::string final_dir);
@@ -21,6 +25,9 @@ class RunDirectory {
   /// Atomically replaces final_dir with the staged folder.
   void commit();
   const std::string& final_dir() const { return final_; }
+  /// "<host>-<pid>": the suffix of this process's staging folders, so a later process can tell
+  /// whether a left-over one belongs to a live process.
+  static std::string staging_tag();
 
  private:
   std::string final_, staging_;

@@ -5,7 +5,9 @@
 #include <fstream>
 #include <set>
 
+#include "core/json_parse.hpp"
 #include "harness/camera_perception.hpp"
+#include "harness/vision_setup.hpp"
 #include "harness/localizer_registry.hpp"
 #include "sim/render/camera_config.hpp"
 #include "sim/motion.hpp"
@@ -27,6 +29,35 @@ void check_on_floor(const Field& f, const Eigen::Vector2d& p, double clearance, 
     throw ConfigError(path, "[" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + "]",
                       what + " inside the walls (|x| <= " + std::to_string(f.half_floor_x() - clearance) +
                           ", |y| <= " + std::to_string(f.half_floor_y() - clearance) + " m)");
+}
+
+// The name becomes a folder under results/runs/: only a safe file-name character set, and never "."
+// or "..", which would write beside or above results/runs (or collapse into results/runs/<seed>).
+bool safe_name(const std::string& n) {
+  if (n.empty() || n.size() > 100 || n == "." || n == "..") return false;
+  for (char c : n)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-')) return false;
+  return true;
+}
+
+// The file stem as a default name, with characters outside the safe set replaced.
+std::string name_from_stem(const std::string& stem) {
+  std::string n;
+  for (char c : stem) n += (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-') ? c : '_';
+  if (n.size() > 100) n.resize(100);
+  return safe_name(n) ? n : std::string("scenario");
+}
+
+// A data file named in the scenario must be readable and loadable now, not after the run has
+// started writing: its errors are reported at the JSON path that names it.
+template <class Load>
+void check_data_file(const std::string& file, const std::string& where, const std::string& what, Load load) {
+  require_readable_file(file, where, what);
+  try {
+    load();
+  } catch (const std::exception& e) {
+    throw ConfigError(where, "\"" + file + "\" (" + e.what() + ")", what);
+  }
 }
 
 }  // namespace
@@ -96,7 +127,9 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   s.source = source;
   JsonReader r(j, "", &s.effective);
   r.allow("comment");
-  s.name = r.string("name", name);
+  s.name = r.string("name", name_from_stem(name));
+  if (!safe_name(s.name))
+    throw ConfigError("/name", json_brief(Json(s.name)), "a name of 1 to 100 characters from A-Z a-z 0-9 . _ - (not \".\" or \"..\"); it names the results folder");
   s.description = r.string("description", std::string());
   s.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, (1LL << 53)));
   s.duration = r.positive("duration", 30.0, 3600.0);
@@ -191,6 +224,9 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
     const auto v = b->numbers("velocity", std::vector<double>{0, 0}, 2);
     s.ball_position = {p[0], p[1]};
     s.ball_velocity = {v[0], v[1]};
+    // Box2D aborts on a velocity that overflows a float (1e39); the hardest kicks are ~15 m/s.
+    if (s.ball_velocity.norm() > 50.0)
+      throw ConfigError("/ball/velocity", json_brief(j["ball"]["velocity"]), "a ball velocity of at most 50 m/s");
     check_on_floor(s.field, s.ball_position, 0.11, "/ball/position", "a ball position");
     b->finish();
   }
@@ -342,8 +378,15 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   s.vision = vis ? *vis : Json::object();
   {
     Json eff;
-    VisionConfig::from_json(s.vision, "/vision", &eff);
+    const VisionConfig vc = VisionConfig::from_json(s.vision, "/vision", &eff);
     s.effective["vision"] = eff;
+    const auto cam = sim::CameraConfig::from_json(s.camera, "/camera");
+    if (vc.calibration != "auto")
+      check_data_file(vc.calibration, "/vision/calibration", "\"auto\" or a calibration map file for this camera (omniloc calibrate)",
+                      [&] { (void)CalibrationMap::load(vc.calibration, camera_tag(cam), cam.width, cam.height); });
+    if (vc.colour_table != "auto")
+      check_data_file(vc.colour_table, "/vision/colour_table", "\"auto\" or a colour table file for this field (omniloc colour-calibrate)",
+                      [&] { (void)ColourTable::load(vc.colour_table, s.field.fingerprint()); });
   }
   r.finish();
   validate_deep(s);
@@ -359,14 +402,7 @@ void validate_deep(const Scenario& s) {
 }
 
 Scenario load_scenario(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "no readable file", "an existing scenario JSON file");
-  Json j;
-  try {
-    j = Json::parse(in);
-  } catch (const Json::parse_error& e) {
-    throw ConfigError(path, "invalid JSON", std::string("valid JSON (") + e.what() + ")");
-  }
+  const Json j = read_json_strict(path, path);
   return parse_scenario(j, std::filesystem::path(path).stem().string(), path);
 }
 

@@ -1,8 +1,13 @@
 #include "harness/sweep.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
+#include <cstring>
 
 #include <atomic>
 #include <chrono>
@@ -18,6 +23,8 @@
 #include <thread>
 
 #include "core/atomic_file.hpp"
+#include "core/json_parse.hpp"
+#include "harness/run_directory.hpp"
 #include "core/version.hpp"
 #include "harness/scenario.hpp"
 
@@ -27,21 +34,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Largest number of scenario combinations a sweep may hold: every one is validated before any run.
+constexpr std::size_t kMaxCombinations = 10000;
+// Largest number of runs (combinations x seeds): the run list is held in memory with each run's scenario.
+constexpr std::size_t kMaxRuns = 1000000;
+
 std::string sanitize(const std::string& s) {
   std::string o;
   for (char c : s) o += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '=' || c == '+') ? c : '_';
   return o.empty() ? "_" : o;
 }
 
-Json read_json_file(const std::string& path, const std::string& what_path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(what_path, "\"" + path + "\" (no such file)", "an existing JSON file");
-  try {
-    return Json::parse(in);
-  } catch (const Json::parse_error& e) {
-    throw ConfigError(path, "invalid JSON", std::string("valid JSON (") + e.what() + ")");
-  }
-}
+Json read_json_file(const std::string& path, const std::string& what_path) { return read_json_strict(path, what_path); }
 
 // Student t 0.975 quantiles for 1..30 degrees of freedom, then the normal value.
 double t975(std::size_t df) {
@@ -101,11 +105,20 @@ std::string fmt_duration(double s) {
   return b;
 }
 
-// Runs one child `omniloc run`; returns its wait status.
-int spawn_run(const std::string& exe, const std::string& spec, const std::string& out, const std::string& log) {
+// Runs one child `omniloc run`; returns its wait status. `lock_fd` (the run's lock, opened
+// close-on-exec) is handed to the child as a plain descriptor, so the lock stays held as long as
+// either process lives.
+int spawn_run(const std::string& exe, const std::string& spec, const std::string& out, const std::string& log, int lock_fd) {
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) return -1;
   if (pid == 0) {
+    // The child dies with the thread that forked it (the sweep's worker): after kill -9 of the sweep
+    // no orphan keeps running beside a later --resume. If the parent died before prctl took effect,
+    // getppid() already differs.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
+    if (lock_fd >= 0) (void)::dup(lock_fd);  // dup() clears FD_CLOEXEC on the copy
     int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd < 0) fd = ::open("/dev/null", O_WRONLY);
     if (fd >= 0) {
@@ -113,7 +126,8 @@ int spawn_run(const std::string& exe, const std::string& spec, const std::string
       ::dup2(fd, 2);
       ::close(fd);
     }
-    ::execl(exe.c_str(), exe.c_str(), "run", spec.c_str(), "-o", out.c_str(), "--quiet", static_cast<char*>(nullptr));
+    // --overwrite: the sweep owns runs/<id>/ and replaces a previous result of the same run.
+    ::execl(exe.c_str(), exe.c_str(), "run", spec.c_str(), "-o", out.c_str(), "--overwrite", "--quiet", static_cast<char*>(nullptr));
     ::_exit(127);
   }
   int status = 0;
@@ -186,6 +200,12 @@ SweepSpec load_sweep(const std::string& path) {
       const std::string pp = json_child(at, it.key());
       if (it.key().empty() || it.key()[0] != '/') throw ConfigError(pp, "\"" + it.key() + "\"", "a JSON pointer such as /robots/0/motion/speed");
       if (!it.value().is_array() || it.value().empty()) throw ConfigError(pp, json_brief(it.value()), "a non-empty array of values");
+      // The cross product grows multiplicatively; refuse it before building it (each combination
+      // is validated as a scenario below, about 10 ms apiece).
+      if (combos.size() * it.value().size() > kMaxCombinations)
+        throw ConfigError(pp, "an array of " + std::to_string(it.value().size()) + " values, making " +
+                                  std::to_string(combos.size() * it.value().size()) + " combinations",
+                          "at most " + std::to_string(kMaxCombinations) + " parameter combinations per scenario entry");
       std::vector<Combo> next;
       for (const auto& c : combos)
         for (const auto& v : it.value()) {
@@ -246,19 +266,30 @@ SweepSpec load_sweep(const std::string& path) {
     seeds = {1};
   } else if (sj->is_array()) {
     for (std::size_t i = 0; i < sj->size(); ++i) {
-      if (!(*sj)[i].is_number_unsigned()) throw ConfigError(json_child("/seeds", i), json_brief((*sj)[i]), "a non-negative integer seed");
+      if (!(*sj)[i].is_number_unsigned() || (*sj)[i].get<std::uint64_t>() > (1ULL << 53))
+        throw ConfigError(json_child("/seeds", i), json_brief((*sj)[i]), "an integer seed in [0, 2^53] (what a scenario's seed accepts)");
       seeds.push_back((*sj)[i].get<std::uint64_t>());
     }
   } else {
     JsonReader s(*sj, "/seeds");
-    const auto first = s.integer("first", 1, 0);
+    const auto first = s.integer("first", 1, 0, 1LL << 52);
     const auto count = s.integer("count", std::nullopt, 1, 100000);
     s.finish();
     for (long long k = 0; k < count; ++k) seeds.push_back(static_cast<std::uint64_t>(first + k));
   }
   if (seeds.empty()) throw ConfigError("/seeds", "[]", "at least one seed");
+  if (seeds.size() > 1000000) throw ConfigError("/seeds", std::to_string(seeds.size()) + " seeds", "at most 1000000 seeds");
   r.finish();
 
+  std::size_t total = 0;
+  for (const auto& sc : scenarios) total += sc.locs.size() * sc.combos.size();
+  if (total > kMaxCombinations)
+    throw ConfigError("/scenarios", std::to_string(total) + " scenario x localizer x parameter combinations",
+                      "at most " + std::to_string(kMaxCombinations) + " (split the sweep)");
+  if (total * seeds.size() > kMaxRuns)
+    throw ConfigError("/seeds", std::to_string(total * seeds.size()) + " runs (" + std::to_string(total) + " combinations x " +
+                                    std::to_string(seeds.size()) + " seeds)",
+                      "at most " + std::to_string(kMaxRuns) + " runs in one sweep (split it)");
   std::set<std::string> ids;
   for (const auto& sc : scenarios)
     for (const auto& [llabel, lj] : sc.locs)
@@ -312,16 +343,11 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
   fs::create_directories(dir / "failed");
   const std::string exe = o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe").string() : o.omniloc_exe;
   auto finished = [&](const SweepRun& r) { return fs::exists(dir / "runs" / r.id / "summary.json"); };
-  // Staging folders of runs killed mid-write are hidden (".<id>.partial-<pid>"); clear this shard's
-  // only: other shards (Slurm array tasks) may be writing theirs into the same folder right now.
-  std::set<std::string> mine;
-  for (const auto& r : spec.runs)
-    if (static_cast<int>(r.index % o.shard_count) == o.shard_index) mine.insert("." + r.id + ".partial-");
-  for (const auto& e : fs::directory_iterator(dir / "runs")) {
-    const std::string f = e.path().filename().string();
-    const auto at = f.find(".partial-");
-    if (at != std::string::npos && mine.count(f.substr(0, at + 9))) fs::remove_all(e.path());
-  }
+  fs::create_directories(dir / "locks");
+  // Staging folders of runs killed mid-write are hidden (".<id>.partial-<host>-<pid>"); clear those
+  // whose process is gone, never those of runs still going (another shard or Slurm array task
+  // sharing the folder), nor another host's, which cannot be judged from here.
+  remove_stale_partials((dir / "runs").string());
 
   // This shard's runs that still need doing.
   std::vector<const SweepRun*> todo;
@@ -341,28 +367,63 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
   std::atomic<std::size_t> next{0};
   std::size_t done = 0, failed = 0;
   const auto t0 = std::chrono::steady_clock::now();
+  std::size_t busy = 0;  // runs another live process holds the lock of
   auto worker = [&] {
     for (;;) {
       const std::size_t i = next.fetch_add(1);
       if (i >= todo.size()) return;
       const SweepRun& r = *todo[i];
-      const std::string spec_path = (dir / "specs" / (r.id + ".json")).string();
-      write_file_atomic(spec_path, r.scenario.dump(2) + "\n");
-      const std::string log = (dir / "logs" / (r.id + ".log")).string();
-      const auto r0 = std::chrono::steady_clock::now();
-      const int st = spawn_run(exe, spec_path, (dir / "runs" / r.id).string(), log);
-      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-      const bool ok = st >= 0 && WIFEXITED(st) && WEXITSTATUS(st) == 0 && finished(r);
       const fs::path fail_marker = dir / "failed" / (r.id + ".json");
-      if (ok) {
-        std::error_code ec;
-        fs::remove(fail_marker, ec);
-      } else {
-        Json f{{"id", r.id}, {"log", tail_of(log, 2000)}};
-        if (st >= 0 && WIFEXITED(st)) f["exit_code"] = WEXITSTATUS(st);
-        if (st >= 0 && WIFSIGNALED(st)) f["signal"] = WTERMSIG(st);
-        write_file_atomic(fail_marker.string(), f.dump(2) + "\n");
+      bool ok = false;
+      double secs = 0;
+      // One lock per run: a second sweep (a --resume beside a sweep still running, or a
+      // resubmitted shard) skips a run somebody else is running instead of running it twice.
+      const std::string lock_path = (dir / "locks" / (r.id + ".lock")).string();
+      const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+      if (lock_fd >= 0 && ::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+        ::close(lock_fd);
+        std::lock_guard<std::mutex> lock(mu);
+        ++busy;
+        if (o.progress) *o.progress << r.id << ": skipped, another process is running it\n";
+        continue;
       }
+      // Any exception here (a full disk while writing the spec or the failure record) becomes a
+      // recorded failure of this run: an exception escaping a std::thread would abort the sweep.
+      try {
+        if (lock_fd < 0) throw RuntimeFailure("cannot create lock " + lock_path + ": " + std::strerror(errno));
+        if (o.resume && finished(r)) {  // finished by another process since the list was made
+          ::close(lock_fd);
+          std::lock_guard<std::mutex> lock(mu);
+          ++busy;
+          continue;
+        }
+        const std::string spec_path = (dir / "specs" / (r.id + ".json")).string();
+        write_file_atomic(spec_path, r.scenario.dump(2) + "\n");
+        const std::string log = (dir / "logs" / (r.id + ".log")).string();
+        const auto r0 = std::chrono::steady_clock::now();
+        const int st = spawn_run(exe, spec_path, (dir / "runs" / r.id).string(), log, lock_fd);
+        secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+        ok = st >= 0 && WIFEXITED(st) && WEXITSTATUS(st) == 0 && finished(r);
+        if (ok) {
+          std::error_code ec;
+          fs::remove(fail_marker, ec);
+        } else {
+          Json f{{"id", r.id}, {"log", tail_of(log, 2000)}};
+          if (st >= 0 && WIFEXITED(st)) f["exit_code"] = WEXITSTATUS(st);
+          if (st >= 0 && WIFSIGNALED(st)) f["signal"] = WTERMSIG(st);
+          write_file_atomic(fail_marker.string(), f.dump(2) + "\n");
+        }
+      } catch (const std::exception& e) {
+        ok = false;
+        std::lock_guard<std::mutex> lock(mu);
+        if (o.progress) *o.progress << r.id << ": FAILED: " << e.what() << "\n";
+        try {
+          write_file_atomic(fail_marker.string(), Json{{"id", r.id}, {"error", e.what()}}.dump(2) + "\n");
+        } catch (const std::exception&) {
+          // The disk that made the run fail may refuse the record too; the count below still has it.
+        }
+      }
+      if (lock_fd >= 0) ::close(lock_fd);
       std::lock_guard<std::mutex> lock(mu);
       ++done;
       if (!ok) ++failed;
@@ -386,6 +447,7 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
   if (tty) *o.progress << "\n";
   out.ran = done;
   out.failed = failed;
+  out.skipped += busy;
 
   // Aggregate over every run of the sweep found finished in the folder, in run order.
   struct Group {
@@ -411,7 +473,12 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
     if (finished(r)) {
       status = "ok";
       ++g.finished;
-      const Json s = Json::parse(read_file((dir / "runs" / r.id / "summary.json").string()));
+      Json s;
+      try {
+        s = Json::parse(read_file((dir / "runs" / r.id / "summary.json").string()));
+      } catch (const std::exception& e) {
+        throw RuntimeFailure("cannot read the finished run " + r.id + ": " + e.what());
+      }
       for (const auto& [k, v] : run_metrics(s)) g.values[k].push_back(v);
       ++run_versions[s.contains("omniloc") ? s["omniloc"].value("version", std::string("unknown")) : std::string("unrecorded")];
     } else if (fs::exists(dir / "failed" / (r.id + ".json"))) {

@@ -3,4 +3,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DOMNILOC_WERROR=ON "$@" >/dev/null
-cmake --build build -j"$(nproc)"
+# OMNILOC_BUILD_TARGETS="omniloc": only those targets (scripts/run.sh needs no tests or benchmarks).
+cmake --build build -j"$(nproc)" ${OMNILOC_BUILD_TARGETS:+--target $OMNILOC_BUILD_TARGETS}

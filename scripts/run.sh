@@ -12,7 +12,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-scripts/build.sh
+# Only the program it runs: the test and benchmark programs took 157 s of a fresh 9-minute build.
+OMNILOC_BUILD_TARGETS=omniloc scripts/build.sh
 PY=/usr/bin/python3; [ -x "$PY" ] || PY=python3
 jobs="$(nproc)"
 

@@ -7,6 +7,10 @@
 
 namespace omniloc::sim {
 
+namespace {
+constexpr double kMaxSpeed = 10.0;  // m/s, the largest max_speed a robot may have
+}  // namespace
+
 DriveCommand ConstantScript::command(const WorldState& world, int self, double) {
   DriveCommand c;
   c.omega = omega_;
@@ -64,6 +68,11 @@ std::unique_ptr<MotionScript> MotionScript::from_json(const Json& j, const std::
     out = std::make_unique<StillScript>();
   } else if (type == "constant") {
     const auto v = r.numbers("velocity", std::vector<double>{0.0, 0.0}, 2);
+    // Box2D aborts on a velocity that is not finite in float (1e39); the drive clamps to max_speed
+    // anyway, so anything beyond the fastest robot allowed (10 m/s) is a typo.
+    for (std::size_t k = 0; k < 2; ++k)
+      if (std::fabs(v[k]) > kMaxSpeed)
+        throw ConfigError(json_child(r.child_path("velocity"), k), json_brief(j["velocity"][k]), "a speed in [-10, 10] m/s");
     const double omega = r.number("omega", 0.0, -20.0, 20.0);
     const std::string frame = r.string("frame", std::string("world"), {"world", "robot"});
     out = std::make_unique<ConstantScript>(Eigen::Vector2d(v[0], v[1]), omega, frame == "robot");
@@ -75,6 +84,8 @@ std::unique_ptr<MotionScript> MotionScript::from_json(const Json& j, const std::
     if (p.kind == "mark") p.target_robot = static_cast<int>(r.integer("target", std::nullopt, 0, 99));
     if (p.kind == "hold") {
       const auto h = r.numbers("home", std::nullopt, 2);
+      if (std::fabs(h[0]) > 100 || std::fabs(h[1]) > 100)
+        throw ConfigError(r.child_path("home"), json_brief(j["home"]), "a point within 100 m of the centre spot");
       p.home = {h[0], h[1]};
       p.radius = r.number("radius", 0.5, 0.0, 5.0);
     }
@@ -93,6 +104,12 @@ std::unique_ptr<MotionScript> MotionScript::from_json(const Json& j, const std::
       if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
         throw ConfigError(json_child(pp, i), json_brief(p), "a point [x, y] in metres");
       points.emplace_back(p[0].get<double>(), p[1].get<double>());
+      // A waypoint beyond the walls can never be reached (the robot pushes against the wall for
+      // ever); without a field (unit tests) the largest field's floor bounds it.
+      const double hx = field ? field->half_floor_x() : 12.0, hy = field ? field->half_floor_y() : 8.0;
+      if (!(std::fabs(points.back().x()) <= hx && std::fabs(points.back().y()) <= hy))
+        throw ConfigError(json_child(pp, i), json_brief(p),
+                          "a point on the floor inside the walls (|x| <= " + std::to_string(hx) + ", |y| <= " + std::to_string(hy) + " m)");
     }
     const double speed = r.positive("speed", 1.0, 6.0);
     const bool loop = r.boolean("loop", false);

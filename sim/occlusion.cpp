@@ -9,6 +9,11 @@
 
 namespace omniloc::sim {
 
+namespace {
+// More black sectors than this make no sense on a 360-degree panorama of a few hundred pixels round.
+constexpr std::size_t kMaxSectors = 360;
+}  // namespace
+
 double OcclusionMask::fraction() const {
   double w = 0;
   for (const auto& s : sectors) w += s.width;
@@ -36,14 +41,24 @@ OcclusionMask OcclusionMask::from_json(const Json& j, const std::string& path) {
         throw ConfigError(json_child(sp, i), json_brief(e), "a sector [start_deg, width_deg] with 0 < width <= 360");
       m.sectors.push_back({wrap_angle_positive(deg2rad(e[0].get<double>())), deg2rad(e[1].get<double>())});
     }
-    // Overlap check on the circle.
-    for (std::size_t a = 0; a < m.sectors.size(); ++a)
-      for (std::size_t b = 0; b < m.sectors.size(); ++b) {
-        if (a == b) continue;
-        const double off = wrap_angle_positive(m.sectors[b].start - m.sectors[a].start);
-        if (off < m.sectors[a].width - 1e-9)
-          throw ConfigError(json_child(sp, b), json_brief((*sj)[b]), "sectors that do not overlap (it overlaps sector " + std::to_string(a) + ")");
+    // Overlap check on the circle, in O(n log n): sorted by start, a sector can only overlap the
+    // sectors after it by also overlapping its next neighbour (whose start lies between), so
+    // comparing each sector with its circular successor finds every overlap. (The pairwise check
+    // took 34 s for 100000 sectors; the count is also capped, since painting is per sector.)
+    if (m.sectors.size() > kMaxSectors)
+      throw ConfigError(sp, "an array of " + std::to_string(m.sectors.size()) + " sectors",
+                        "at most " + std::to_string(kMaxSectors) + " sectors");
+    std::vector<std::size_t> order(m.sectors.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return m.sectors[x].start < m.sectors[y].start; });
+    for (std::size_t k = 0; order.size() > 1 && k < order.size(); ++k) {
+      const std::size_t a = order[k], b = order[(k + 1) % order.size()];
+      const double off = wrap_angle_positive(m.sectors[b].start - m.sectors[a].start);
+      if (off < m.sectors[a].width - 1e-9) {
+        const std::size_t later = std::max(a, b), earlier = std::min(a, b);
+        throw ConfigError(json_child(sp, later), json_brief((*sj)[later]), "sectors that do not overlap (it overlaps sector " + std::to_string(earlier) + ")");
       }
+    }
   } else {
     const double f = r.number("fraction", std::nullopt, 0.0, 1.0);
     const long long n = sj ? r.integer("sectors", 1, 1, 36) : 1;

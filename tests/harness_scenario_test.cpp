@@ -159,7 +159,9 @@ TEST(ScenarioValidation, SyntaxErrorNamesTheFile) {
     load_scenario(p);
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_EQ(e.path(), p);
+    // The path is the JSON pointer where the parser stood (the object); the message names the file.
+    EXPECT_EQ(e.path(), "");
+    EXPECT_NE(std::string(e.what()).find(p), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("parse error"), std::string::npos);
   }
 }

@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "harness/run_directory.hpp"
 #include "harness/sweep.hpp"
 
 using namespace omniloc;
@@ -196,17 +197,19 @@ TEST(Sweep, ScenarioEntriesCarryTheirOwnParametersAndLocalizers) {
 
 // Shards share one results folder (Slurm array tasks): a shard starting must not delete the staging
 // folder another shard is writing, only the leftovers of its own runs.
-TEST(Sweep, ShardClearsOnlyItsOwnStagingFolders) {
+TEST(Sweep, ShardLeavesLiveStagingFoldersAloneAndClearsDeadOnes) {
+  // Shards (Slurm array tasks) share the runs folder: a shard starting up must not delete the
+  // staging folder of a run another live process is writing, but does clear one whose process died.
   fs::remove_all(test_dir());
   const SweepSpec spec = load_sweep(make_sweep());
   const fs::path runs = test_dir() / "shared" / "runs";
-  const fs::path other = runs / ("." + spec.runs[1].id + ".partial-4242");  // run 1: shard 1 of 2
-  const fs::path mine = runs / ("." + spec.runs[2].id + ".partial-4242");   // run 2: shard 0 of 2
+  const std::string live_tag = omniloc::harness::RunDirectory::staging_tag();  // this test process: alive
+  const std::string host = live_tag.substr(0, live_tag.rfind('-'));
+  const fs::path other = runs / ("." + spec.runs[1].id + ".partial-" + live_tag);        // run 1: shard 1 of 2, live
+  const fs::path dead = runs / ("." + spec.runs[3].id + ".partial-" + host + "-999999999");  // no such pid
   fs::create_directories(other);
-  fs::create_directories(mine);
+  fs::create_directories(dead);
   sweep_into(spec, "shared", 1, true, 1, 0, 2);
   EXPECT_TRUE(fs::exists(other));
-  EXPECT_FALSE(fs::exists(mine));
-  sweep_into(spec, "shared", 1, true, 1, 1, 2);
-  EXPECT_FALSE(fs::exists(other));
+  EXPECT_FALSE(fs::exists(dead));
 }

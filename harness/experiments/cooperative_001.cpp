@@ -1,6 +1,8 @@
 // Experiment "cooperative_001": paper 001's simulation. See cooperative_001.hpp and docs/cooperative.md.
 #include "harness/experiments/cooperative_001.hpp"
 
+#include "core/json_parse.hpp"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -157,15 +159,7 @@ Cooperative001Config parse_cooperative_001(const Json& j) {
 }
 
 Cooperative001Config load_cooperative_001(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw ConfigError(file, "no readable file", "an existing experiment description (JSON)");
-  Json j;
-  try {
-    j = Json::parse(in);
-  } catch (const Json::parse_error& e) {
-    throw ConfigError(file, "invalid JSON", std::string("valid JSON (") + e.what() + ")");
-  }
-  return parse_cooperative_001(j);
+  return parse_cooperative_001(read_json_strict(file, file));
 }
 
 std::string cooperative_001_default_file() { return std::string(OMNILOC_SOURCE_DIR) + "/scenarios/experiments/cooperative_001.json"; }

@@ -20,6 +20,22 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
   c.rim_fraction = r.number("rim_fraction", 0.49, 0.2, 0.5);
   const auto off = r.numbers("centre_offset_px", std::vector<double>{0.0, 0.0}, 2);
   c.centre_offset_px = {off[0], off[1]};
+  // Settings that validate but cannot be calibrated were found at run time ("only 0 of 36
+  // directions showed all 15 patch edges"). Measured with omniloc calibrate on the default mirror:
+  // a mirror radius of 188 px calibrates all 36 directions, 172 px 21, 157 px fails; an offset that
+  // pushes the mirror's disc 5 px past the image border costs half the directions, 16 px more fail.
+  // So the mirror's radius must be at least 180 px and its disc may leave the picture by 10 px at most.
+  const double side = std::min(c.width, c.height), rim_px = c.rim_fraction * side;
+  if (rim_px < 180.0)
+    // Blame rim_fraction when a larger one would do on this image, else the image size.
+    throw ConfigError(r.child_path(0.5 * side >= 180.0 ? "rim_fraction" : c.width <= c.height ? "width" : "height"),
+                      0.5 * side >= 180.0 ? std::to_string(c.rim_fraction) : std::to_string(std::min(c.width, c.height)),
+                      "an image with a mirror radius (rim_fraction x the smaller side, here " + std::to_string(rim_px) +
+                          " px) of at least 180 px; smaller mirror images cannot be calibrated");
+  if (c.centre_offset_px.norm() + rim_px > 0.5 * side + 10.0)
+    throw ConfigError(r.child_path("centre_offset_px"), json_brief(j["centre_offset_px"]),
+                      "an offset of at most " + std::to_string(0.5 * side + 10.0 - rim_px) +
+                          " px (the mirror's disc must stay inside the image, 10 px of it may be cut); otherwise it cannot be calibrated");
   c.mirror_tilt = deg2rad(r.number("mirror_tilt_deg", 0.0, -5.0, 5.0));
   c.vibration_std = deg2rad(r.number("vibration_deg", 0.3, 0.0, 5.0));
   c.latency = 1e-3 * r.number("latency_ms", 0.0, 0.0, 500.0);

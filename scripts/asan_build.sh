@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Builds TARGETS in build-asan/: clang-14 with AddressSanitizer + UndefinedBehaviorSanitizer and
+# libFuzzer coverage, shared by scripts/sanitize.sh (unit tests) and scripts/fuzz.sh (fuzz target),
+# so the libraries are compiled once for both. Installs clang-14 and its runtimes (libFuzzer is in
+# libclang-rt-14-dev) from Debian when missing. Usage: scripts/asan_build.sh TARGET...
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh >/dev/null
+missing=()
+for p in clang-14 libclang-rt-14-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+# RelWithDebInfo: -O2 keeps the sanitized tests fast enough for CI, -g gives readable reports.
+# Benchmarks are not built: they are timing programs, not correctness checks.
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+  -DOMNILOC_SANITIZE=ON -DOMNILOC_FUZZ=ON -DOMNILOC_BUILD_BENCH=OFF >/dev/null
+cmake --build build-asan -j"$(nproc)" --target "$@"

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The unit tests under AddressSanitizer + UndefinedBehaviorSanitizer with leak detection (issue 19).
+# Builds only the unit-test programs and omniloc (the CLI tests run it) in build-asan/, never the
+# slow end-to-end scenario tests or the benchmarks, then runs ctest -LE 'scenario|cluster|mutation'.
+# Leaks inside Mesa (llvmpipe, OSMesa, LLVM) are suppressed by .ci/lsan-mesa.supp, nothing else.
+# Usage: scripts/sanitize.sh [ctest arguments]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+targets=(omniloc)
+for f in tests/*_test.cpp; do
+  name=$(basename "$f" .cpp)
+  case "$name" in scenario_*) continue ;; esac
+  targets+=("$name")
+done
+t0=$(date +%s)
+scripts/asan_build.sh "${targets[@]}"
+t1=$(date +%s)
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=0"
+export LSAN_OPTIONS="suppressions=$PWD/.ci/lsan-mesa.supp:print_suppressions=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+cd build-asan
+# Test programs of the scenario label are not built here: ctest would report them as missing.
+# -E _NOT_BUILT: gtest_discover_tests adds a failing placeholder for each test program not built here.
+# -E Regression.: the committed reference numbers are those of the GCC Release build; this clang
+# build gives slightly different floats (tracking_short: position rmse 0.0476 and 0.0484 m, with no
+# sanitizer report), so that byte-exact gate belongs to the Release stage. Not yet explained.
+ctest --output-on-failure -j"$(nproc)" --timeout 1800 -LE 'scenario|cluster|mutation' -E '_NOT_BUILT$|^Regression\.' "$@"
+echo "sanitize: build $((t1 - t0)) s, tests $(($(date +%s) - t1)) s"
