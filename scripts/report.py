@@ -617,7 +617,7 @@ def load_jsonl(path):
     return out
 
 
-def history_plot(rep, records, field, key, ylabel, caption):
+def history_plot(rep, records, field, key, ylabel, caption, fmt):
     """One line per workload: `field` of every record, relative to the workload's first record, in
     the order the records were appended (one point per measured commit)."""
     series = {}
@@ -640,30 +640,32 @@ def history_plot(rep, records, field, key, ylabel, caption):
     ax.grid(alpha=0.3)
     fig.tight_layout()
     rep.figure(fig, key, caption)
-    first, last = records[0], records[-1]
     rows = []
     for w, pts in sorted(series.items()):
-        rows.append([w, fnum(pts[0][1], 6), fnum(pts[-1][1], 6), fnum(pts[-1][1] / pts[0][1], 3)])
-    rep.table(["workload", f"first ({first.get('commit', '?')})", f"last ({last.get('commit', '?')})", "last / first"], rows)
+        (i0, v0), (i1, v1) = pts[0], pts[-1]
+        rows.append([w, records[i0].get("commit", "?"), fmt(v0), records[i1].get("commit", "?"), fmt(v1), fnum(v1 / v0, 3)])
+    rep.table(["workload", "first commit", "first", "last commit", "last", "last / first"], rows)
 
 
-def report_history(rep, folder):
+def report_history(rep, folder, reference=None):
     # The committed baseline history (one record per baseline change) first, then this machine's runs.
-    reference = pathlib.Path(__file__).resolve().parent.parent / "results" / "reference" / "icount_history.jsonl"
+    reference = pathlib.Path(reference or pathlib.Path(__file__).resolve().parent.parent / "results" / "reference" / "icount_history.jsonl")
     icount = load_jsonl(reference) + load_jsonl(folder / "icount.jsonl")
     bench = load_jsonl(folder / "bench.jsonl")
     if not (icount or bench):
         return
     rep.heading("Speed over commits", 2, "history")
-    rep.para(f"From {reference.relative_to(reference.parents[2])} (committed baselines) and {folder} (this machine): every run of scripts/icount.sh and scripts/bench.sh appends its figures with the commit. "
+    rep.para(f"From {reference} (committed baselines) and {folder} (this machine): every run of scripts/icount.sh and scripts/bench.sh appends its figures with the commit. "
              "Instruction counts (callgrind, fixed work) do not depend on the machine's load; wall times do, so compare "
              "wall times only between records measured in the same minutes.")
     if icount:
         history_plot(rep, icount, "instructions", "history_icount", "instructions / first record",
-                     "instructions per workload (scripts/icount.sh), relative to each workload's first record")
+                     "instructions per workload (scripts/icount.sh), relative to each workload's first record",
+                     lambda v: f"{v:,.0f}")
     if bench:
         history_plot(rep, bench, "real_time_ns", "history_bench", "median wall time / first record",
-                     "Google Benchmark median wall time per benchmark (scripts/bench.sh), relative to its first record")
+                     "Google Benchmark median wall time per benchmark (scripts/bench.sh), relative to its first record",
+                     lambda v: f"{v:,.1f} ns")
 
 
 def picture_order(p):

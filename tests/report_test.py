@@ -305,3 +305,27 @@ class IcountGateTest(unittest.TestCase):
             r = subprocess.run(cmd, capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
             self.assertEqual(len((d / "h.jsonl").read_text().splitlines()), 3)
+
+
+class HistoryTest(unittest.TestCase):
+    """report.py's "Speed over commits": per workload the first and last record and their ratio, from
+    the committed baseline history followed by this machine's runs; a cut line is skipped."""
+
+    def test_first_last_and_ratio_per_workload(self):
+        import report
+        with tempfile.TemporaryDirectory() as d:
+            d = pathlib.Path(d)
+            ref = d / "icount_history.jsonl"
+            ref.write_text(json.dumps({"commit": "aaa", "instructions": {"matching": 200}}) + "\n")
+            (d / "hist").mkdir()
+            (d / "hist" / "icount.jsonl").write_text(
+                json.dumps({"commit": "bbb", "instructions": {"matching": 150, "mcl": 10}}) + "\n{\"commit\": \"cut")
+            (d / "hist" / "bench.jsonl").write_text(json.dumps({"commit": "bbb", "real_time_ns": {"BM_X": 5.0}}) + "\n")
+            rep = report.Report(str(d / "out"), "t")
+            report.report_history(rep, d / "hist", reference=ref)
+            rep.write()
+            md = (d / "out" / "report.md").read_text()
+            self.assertIn("| matching | aaa | 200 | bbb | 150 | 0.750 |", md)
+            self.assertIn("| mcl | bbb | 10 | bbb | 10 | 1.000 |", md)
+            self.assertIn("| BM_X | bbb | 5.0 ns | bbb | 5.0 ns | 1.000 |", md)
+            self.assertEqual(md.count(".png)"), 2)
