@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 
 #include <atomic>
@@ -441,6 +442,14 @@ SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
       }
     }
   };
+  // llvmpipe draws with one thread per core by default, so N parallel runs on N cores would run N^2
+  // rasterizer threads: on 2 cores -j 2 took 19.0-19.7 s for 8 short tracking runs with the default
+  // and 16.6-17.9 s with one thread per run (docs/performance.md). Results are byte-identical with
+  // any thread count. The children inherit the variable; a value the user set is kept.
+  if (o.jobs > 1 && std::getenv("LP_NUM_THREADS") == nullptr) {
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    ::setenv("LP_NUM_THREADS", std::to_string(std::max(1u, cores / static_cast<unsigned>(o.jobs))).c_str(), 0);
+  }
   std::vector<std::thread> pool;
   for (int k = 0; k < std::max(1, o.jobs); ++k) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
