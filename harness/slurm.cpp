@@ -454,6 +454,9 @@ SlurmSubmission submit_slurm(const SweepSpec& spec, const std::string& spec_path
       "#SBATCH --output=" + (folder / "logs" / "task-%A_%a.log").string() + "\n" + common + prologue +
       "# N is fixed here, not read from SLURM_ARRAY_TASK_COUNT: a resubmitted subset has another count.\n"
       "N=" + std::to_string(out.tasks) + "\n"
+      "# llvmpipe would start one rendering thread per core of the whole node; the task owns only its\n"
+      "# --cpus-per-task cores, shared by its -j runs (an LP_NUM_THREADS set in env.sh is kept).\n"
+      "export LP_NUM_THREADS=\"${LP_NUM_THREADS:-1}\"\n"
       "exec " + shq(exe) + " sweep " + shq(spec_abs.string()) + " --shard \"${SLURM_ARRAY_TASK_ID}/${N}\"" + shard_cmd_tail + "\n";
   const std::string report = (folder / "report.txt").string();
   const std::string merge_sbatch =
