@@ -34,7 +34,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 command -v valgrind >/dev/null || scripts/install-deps.sh
-[ -f build/CMakeCache.txt ] || cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DOMNILOC_WERROR=ON >/dev/null
+[ -f build/CMakeCache.txt ] || scripts/build.sh  # one place for the configure flags
 cmake --build build -j"$(nproc)" --target icount >/dev/null
 
 work=$(mktemp -d)

@@ -53,6 +53,12 @@ def cpu_signature():
     return {"model": model, "isa": isa}
 
 
+def append_jsonl(path, record):
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    with open(path, "a") as f:
+        f.write(json.dumps(record, sort_keys=True) + "\n")
+
+
 def write_atomic(path, text):
     folder = os.path.dirname(path) or "."
     os.makedirs(folder, exist_ok=True)
@@ -84,9 +90,7 @@ def main():
               "tool": valgrind + " callgrind", "cpu": cpu_signature(), "instructions": dict(sorted(counts.items())),
               "valgrind_seconds": {w: ms[w] / 1000.0 for w in sorted(ms)}}
     if a.history:
-        os.makedirs(os.path.dirname(a.history) or ".", exist_ok=True)
-        with open(a.history, "a") as f:
-            f.write(json.dumps(record, sort_keys=True) + "\n")
+        append_jsonl(a.history, record)
     if a.out:
         write_atomic(a.out, json.dumps(record, indent=2, sort_keys=True) + "\n")
     base_record = json.load(open(a.baseline)) if os.path.exists(a.baseline) else {}
@@ -102,13 +106,12 @@ def main():
     if a.update:
         merged = dict(base)
         merged.update(counts)
-        rec = {k: v for k, v in record.items() if k != "valgrind_seconds"}
-        rec["instructions"] = dict(sorted(merged.items()))
-        rec["threshold_percent"] = a.threshold
-        write_atomic(a.baseline, json.dumps(rec, indent=2, sort_keys=True) + "\n")
+        # Valgrind's wall time is this machine's, not part of the committed records.
+        stored = {k: v for k, v in record.items() if k != "valgrind_seconds"}
+        write_atomic(a.baseline, json.dumps(dict(stored, instructions=dict(sorted(merged.items())), threshold_percent=a.threshold),
+                                            indent=2, sort_keys=True) + "\n")
         # The committed history: one record per baseline change, drawn by scripts/report.py.
-        with open(os.path.join(os.path.dirname(a.baseline) or ".", "icount_history.jsonl"), "a") as f:
-            f.write(json.dumps({k: v for k, v in record.items() if k != "valgrind_seconds"}, sort_keys=True) + "\n")
+        append_jsonl(os.path.join(os.path.dirname(a.baseline) or ".", "icount_history.jsonl"), stored)
         print(f"baseline written: {a.baseline} (commit {a.commit}); commit it with a message that says why")
         return 0
     if failed:
