@@ -15,6 +15,7 @@ struct World::Robot {
   b2Body* body = nullptr;
   Eigen::Vector2d wheel_velocity = Eigen::Vector2d::Zero();  // world frame, what the drive does
   double wheel_omega = 0.0;
+  Eigen::Vector2d drive_accel = Eigen::Vector2d::Zero();  // world frame, m/s^2, over the last step
   DriveCommand cmd;
   Pose2 last_wheel_motion;
   bool contact = false;
@@ -137,6 +138,7 @@ void World::teleport(int robot_id, const Pose2& pose) {
   r.body->SetAngularVelocity(0);
   r.wheel_velocity.setZero();
   r.wheel_omega = 0.0;
+  r.drive_accel.setZero();
 }
 
 void World::step() {
@@ -145,7 +147,9 @@ void World::step() {
     Eigen::Vector2d v = r->cmd.velocity;
     if (v.norm() > s.max_speed) v *= s.max_speed / v.norm();
     const double w = std::clamp(r->cmd.omega, -s.max_omega, s.max_omega);
+    const Eigen::Vector2d before = r->wheel_velocity;
     r->wheel_velocity = approach(r->wheel_velocity, v, s.max_accel * dt_);
+    r->drive_accel = (r->wheel_velocity - before) / dt_;
     r->wheel_omega += std::clamp(w - r->wheel_omega, -s.max_alpha * dt_, s.max_alpha * dt_);
     // The drive imposes its velocity on the body; contacts then act within the step, so a robot
     // stopped by a wall or pushed by another ends up where its wheels did not take it.
@@ -183,6 +187,8 @@ WorldState World::state() const {
     rs.team = r->spec.team;
     rs.pose = pose(r->spec.id);
     rs.velocity = {r->body->GetLinearVelocity().x, r->body->GetLinearVelocity().y};
+    rs.omega = r->body->GetAngularVelocity();
+    rs.acceleration = r->drive_accel;
     rs.radius = r->spec.radius;
     rs.height = r->spec.height;
     s.robots.push_back(rs);

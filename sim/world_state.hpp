@@ -15,6 +15,10 @@ struct RobotState {
   int team = 0;             ///< 0 = the observer's team, 1 = opponents
   Pose2 pose;               ///< world frame
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< world frame, m/s
+  double omega = 0.0;                                  ///< rad/s, anticlockwise
+  /// What the drive's wheels push the body with over the last physics step (world frame, m/s^2);
+  /// the camera turns it into the body's tilt on its suspension. Contact forces are not included.
+  Eigen::Vector2d acceleration = Eigen::Vector2d::Zero();
   double radius = 0.26;     ///< footprint radius, metres (MSL robots ~0.52 m across)
   double height = 0.8;      ///< metres
 };

@@ -39,6 +39,10 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
   c.mirror_tilt = deg2rad(r.number("mirror_tilt_deg", 0.0, -5.0, 5.0));
   c.vibration_std = deg2rad(r.number("vibration_deg", 0.3, 0.0, 5.0));
   c.latency = 1e-3 * r.number("latency_ms", 0.0, 0.0, 500.0);
+  c.tilt_per_accel = deg2rad(r.number("tilt_deg_per_mps2", 0.0, 0.0, 5.0));
+  c.optical_blur_px = r.number("optical_blur_px", 0.0, 0.0, 20.0);
+  c.focus_radius_fraction = r.number("focus_radius_fraction", 0.5, 0.0, 0.95);
+  c.motion_blur = r.boolean("motion_blur", false);
   c.read_noise = r.number("read_noise", 1.5, 0.0, 50.0);
   c.shot_noise = r.number("shot_noise", 0.35, 0.0, 10.0);
   c.backend = r.string("backend", std::string("osmesa"), gl_backends());
@@ -62,7 +66,9 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
 Json CameraConfig::to_json() const {
   return Json{{"width", width}, {"height", height}, {"mount_height", mount_height}, {"mirror", mirror}, {"rim_fraction", rim_fraction},
               {"centre_offset_px", {centre_offset_px.x(), centre_offset_px.y()}}, {"mirror_tilt_deg", rad2deg(mirror_tilt)},
-              {"vibration_deg", rad2deg(vibration_std)}, {"latency_ms", 1e3 * latency}, {"read_noise", read_noise}, {"shot_noise", shot_noise}, {"backend", backend},
+              {"vibration_deg", rad2deg(vibration_std)}, {"latency_ms", 1e3 * latency},
+              {"tilt_deg_per_mps2", rad2deg(tilt_per_accel)}, {"optical_blur_px", optical_blur_px},
+              {"focus_radius_fraction", focus_radius_fraction}, {"motion_blur", motion_blur}, {"read_noise", read_noise}, {"shot_noise", shot_noise}, {"backend", backend},
               {"quality", quality}, {"exposure", initial.exposure_ms}, {"gain", initial.gain}, {"exposure_min", exposure_min},
               {"exposure_max", exposure_max}, {"gain_min", gain_min}, {"gain_max", gain_max}};
 }

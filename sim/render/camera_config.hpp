@@ -17,6 +17,14 @@ struct CameraConfig {
   double rim_fraction = 0.49;           ///< mirror rim radius as a fraction of min(width, height)
   Eigen::Vector2d centre_offset_px{0.0, 0.0};  ///< mirror axis offset from the image centre, pixels
   double mirror_tilt = 0.0;             ///< fixed mirror tilt about the robot's x axis, radians
+  /// Body tilt on the suspension per unit of drive acceleration, radians per m/s^2 (0: a rigid robot).
+  double tilt_per_accel = 0.0;
+  /// Defocus blur-circle diameter at the mirror's rim, image pixels (0: sharp everywhere), and the
+  /// image radius in focus, as a fraction of the rim radius (docs/camera.md "Optical blur").
+  double optical_blur_px = 0.0;
+  double focus_radius_fraction = 0.5;
+  /// Integrate the image over the exposure: this robot's rotation as a polar smear, translations by sub-frames.
+  bool motion_blur = false;
   double latency = 0.0;                 ///< seconds between exposure and the odometry it is paired with
   double vibration_std = 0.0052;        ///< per-frame roll/pitch std, radians (0.3 deg: a robot on carpet)
   double read_noise = 1.5;              ///< DN at gain 18

@@ -5,6 +5,7 @@
 // neither glvnd's libGL nor libOSMesa is linked and their gl* symbols can never clash. Rendering
 // always goes into a framebuffer object that is read back with glReadPixels, the same on both.
 #include <memory>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,8 @@ class GlContext {
   void bind_framebuffer(int width, int height);
   /// Reads the bound framebuffer as RGBA8, rows bottom-up (GL order).
   void read_rgba(std::vector<unsigned char>& out) const;
+  /// The same at the framebuffer's 16 bits per channel.
+  void read_rgba16(std::vector<std::uint16_t>& out) const;
   bool has_extension(const std::string& name) const;
   /// Compiles and links a program of one GLSL fragment shader (the vertex stage stays fixed
   /// function). Throws RuntimeFailure with the compiler's log, naming the back-end and `what`.

@@ -79,6 +79,16 @@ MirrorProfile MirrorProfile::preset(const std::string& name, double rim_px, doub
       }
       return 0.5 * (lo + hi) - kPi / 2;
     };
+  } else if (name == "nubot_tan") {
+    // A measured mirror: NuBot's published calibration of one of its robots (nubot-nudt/nubot_ws,
+    // src/nubot/omni_vision/calib_results/2/mirror_calib.xml and ROI.xml): floor distance
+    // d(r) = a tan(b r), a = 1.6768 m, b = 0.0067311 rad/px on a 485 px image whose mirror ends at
+    // max_radius = pi / (2b) = 233.4 px, the horizon; the robot's body hides the image within
+    // small_radius = 38 px, i.e. the floor within a tan(38 b) = 0.44 m. Scaled to this image's rim
+    // (b = pi / (2 rim)), so the horizon again falls on the rim; a and the body's floor radius are kept.
+    const double a = 1.6768, b = kPi / (2.0 * rim_px), body_floor = 1.6768 * std::tan(38.0 * 0.0067311);
+    m.body_px_ = std::atan(body_floor / a) / b;
+    elev_of_r = [a, b, mount_height](double r) { return r >= kPi / (2.0 * b) ? 0.0 : -std::atan2(mount_height, a * std::tan(b * r)); };
   } else {
     std::string known;
     for (const auto& p : presets()) known += (known.empty() ? "\"" : ", \"") + p + "\"";

@@ -10,10 +10,10 @@ namespace omniloc::sim {
 
 class MirrorProfile {
  public:
-  /// "nubot_composite" (default) or "hyperbolic"; scaled so that the outer rim sits at `rim_px`.
+  /// "nubot_composite" (default), "hyperbolic" or "nubot_tan" (NuBot's measured d = a tan(b r)); scaled so that the outer rim sits at `rim_px`.
   /// `mount_height`: viewpoint height above the floor, metres. Throws ConfigError (path "/camera/mirror").
   static MirrorProfile preset(const std::string& name, double rim_px, double mount_height);
-  static std::vector<std::string> presets() { return {"nubot_composite", "hyperbolic"}; }
+  static std::vector<std::string> presets() { return {"nubot_composite", "hyperbolic", "nubot_tan"}; }
 
   /// Image radius (px) of a ray of elevation e (rad). Extrapolated beyond the rim (outside the image).
   double radius(double elevation) const;

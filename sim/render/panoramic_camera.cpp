@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 
 #include "core/angles.hpp"
 #include "core/error.hpp"
+#include "sim/render/image_blur.hpp"
 
 namespace omniloc::sim {
 
@@ -237,10 +240,15 @@ struct PanoramicCameraImpl {
   std::vector<unsigned> mesh_idx;
   SharedTris walls;                    // the hall's walls
   SharedTris statics;                  // goals, landmarks
-  std::vector<unsigned char> readback;
+  std::vector<unsigned char> readback;      // labels, RGBA8
+  std::vector<std::uint16_t> readback16;   // radiance, RGBA16
+  std::vector<std::uint16_t> subframe;     // one sub-frame of a motion-blurred exposure
+  std::vector<std::uint32_t> accumulate;   // the sum of the sub-frames
+  std::unique_ptr<RadialDefocus> defocus;  // null: sharp
+  std::unique_ptr<RotationSmear> smear;    // null: no motion blur
+  double finest_floor_m_per_px = 0.0;      // the smallest floor extent of an image pixel (at the body's edge)
   std::vector<std::uint8_t> noise;     // standard normals in steps of kNoiseStep, drawn once from the first render's Rng
-  std::vector<std::uint8_t> table;     // output value by GL level and noise step, for table_settings
-  CameraSettings table_settings;
+  std::vector<float> row_radiance;     // photometry scratch: one row's linear values
   // Per-draw scratch.
   std::vector<float> pos, col, tex;
   std::vector<float> shared_xyz;       // this frame's projections of a SharedTris' vertices
@@ -408,6 +416,30 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   }
   m.walls = share_vertices(std::move(wall_tris));
   m.statics = share_vertices(std::move(static_tris));
+
+  // Defocus (docs/camera.md "Optical blur"): the camera focuses on the mirror's virtual image at
+  // focus_radius; elsewhere the virtual image lies off the focused surface by a depth that grows
+  // with the squared image radius (a curved image surface), so the blur circle's diameter is
+  // b(r) = optical_blur_px |r^2 - rf^2| / (rim^2 - rf^2); a uniform disc of diameter b has a
+  // per-axis std of b / 4, used as the Gaussian's sigma.
+  if (cfg_.optical_blur_px > 0) {
+    const double rim = mirror_.rim(), rf = cfg_.focus_radius_fraction * rim;
+    const int n = static_cast<int>(std::ceil(rim * m.ss)) + 2;
+    std::vector<double> sigma(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const double r = static_cast<double>(i) / m.ss;
+      sigma[static_cast<std::size_t>(i)] = m.ss * 0.25 * cfg_.optical_blur_px * std::fabs(r * r - rf * rf) / (rim * rim - rf * rf);
+    }
+    m.defocus = std::make_unique<RadialDefocus>(m.W, m.H, centre() * m.ss, rim * m.ss, sigma);
+  }
+  if (cfg_.motion_blur) m.smear = std::make_unique<RotationSmear>(m.W, m.H, centre() * m.ss, mirror_.rim() * m.ss);
+  // The floor's finest sampling sets how many sub-frames an exposure of a moving robot needs.
+  m.finest_floor_m_per_px = 1e9;
+  for (double r = mirror_.body_radius(); r + 1.0 <= mirror_.rim(); r += 1.0) {
+    const double e0 = mirror_.elevation(r), e1 = mirror_.elevation(r + 1.0);
+    if (e1 >= -1e-6) break;
+    m.finest_floor_m_per_px = std::min(m.finest_floor_m_per_px, cfg_.mount_height / std::tan(-e1) - cfg_.mount_height / std::tan(-e0));
+  }
 }
 
 PanoramicCamera::~PanoramicCamera() {
@@ -755,34 +787,64 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
       m.noise[i] = static_cast<std::uint8_t>(std::clamp(std::lround(kNoiseZero + rng.normal() / kNoiseStep), 0L, 255L));
     std::copy(m.noise.begin(), m.noise.begin() + static_cast<std::ptrdiff_t>(m.noise.size() - n), m.noise.begin() + static_cast<std::ptrdiff_t>(n));
   }
-  const double roll = cfg_.mirror_tilt + (cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0);
-  const double pitch = cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0;
+  // Tilt: per-frame vibration plus the body's pitch and roll on its suspension under the drive's
+  // acceleration (forward acceleration tips the top backwards, acceleration to the left tips it
+  // to the right; docs/camera.md "Tilt").
+  const Eigen::Vector2d acc = Pose2(0, 0, me->pose.theta).inverse_transform(me->acceleration);
+  const double roll = cfg_.mirror_tilt + (cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0) + cfg_.tilt_per_accel * acc.y();
+  const double pitch = (cfg_.vibration_std > 0 ? rng.normal(0.0, cfg_.vibration_std) : 0.0) - cfg_.tilt_per_accel * acc.x();
   const std::uint64_t off = rng.next_u64();
 
   m.ctx->make_current();
   m.ctx->bind_framebuffer(m.W, m.H);
-  draw_scene(m, cfg_, mirror_, centre(), world, *me, camera_rotation(roll, pitch), false);
-  m.ctx->read_rgba(m.readback);
-
-  // Photometry: the output value for every GL level (sum of ss * ss samples) and noise step, a
-  // table rebuilt when the settings change; then one lookup per pixel and channel.
-  const int samples = m.ss * m.ss;
-  const int levels = 255 * samples + 1;
-  if (m.table_settings.exposure_ms != st.exposure_ms || m.table_settings.gain != st.gain || m.table.empty()) {
-    m.table_settings = st;
-    m.table.resize(static_cast<std::size_t>(levels) * 256);
-    const double gainf = st.gain / 18.0;
-    const double per_unit = kRadianceScale / 255.0 / samples * kResponse * st.exposure_ms * st.gain;
-    for (int l = 0; l < levels; ++l) {
-      const double mean = l * per_unit;
-      const double sigma = std::sqrt(cfg_.read_noise * cfg_.read_noise * gainf * gainf + cfg_.shot_noise * cfg_.shot_noise * std::min(255.0, mean) * gainf);
-      for (int q = 0; q < 256; ++q) {
-        const double val = mean + sigma * (q - kNoiseZero) * kNoiseStep;
-        m.table[static_cast<std::size_t>(l) * 256 + q] = static_cast<std::uint8_t>(val <= 0.0 ? 0.0 : (val >= 255.0 ? 255.0 : val + 0.5));
-      }
-    }
+  const Eigen::Matrix3d R = camera_rotation(roll, pitch);
+  // Motion blur: the sensor integrates over the exposure [t - T, t]. Translation (of this robot and
+  // everything else moving) by sub-frames along constant velocities, as many as the fastest image
+  // motion needs at the floor's finest sampling (one per pixel of smear, at most kMaxSubframes);
+  // this robot's rotation about the mirror axis as an exact polar smear of omega * T below.
+  const double exposure_s = cfg_.motion_blur ? 1e-3 * st.exposure_ms : 0.0;
+  constexpr int kMaxSubframes = 3;
+  int subframes = 1;
+  if (exposure_s > 0) {
+    const double px = me->velocity.norm() * exposure_s / m.finest_floor_m_per_px;
+    subframes = std::clamp(static_cast<int>(std::ceil(px)), 1, kMaxSubframes);
   }
-  const std::uint8_t* table = m.table.data();
+  if (subframes == 1) {
+    draw_scene(m, cfg_, mirror_, centre(), world, *me, R, false);
+    m.ctx->read_rgba16(m.readback16);
+  } else {
+    m.accumulate.assign(static_cast<std::size_t>(m.W) * m.H * 4, 0u);
+    for (int k = 0; k < subframes; ++k) {
+      const double back = exposure_s * (1.0 - (k + 0.5) / subframes);  // seconds before t
+      WorldState w = world;
+      for (auto& r : w.robots) r.pose = Pose2(r.pose.x - back * r.velocity.x(), r.pose.y - back * r.velocity.y(), r.pose.theta);
+      w.ball.position -= back * w.ball.velocity;
+      draw_scene(m, cfg_, mirror_, centre(), w, *w.robot(robot_id), R, false);
+      m.ctx->read_rgba16(m.subframe);
+      for (std::size_t i = 0; i < m.subframe.size(); ++i) m.accumulate[i] += m.subframe[i];
+    }
+    m.readback16.resize(m.accumulate.size());
+    for (std::size_t i = 0; i < m.accumulate.size(); ++i)
+      m.readback16[i] = static_cast<std::uint16_t>((m.accumulate[i] + static_cast<std::uint32_t>(subframes / 2)) / static_cast<std::uint32_t>(subframes));
+  }
+  const Rgba16View view{m.readback16.data(), m.W, m.H};
+  // Over the exposure the robot turned by omega * T; the image at time t - s is the final one turned
+  // back by omega * s about the mirror axis (robot forward up, left left: a left turn moves the
+  // scene clockwise on the image).
+  if (m.smear) m.smear->apply(view, me->omega * exposure_s);
+  if (m.defocus) m.defocus->apply(view);
+
+  // Photometry per pixel and channel from the full 16 bits (a table by 8-bit GL level, the way
+  // until photometry v3, put steps of up to 8 DN into a dimly lit carpet once exposure and gain
+  // were raised): value = radiance * K * exposure * gain, plus noise of std
+  // sqrt(read^2 (g/18)^2 + shot^2 * min(255, value) * g/18) times a standard normal from the
+  // table, rounded and clipped. Written as plain float arithmetic over one row so it vectorises.
+  const int samples = m.ss * m.ss;
+  const float per_unit = static_cast<float>(kRadianceScale / 65535.0 / samples * kResponse * st.exposure_ms * st.gain);
+  const float gainf = static_cast<float>(st.gain / 18.0);
+  const float var_read = static_cast<float>(cfg_.read_noise * cfg_.read_noise) * gainf * gainf;
+  const float var_shot = static_cast<float>(cfg_.shot_noise * cfg_.shot_noise) * gainf;
+  const float step = static_cast<float>(kNoiseStep), zero = static_cast<float>(kNoiseZero);
   Image img;
   img.width = cfg_.width;
   img.height = cfg_.height;
@@ -792,6 +854,7 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
   const Eigen::Vector2d c = centre();
   const double rim = mirror_.rim();
   std::fill(img.rgb.begin(), img.rgb.end(), std::uint8_t{0});  // outside the mirror: black
+  std::vector<float>& radiance = m.row_radiance;
   for (int v = 0; v < img.height; ++v) {
     // The span of this row inside the mirror rim.
     const double dv = v + 0.5 - c.y();
@@ -800,22 +863,30 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
     const int u0 = std::max(0, static_cast<int>(std::ceil(c.x() - half - 0.5)));
     const int u1 = std::min(img.width - 1, static_cast<int>(std::floor(c.x() + half - 0.5)));
     if (u1 < u0) continue;
-    std::uint8_t* out = img.row(v);
-    const std::uint8_t* nz = &m.noise[k];
-    const unsigned char* r0 = &m.readback[static_cast<std::size_t>(m.H - 1 - v * m.ss) * m.W * 4];  // GL rows bottom-up
-    auto emit = [&](int u, int ch, int sum) { out[3 * u + ch] = table[(static_cast<std::size_t>(sum) << 8) | nz[3 * (u - u0) + ch]]; };
+    const int n = 3 * (u1 - u0 + 1);
+    radiance.resize(static_cast<std::size_t>(n));
+    const std::uint16_t* r0 = &m.readback16[static_cast<std::size_t>(m.H - 1 - v * m.ss) * m.W * 4];  // GL rows bottom-up
     if (m.ss == 1) {
       for (int u = u0; u <= u1; ++u)
-        for (int ch = 0; ch < 3; ++ch) emit(u, ch, r0[u * 4 + ch]);
+        for (int ch = 0; ch < 3; ++ch) radiance[static_cast<std::size_t>(3 * (u - u0) + ch)] = r0[u * 4 + ch];
     } else {
-      const unsigned char* r1 = r0 - static_cast<std::ptrdiff_t>(m.W) * 4;
+      const std::uint16_t* r1 = r0 - static_cast<std::ptrdiff_t>(m.W) * 4;
       for (int u = u0; u <= u1; ++u)
         for (int ch = 0; ch < 3; ++ch) {
           const int a = (2 * u) * 4 + ch, b = a + 4;
-          emit(u, ch, r0[a] + r0[b] + r1[a] + r1[b]);
+          radiance[static_cast<std::size_t>(3 * (u - u0) + ch)] = static_cast<float>(r0[a] + r0[b] + r1[a] + r1[b]);
         }
     }
-    k = (k + 3 * static_cast<std::size_t>(u1 - u0 + 1)) & mask;
+    const std::uint8_t* nz = &m.noise[k];
+    std::uint8_t* out = img.row(v) + 3 * u0;
+    const float* rad = radiance.data();
+    for (int i = 0; i < n; ++i) {
+      const float mean = rad[i] * per_unit;
+      const float sigma = std::sqrt(var_read + var_shot * std::min(mean, 255.0f));
+      const float val = mean + sigma * (static_cast<float>(nz[i]) - zero) * step + 0.5f;
+      out[i] = static_cast<std::uint8_t>(std::clamp(val, 0.0f, 255.0f));
+    }
+    k = (k + static_cast<std::size_t>(n)) & mask;
   }
   return img;
 }
