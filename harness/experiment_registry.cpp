@@ -1,6 +1,7 @@
 #include "harness/experiment.hpp"
 #include "harness/experiments/cooperative_001.hpp"
 #include "harness/experiments/entropy_maps.hpp"
+#include "harness/experiments/error_budget.hpp"
 #include "harness/experiments/global_figures.hpp"
 #include "harness/experiments/landmark_maps.hpp"
 
@@ -16,6 +17,10 @@ const std::vector<ExperimentInfo>& experiments() {
        "paper 001 simulation: Hough-space ball fix by 5 robots over a lossy network (equal vs 1/L weights, error vs robot count), "
        "FBPF vs MFBPF growth model, trackers on the fixes (scenarios/experiments/cooperative_001.json)",
        run_cooperative_001, validate_cooperative_001},
+      {"error_budget",
+       "issue 17: the tracking path with every error source off, each alone, and all together (robot, field_robot), for matching, "
+       "MCL and the hybrid (scenarios/experiments/error_budget.json)",
+       run_error_budget, validate_error_budget},
       {"landmark_maps", "paper 004 solver error maps and table 1, paper 003 landmark groups with voting (simulation)", run_landmark_maps},
   };
   return list;

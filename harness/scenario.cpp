@@ -396,8 +396,8 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
     const VisionConfig vc = VisionConfig::from_json(s.vision, "/vision", &eff);
     s.effective["vision"] = eff;
     const auto cam = sim::CameraConfig::from_json(s.camera, "/camera");
-    if (vc.calibration != "auto")
-      check_data_file(vc.calibration, "/vision/calibration", "\"auto\" or a calibration map file for this camera (omniloc calibrate)",
+    if (vc.calibration != "auto" && vc.calibration != "exact")
+      check_data_file(vc.calibration, "/vision/calibration", "\"auto\", \"exact\" or a calibration map file for this camera (omniloc calibrate)",
                       [&] { (void)CalibrationMap::load(vc.calibration, camera_tag(cam), cam.width, cam.height); });
     if (vc.colour_table != "auto")
       check_data_file(vc.colour_table, "/vision/colour_table", "\"auto\" or a colour table file for this field (omniloc colour-calibrate)",

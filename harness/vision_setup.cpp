@@ -162,8 +162,28 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
   return t;
 }
 
+CalibrationMap exact_calibration(const sim::CameraConfig& cfg) {
+  // The simulator's own mirror, centre and mount, tabulated in the map's format (72 directions,
+  // floor distances every 5 cm from the body's edge to 8 m, the model-free map's range).
+  const double rim = cfg.rim_fraction * std::min(cfg.width, cfg.height);
+  const sim::MirrorProfile mirror = sim::MirrorProfile::preset(cfg.mirror, rim, cfg.mount_height);
+  const double h = cfg.mount_height;
+  const double d_body = h / std::tan(-mirror.elevation(mirror.body_radius()));
+  std::vector<double> dist;
+  for (double d = std::ceil((d_body + 0.01) / 0.05) * 0.05; d <= 8.0 + 1e-9; d += 0.05) dist.push_back(d);
+  std::vector<double> radii;
+  for (double d : dist) radii.push_back(mirror.radius(-std::atan2(h, d)));
+  const int n = 72;
+  const Eigen::Vector2d centre = Eigen::Vector2d(0.5 * cfg.width, 0.5 * cfg.height) + cfg.centre_offset_px;
+  CalibrationMap map;
+  map.set_tables(cfg.width, cfg.height, centre, std::vector<std::vector<double>>(n, radii), std::vector<std::vector<double>>(n, dist));
+  map.tag = camera_tag(cfg);
+  return map;
+}
+
 CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed) {
   const std::string tag = camera_tag(cfg);
+  if (path == "exact") return exact_calibration(cfg);
   if (path != "auto") return CalibrationMap::load(path, tag, cfg.width, cfg.height);
   const std::string file = std::string(kCache) + "/calibration_" + tag + ".json";
   if (std::filesystem::exists(file)) {

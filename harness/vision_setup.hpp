@@ -26,6 +26,10 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
 std::string camera_tag(const sim::CameraConfig& cfg);
 
 /// The map for `cfg`: from `path` when given ("auto" = cached, calibrating when missing).
+/// A perfect calibration: the simulator's true mirror profile and centre in the map's format (no
+/// tilt). A measurement-model baseline for the error budget ("calibration": "exact"), never a default.
+CalibrationMap exact_calibration(const sim::CameraConfig& cfg);
+/// "auto": the model-free calibration (cached under results/cache), "exact": exact_calibration, else a map file.
 CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed);
 /// The colour table for `cfg` and `field`: from `path` when given ("auto" = cached or learned).
 ColourTable colour_table_for(const sim::CameraConfig& cfg, const Field& field, const std::string& path, std::uint64_t seed);

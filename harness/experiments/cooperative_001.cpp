@@ -425,17 +425,6 @@ PathStats run_path(const Cooperative001Config& c, CoopNoiseModel model, const si
   return s;
 }
 
-std::string machine_text() {
-  std::string model = "unknown CPU";
-  std::ifstream in("/proc/cpuinfo");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("model name", 0) == 0) {
-      model = line.substr(line.find(':') + 2);
-      break;
-    }
-  return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
-}
-
 Json read_published() {
   std::ifstream in(std::string(OMNILOC_SOURCE_DIR) + "/results/reference/papers.json");
   if (!in) return Json::object();
