@@ -178,13 +178,14 @@ CalibrationMap CalibrationMap::load(const std::string& path, const std::string& 
 // floor up to the horizon, the far floor above the walls). Taking the pixel-wise maximum over the
 // calibration views (the robot turns, the mirror does not) removes whatever dark things the scene
 // put near the rim in any one view (the calibration patch's black stripes, a black robot), so the
-// rim step is 40-100 DN everywhere against a few DN of noise, and it lies on a circle of ~310 px:
-// hundreds of independent edge points whose pixel quantisation (the simulator's rim is a hard,
-// non-anti-aliased mask) averages out in the fit. The robot body's disc is also drawn on the mirror
-// axis, but its edge is ~15x shorter (a 20-30 px radius: a 1 px error there moves the centre ~15x
-// more per point), its contrast depends on the carpet and the light on the robot, and on a real
-// robot the body is seen through the mirror's inner, least precise part; the patch symmetry needs
-// the patch's edges, which are themselves what the centre is for. The rim is used alone.
+// rim step is large everywhere (about 150 DN just inside the rim of a default-camera frame, against
+// a few DN of noise), and it lies on a circle of ~310 px: hundreds of independent edge points whose
+// pixel quantisation (the simulator's rim is a hard, non-anti-aliased mask) averages out in the fit.
+// The robot body's disc is also drawn on the mirror axis, but its edge is ~8x shorter (37.7 px
+// radius for the default mirror: far fewer points, each with the same pixel quantisation), its
+// contrast depends on the carpet and the light on the robot, and on a real robot the body is seen
+// through the mirror's inner part; the patch symmetry needs the patch's edges, which are
+// themselves what the centre is for. The rim is used alone.
 namespace {
 
 // Bilinear sample of a single-channel float image at (x, y) in pixel coordinates with pixel centres
