@@ -93,7 +93,9 @@ const cli::Command kRender{"render", "FILE", 1, 1, "Render the panorama robot ID
                             {"-o", "FILE.png", "output picture (required)"}}};
 const cli::Command kCalibrate{"calibrate", "FILE", 1, 1,
                               "Model-free mirror calibration with the scenario's camera; prints the map's error against the true mirror.",
-                              {{"-o", "MAP.json", "output map (default results/cache/calibration_<camera>.json)"}, {"--seed", "N", "seed (default 1)"}}};
+                              {{"-o", "MAP.json", "output map (default results/cache/calibration_v2_<camera>.json)"},
+                               {"--seed", "N", "seed (default 1)"},
+                               {"--image-centre", "", "assume the mirror axis at the image centre (before issue 17; saved only with -o)"}}};
 const cli::Command kColourCalibrate{"colour-calibrate", "FILE", 1, 1, "Learn the colour look-up table from labelled renders of the scenario's field.",
                                     {{"-o", "TABLE.lut", "output table (default results/cache/colour_<camera>_<field>.lut)"},
                                      {"--seed", "N", "seed (default 1)"}}};
@@ -302,15 +304,28 @@ int cmd_calibrate(const cli::Args& a) {
   const auto s = harness::load_scenario(a.positional[0]);
   const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
   Json report;
-  auto r = harness::calibrate_camera(cfg, seed, &report);
-  const std::string out = a.value("-o", "results/cache/calibration_" + harness::camera_tag(cfg) + ".json");
-  r.map.save(out);
-  std::printf("directions used %d, rejected %d\n%10s %12s %12s %12s\n", r.directions_used, r.directions_rejected, "distance m", "mean err cm",
-              "p95 err cm", "max err cm");
+  const bool image_centre = a.has("--image-centre");
+  auto r = harness::calibrate_camera(cfg, seed, &report, image_centre ? harness::CentreSource::kImageCentre : harness::CentreSource::kRim);
+  // An image-centre map is a comparison, not what runs should pick up from the cache.
+  const std::string out = a.value("-o", image_centre ? std::string() : harness::calibration_cache_file(cfg));
+  if (!out.empty()) r.map.save(out);
+  std::printf("directions used %d, rejected %d\n", r.directions_used, r.directions_rejected);
+  const auto& c = report["centre_px"];
+  const auto& t = report["true_centre_px"];
+  if (image_centre)
+    std::printf("mirror centre: image centre (%.2f, %.2f) assumed; true (%.2f, %.2f), off by %.2f px\n", c[0].get<double>(), c[1].get<double>(),
+                t[0].get<double>(), t[1].get<double>(), report["centre_error_px"].get<double>());
+  else
+    std::printf("mirror centre: estimated (%.2f, %.2f) from the rim (radius %.2f px, rms %.3f px, %d points, %d rejected);\n"
+                "               true (%.2f, %.2f), radius %.2f px: off by %.3f px\n",
+                c[0].get<double>(), c[1].get<double>(), report["rim_radius_px"].get<double>(), report["rim_rms_px"].get<double>(),
+                report["rim_points"].get<int>(), report["rim_rejected"].get<int>(), t[0].get<double>(), t[1].get<double>(),
+                report["true_rim_radius_px"].get<double>(), report["centre_error_px"].get<double>());
+  std::printf("%10s %12s %12s %12s\n", "distance m", "mean err cm", "p95 err cm", "max err cm");
   for (const auto& row : report["error_by_distance"])
     std::printf("%10.1f %12.2f %12.2f %12.2f\n", row["distance_m"].get<double>(), 100 * row["mean_error_m"].get<double>(),
                 100 * row["p95_error_m"].get<double>(), 100 * row["max_error_m"].get<double>());
-  std::cout << "wrote " << out << "\n";
+  if (!out.empty()) std::cout << "wrote " << out << "\n";
   return 0;
 }
 

@@ -38,7 +38,7 @@ std::string camera_tag(const sim::CameraConfig& cfg) {
   return "cam-" + fnv_hex(j.dump());
 }
 
-CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t seed, Json* report) {
+CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t seed, Json* report, CentreSource centre_source) {
   // An empty floor large enough for the 8 m patch; the robot stands at the origin and turns.
   const Field floor = Field::from_json(Json{{"type", "plain"}, {"length", 22.0}, {"width", 14.0}, {"margin", 1.0}, {"wall_height", 0.0}}, "/calibration");
   // The robot turns slowly on the spot while calibrating, so the camera does not vibrate; pixel
@@ -66,10 +66,20 @@ CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t s
     w.robots[0].pose = Pose2(0, 0, -bearing);  // the patch along world +x appears at this robot bearing
     views.push_back({cam.render(w, 0, cfg.initial, rng), bearing});
   }
-  // Model-free: the mirror axis is taken as the image centre (a camera mounted on axis); a mounting
-  // offset shows up as calibration error.
-  const Eigen::Vector2d centre(0.5 * cfg.width, 0.5 * cfg.height);
-  CalibrationResult res = calibrate_from_images(views, std::vector<double>(edges.begin(), edges.end()), centre, cam.body_radius_px() + 1.0);
+  // Model-free: the mirror axis is estimated from the rim in the images (never from the
+  // simulator's centre()), or, for comparison, assumed at the image centre.
+  // Edges the robot's own body hides cannot be found: a team measures where the floor disappears
+  // under the body and lays the strip's first edges beyond it (NuBot's body hides 0.44 m, the
+  // strip starts at 0.35 m; the default mirror's body 0.30 m).
+  const double body = cam.body_radius_px() + 1.0;
+  const auto hidden = cam.floor_point(cam.centre().x(), cam.centre().y() - (body + 3.0));
+  const double body_floor = hidden ? hidden->norm() : 0.0;
+  std::vector<double> edge_distances;
+  for (double e : edges)
+    if (e > body_floor + 0.02) edge_distances.push_back(e);
+  CalibrationResult res = centre_source == CentreSource::kRim
+                              ? calibrate_from_images(views, edge_distances, body)
+                              : calibrate_from_images(views, edge_distances, Eigen::Vector2d(0.5 * cfg.width, 0.5 * cfg.height), body);
   res.map.tag = camera_tag(cfg);
   if (report) {
     // Error against the true mirror: project floor points at known distances, map them back.
@@ -90,7 +100,19 @@ CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t s
       }
       rows.push_back({{"distance_m", d}, {"mean_error_m", mean}, {"p95_error_m", percentile(errs, 95)}, {"max_error_m", mx}, {"samples", errs.size()}});
     }
-    *report = {{"directions_used", res.directions_used}, {"directions_rejected", res.directions_rejected}, {"error_by_distance", rows}};
+    const Eigen::Vector2d est = res.map.centre(), truth = cam.centre();
+    *report = {{"directions_used", res.directions_used},
+               {"directions_rejected", res.directions_rejected},
+               {"centre_source", centre_source == CentreSource::kRim ? "rim" : "image-centre"},
+               {"centre_px", {est.x(), est.y()}},
+               {"true_centre_px", {truth.x(), truth.y()}},
+               {"centre_error_px", (est - truth).norm()},
+               {"rim_radius_px", res.rim.radius},
+               {"true_rim_radius_px", cam.rim_px()},
+               {"rim_rms_px", res.rim.rms_px},
+               {"rim_points", res.rim.edge_points},
+               {"rim_rejected", res.rim.rejected},
+               {"error_by_distance", rows}};
   }
   return res;
 }
@@ -181,11 +203,17 @@ CalibrationMap exact_calibration(const sim::CameraConfig& cfg) {
   return map;
 }
 
+std::string calibration_cache_file(const sim::CameraConfig& cfg) {
+  // v2: the mirror axis is estimated from the rim (issue 17); "calibration_<tag>" files took the
+  // image centre and are not reused.
+  return std::string(kCache) + "/calibration_v2_" + camera_tag(cfg) + ".json";
+}
+
 CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed) {
   const std::string tag = camera_tag(cfg);
   if (path == "exact") return exact_calibration(cfg);
   if (path != "auto") return CalibrationMap::load(path, tag, cfg.width, cfg.height);
-  const std::string file = std::string(kCache) + "/calibration_" + tag + ".json";
+  const std::string file = calibration_cache_file(cfg);
   if (std::filesystem::exists(file)) {
     try {
       return CalibrationMap::load(file, tag, cfg.width, cfg.height);

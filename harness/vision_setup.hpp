@@ -13,10 +13,17 @@
 
 namespace omniloc::harness {
 
+/// Where the calibration takes the mirror axis from.
+enum class CentreSource {
+  kRim,          ///< estimated from the mirror rim in the calibration images (the default)
+  kImageCentre,  ///< assumed at the image centre (before issue 17: a decentred mirror becomes error)
+};
+
 /// Renders the calibration patch in 36 directions while the robot turns on an empty floor, finds
-/// the edges and builds the map. `report`: optional, gets the map's error against the true mirror by
-/// distance (a JSON object) for the docs.
-CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t seed, Json* report = nullptr);
+/// the mirror axis and the edges and builds the map. `report`: optional, gets the map's error
+/// against the true mirror by distance and the estimated and true centres (a JSON object) for the docs.
+CalibrationResult calibrate_camera(const sim::CameraConfig& cfg, std::uint64_t seed, Json* report = nullptr,
+                                   CentreSource centre = CentreSource::kRim);
 
 /// Renders labelled frames of the field under normal light (observer at seeded random poses with
 /// robots and the ball around it) and learns the table.
@@ -25,6 +32,8 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
 /// Tag identifying a camera configuration (what a calibration map was made for).
 std::string camera_tag(const sim::CameraConfig& cfg);
 
+/// The cache file of `cfg`'s calibration map (results/cache/calibration_v2_<tag>.json).
+std::string calibration_cache_file(const sim::CameraConfig& cfg);
 /// The map for `cfg`: from `path` when given ("auto" = cached, calibrating when missing).
 /// A perfect calibration: the simulator's true mirror profile and centre in the map's format (no
 /// tilt). A measurement-model baseline for the error budget ("calibration": "exact"), never a default.

@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/field.hpp"
+#include "core/rng.hpp"
 #include "harness/vision_setup.hpp"
 #include "localization/vision/scan_lines.hpp"
 #include "sim/occlusion.hpp"
@@ -125,4 +127,90 @@ TEST_F(VisionTest, TablesAndMapsOfAnotherFieldOrSizeAreRefused) {
   EXPECT_THROW(CalibrationMap::load(m, "", 800, 800), ConfigError);
   EXPECT_THROW(CalibrationMap::load((dir / "omniloc_missing_map.json").string()), ConfigError);
   EXPECT_THROW(ColourTable::load((dir / "omniloc_missing.lut").string()), ConfigError);
+}
+
+// Issue 17: the calibration estimates the mirror axis from the rim, so a decentred mirror (NuBot's
+// calibration files correct about 9 px) is calibrated instead of becoming map error. The renderer's
+// centre() is the truth, used here only.
+TEST(CalibrationCentre, RimFitGivesTheMirrorAxisWithin1PxAndTheMapKeepsItsBounds) {
+  const Field field = Field::preset("msl2012");
+  for (const Eigen::Vector2d& offset : {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(9.0, 0.0), Eigen::Vector2d(6.4, -6.4), Eigen::Vector2d(-5.2, 7.4)}) {
+    CameraConfig cfg;  // default noise: read and shot noise (calibration turns vibration off)
+    cfg.centre_offset_px = offset;
+    const PanoramicCamera cam(cfg, field);
+    const CalibrationResult r = harness::calibrate_camera(cfg, 1);
+    EXPECT_LT((r.map.centre() - cam.centre()).norm(), 1.0) << "offset " << offset.transpose() << ": estimated " << r.map.centre().transpose();
+    EXPECT_NEAR(r.rim.radius, cam.rim_px(), 1.0);
+    EXPECT_GT(r.rim.edge_points, 400);
+    // The bounds of CalibrationMapMatchesTheTrueMirror, for every bearing.
+    for (double d : {1.0, 4.0})
+      for (int k = 0; k < 24; ++k) {
+        const double b = kTwoPi * k / 24 + 0.05;
+        const Eigen::Vector2d truth(d * std::cos(b), d * std::sin(b));
+        const auto px = cam.project({truth.x(), truth.y(), 0.0});
+        ASSERT_TRUE(px);
+        const auto back = r.map.to_robot(px->x(), px->y());
+        ASSERT_TRUE(back) << "offset " << offset.transpose() << " d " << d << " bearing " << b;
+        EXPECT_LT((*back - truth).norm(), d < 2 ? 0.03 : 0.05) << "offset " << offset.transpose() << " d " << d << " bearing " << b;
+      }
+  }
+}
+
+TEST(CalibrationCentre, ImageCentreAssumptionFailsTheBoundsWithADecentredMirror) {
+  // What the calibration did before: with the mirror 9 px off the image centre the map misses by
+  // decimetres somewhere at 4 m (this is what the rim fit removes; it also shows the test above can fail).
+  CameraConfig cfg;
+  cfg.centre_offset_px = {9.0, 0.0};
+  const PanoramicCamera cam(cfg, Field::preset("msl2012"));
+  const CalibrationResult r = harness::calibrate_camera(cfg, 1, nullptr, harness::CentreSource::kImageCentre);
+  EXPECT_EQ(r.map.centre(), Eigen::Vector2d(320.0, 320.0));
+  double worst = 0;
+  for (int k = 0; k < 24; ++k) {
+    const double b = kTwoPi * k / 24 + 0.05;
+    const Eigen::Vector2d truth(4.0 * std::cos(b), 4.0 * std::sin(b));
+    const auto px = cam.project({truth.x(), truth.y(), 0.0});
+    const auto back = px ? r.map.to_robot(px->x(), px->y()) : std::nullopt;
+    if (back) worst = std::max(worst, (*back - truth).norm());
+  }
+  EXPECT_GT(worst, 0.05);
+}
+
+TEST(CalibrationCentre, CircleFitIsExactAndDropsOutliers) {
+  std::vector<Eigen::Vector2d> pts;
+  const Eigen::Vector2d c(331.7, 308.2);
+  Rng rng(5);
+  for (int k = 0; k < 300; ++k) {
+    const double a = 0.2 + 4.5 * k / 300.0;  // a partial arc (the rim clipped by the image border)
+    pts.push_back(c + (313.6 + rng.normal(0.0, 0.2)) * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+  for (int k = 0; k < 30; ++k) pts.push_back(c + rng.uniform(150.0, 300.0) * Eigen::Vector2d(std::cos(0.1 * k), std::sin(0.1 * k)));
+  std::vector<bool> inlier;
+  const MirrorRim rim = fit_circle(pts, &inlier);
+  EXPECT_LT((rim.centre - c).norm(), 0.05);
+  EXPECT_NEAR(rim.radius, 313.6, 0.05);
+  EXPECT_EQ(rim.edge_points, 300);
+  EXPECT_EQ(rim.rejected, 30);
+  EXPECT_LT(rim.rms_px, 0.25);
+}
+
+TEST(CalibrationCentre, Version1MapsStillLoad) {
+  // Maps written before the centre was estimated: version 1, no rim; the centre they stored is used.
+  const auto file = (std::filesystem::temp_directory_path() / "omniloc_map_v1.json").string();
+  {
+    std::ofstream out(file);
+    out << R"({"format":"omniloc-calibration-map","version":1,"width":640,"height":640,"centre":[320.0,320.0],"tag":"t",)"
+        << R"("radii_px":[[40,60,80,100],[40,60,80,100],[40,60,80,100],[40,60,80,100]],)"
+        << R"("distances_m":[[0.5,1,1.5,2],[0.5,1,1.5,2],[0.5,1,1.5,2],[0.5,1,1.5,2]]})";
+  }
+  const CalibrationMap m = CalibrationMap::load(file, "t", 640, 640);
+  EXPECT_EQ(m.centre(), Eigen::Vector2d(320.0, 320.0));
+  EXPECT_EQ(m.rim_radius, 0.0);
+  const auto d = m.ground_distance(60.0, 0.3);
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(*d, 1.0, 1e-9);
+  // Saved again it is version 2 and reads back the same.
+  m.save(file);
+  const CalibrationMap m2 = CalibrationMap::load(file, "t", 640, 640);
+  EXPECT_EQ(m2.centre(), m.centre());
+  EXPECT_NEAR(*m2.ground_distance(60.0, 0.3), 1.0, 1e-9);
 }
