@@ -25,7 +25,7 @@ struct GridGlobalParams {
   int candidates = 5;         ///< best samples refined by RPROP (paper 000)
   double c_grid = 2.55;       ///< m, error scale of E_k (paper 000: c = 255 in cm)
   int grid_points = 100;      ///< line points (evenly subsampled) used for E_k
-  int refine_iterations = 30; ///< RPROP iterations per candidate (paper 000: converges in ~10)
+  int refine_iterations = 30; ///< at most this many RPROP iterations per candidate (paper 000: converges in ~10)
   double refine_c_start = 1.0;  ///< m: continuation of c from here down to matching.c while refining
   double accept_error = 0.12; ///< mean e(d) at matching.c under which a candidate is accepted at once
   double min_separation = 1.5;  ///< m: the 5 candidates are distinct samples at least this far apart

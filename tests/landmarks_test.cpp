@@ -3,7 +3,9 @@
 // least squares over 4-6 landmarks against a single triple under bearing noise.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdio>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -224,6 +226,76 @@ TEST(Landmarks, OnTheSingularSets) {
         ASSERT_TRUE(f.ok) << all[k].first << ": " << f.reason;
         EXPECT_LT(pos_err(f, on_line), kTolPos) << all[k].first << " t=" << t;
         EXPECT_LT(std::fabs(angle_diff(f.pose.theta, on_line.theta)), kTolAng) << all[k].first;
+      }
+    }
+  }
+}
+
+TEST(Landmarks, TotalLikeExactOnEveryLineThroughTwoLandmarks) {
+  // Issue 17: ToTal-like placed a robot on the line through landmarks 1 and 2 up to 4 mm wrong (the
+  // clamped cotangent of that pair entered both factors of D). On each line the bearing difference
+  // of its pair is 0 (beyond the landmarks) or pi (between them) to rounding, so that cotangent is
+  // clamped (kCotMax = 1e14); the solver puts it in T31, where the position is a ratio of two terms
+  // linear in it, so the clamp moves the fix by ~range^2 / (baseline * 1e14): measured worst 8e-12 m,
+  // at t = 3 (robots up to ~40 m away). Rounding, with no cancellation left, is ~1e-15 relative.
+  // 1e-9 m leaves two decades. Positions: beyond either landmark, between them, near either one.
+  Rng rng(23);
+  double worst = 0;
+  int fixes = 0;
+  for (int rep = 0; rep < 50; ++rep) {
+    const auto L = random_triangle(rng);
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector2d& A = L[static_cast<std::size_t>(i)];
+      const Eigen::Vector2d& B = L[static_cast<std::size_t>((i + 1) % 3)];
+      for (const double t : {-1.5, -0.7, -0.05, 0.1, 0.4, 0.5, 0.93, 1.08, 1.8, 3.0}) {
+        const Eigen::Vector2d p = A + t * (B - A);
+        const Pose2 truth(p.x(), p.y(), rng.uniform(-kPi, kPi));
+        if (near_circle(L, p, kMargin)) continue;  // where the line crosses the circle
+        const Fix f = total_like(observe(L, truth));
+        ASSERT_TRUE(f.ok) << "line " << i << "-" << (i + 1) % 3 << " t=" << t << ": " << f.reason;
+        EXPECT_LT(pos_err(f, truth), 1e-9) << "line " << i << "-" << (i + 1) % 3 << " t=" << t;
+        EXPECT_LT(std::fabs(angle_diff(f.pose.theta, truth.theta)), 1e-9) << "line " << i << "-" << (i + 1) % 3 << " t=" << t;
+        worst = std::max(worst, pos_err(f, truth));
+        ++fixes;
+      }
+    }
+  }
+  std::printf("total_like on the three lines: %d fixes, worst position error %.3g m\n", fixes, worst);
+}
+
+TEST(Landmarks, TotalLikeNearTheCircleIsExactFlaggedOrRefused) {
+  // Within a few cm of the circle through the landmarks D -> 0 and the fix is ill-conditioned, but
+  // on noise-free bearings it stays exact to rounding amplified by 1 / D: we require a finite fix
+  // within 1e-6 m, or a refusal with a reason, and reliability (1/D-like) falling towards the circle.
+  Rng rng(29);
+  for (int rep = 0; rep < 50; ++rep) {
+    const auto L = random_triangle(rng);
+    Eigen::Vector2d c;
+    double r = 0;
+    circumcircle(L[0], L[1], L[2], c, r);
+    const double phi = rng.uniform(-kPi, kPi);
+    const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
+    double last_rel = -1;
+    for (const double d : {0.05, 0.02, 0.005, 0.001, 1e-4}) {
+      for (const double side : {-1.0, 1.0}) {
+        const Eigen::Vector2d p = c + (r + side * d) * u;
+        bool near_landmark = false;
+        for (const auto& l : L) near_landmark |= (l - p).norm() < 0.1;
+        if (near_landmark) continue;
+        const Pose2 truth(p.x(), p.y(), rng.uniform(-kPi, kPi));
+        const Fix f = total_like(observe(L, truth));
+        EXPECT_TRUE(std::isfinite(f.pose.x) && std::isfinite(f.pose.y) && std::isfinite(f.reliability)) << "d=" << d;
+        if (!f.ok) {
+          EXPECT_FALSE(f.reason.empty()) << "d=" << d;
+          continue;
+        }
+        EXPECT_LT(pos_err(f, truth), 1e-6) << "d=" << side * d;
+        if (side > 0) {
+          if (last_rel >= 0) {
+            EXPECT_LT(f.reliability, last_rel) << "d=" << d;
+          }
+          last_rel = f.reliability;
+        }
       }
     }
   }

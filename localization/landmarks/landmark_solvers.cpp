@@ -168,10 +168,13 @@ Fix circle_intersection_003(std::span<const BearingObs> obs) {
 namespace {
 /// cot from (cos, sin); an infinite cotangent (bearing difference 0 or pi: the robot on the line
 /// through two landmarks) becomes +-kCotMax, so the formulas stay finite and the other two circles
-/// carry the solution. The value is our choice: the position error it causes is of the order of
-/// scale / kCotMax, and |sin| above 1 / kCotMax keeps a relative error of at most ~1e-4 in the
-/// cotangent, which moves the position by ~1e-4 * scale / |cot| ~ 1e-16 m.
-constexpr double kCotMax = 1e12;
+/// carry the solution. The value is our choice. total_like lets only T31 get this large, and there
+/// the position is a ratio of two terms linear in T31, so the clamp moves it by ~F / kCotMax, with F
+/// growing as range^2 / baseline: measured 8e-10 m at 1e12 and 8e-12 m at 1e14 for robots up to
+/// ~40 m away on the lines through two landmarks (tests/landmarks_test.cpp). |sin| above 1 / kCotMax
+/// = 1e-14 keeps the cotangent's relative error (sin's rounding is ~1e-16) below 1e-2, which moves
+/// the position by ~1e-2 F / kCotMax ~ 1e-13 m.
+constexpr double kCotMax = 1e14;
 double cot_safe(double c, double s) {
   if (std::fabs(s) * kCotMax > std::fabs(c)) return c / s;
   return std::signbit(s) != std::signbit(c) ? -kCotMax : kCotMax;
@@ -180,18 +183,42 @@ double cot_safe(double c, double s) {
 
 Fix total_like(std::span<const BearingObs> obs) {
   if (auto r = check_triple(obs); !r.empty()) return no_fix(std::move(r));
-  const auto dirs = bearing_dirs(obs);
-  const Eigen::Vector2d& B2 = obs[1].landmark;
+  const auto dirs0 = bearing_dirs(obs);
+  // ToTal (Pierlot, Van Droogenbroeck, "A New Three Object Triangulation Algorithm for Mobile Robot
+  // Positioning", IEEE T-RO 30(3), 2014), formulated here from its equations; our own code.
+  // x12..y31 are twice the centres of the circles (B1, B2, R), (B2, B3, R), (B3, B1, R) relative
+  // to B2, k31 is the power-like term of the third circle, and
+  //   D = (x12 - x23)(y23 - y31) - (y12 - y23)(x23 - x31),  R = B2 + k31 (y12 - y23, x23 - x12) / D.
+  // D and the numerator are linear in T31 = cot(alpha31), but c12 and c23 enter D twice (both
+  // factors): a clamped, huge T12 or T23 makes D the difference of two products of size T^2 whose
+  // difference is of size T, and the cancellation cost up to 4 mm on the line through the second
+  // and third landmarks (issue 17). As in ToTal, only T31 may be infinite: the landmarks are
+  // renumbered cyclically (which keeps every signed angle) so that the pair whose bearing
+  // difference is nearest 0 or pi is (3, 1). The robot is on at most one of the three lines
+  // (two meet only at a landmark, refused by check_triple), so T12 and T23 stay finite and of
+  // moderate size, and the clamped T31 = +-kCotMax moves R by ~1e-11 m at most (see cot_safe).
+  std::array<std::size_t, 3> idx{0, 1, 2};
+  {
+    const double s01 = std::fabs(cross(dirs0[0], dirs0[1]));
+    const double s12 = std::fabs(cross(dirs0[1], dirs0[2]));
+    const double s20 = std::fabs(cross(dirs0[2], dirs0[0]));
+    if (s01 < s12 && s01 < s20) idx = {1, 2, 0};       // pair (0, 1) becomes (3, 1)
+    else if (s12 < s20 && s12 <= s01) idx = {2, 0, 1};  // pair (1, 2) becomes (3, 1)
+  }
+  const Eigen::Vector2d& B1 = obs[idx[0]].landmark;
+  const Eigen::Vector2d& B2 = obs[idx[1]].landmark;
+  const Eigen::Vector2d& B3 = obs[idx[2]].landmark;
+  const Eigen::Vector2d &d1 = dirs0[idx[0]], &d2 = dirs0[idx[1]], &d3 = dirs0[idx[2]];
   // Landmarks relative to the second one.
-  const Eigen::Vector2d p1 = obs[0].landmark - B2;
-  const Eigen::Vector2d p3 = obs[2].landmark - B2;
+  const Eigen::Vector2d p1 = B1 - B2;
+  const Eigen::Vector2d p3 = B3 - B2;
   // Cotangents of the bearing differences (angles subtended at the robot by the pairs 1-2, 2-3, 3-1).
-  const Eigen::Vector2d e12 = diff_dir(dirs[0], dirs[1]);
-  const Eigen::Vector2d e23 = diff_dir(dirs[1], dirs[2]);
-  const Eigen::Vector2d e31 = diff_dir(dirs[2], dirs[0]);
+  const Eigen::Vector2d e12 = diff_dir(d1, d2);
+  const Eigen::Vector2d e23 = diff_dir(d2, d3);
+  const Eigen::Vector2d e31 = diff_dir(d3, d1);
   const double T12 = cot_safe(e12.x(), e12.y());
   const double T23 = cot_safe(e23.x(), e23.y());
-  const double T31 = cot_safe(e31.x(), e31.y());
+  const double T31 = cot_safe(e31.x(), e31.y());  // the only one that can be clamped
   // Modified centres: twice the centres of the circles (B1, B2, R), (B2, B3, R), (B3, B1, R),
   // relative to B2 (inscribed-angle theorem, as in inscribed_centre).
   const Eigen::Vector2d c12(p1.x() + T12 * p1.y(), p1.y() - T12 * p1.x());
@@ -210,7 +237,7 @@ Fix total_like(std::span<const BearingObs> obs) {
   if (!(std::fabs(D) > 1e-14 * dnorm)) return no_fix(kOnCircle);
   const double invD = 1.0 / D;  // the single division
   const Eigen::Vector2d R(B2.x() + k31 * (c12.y() - c23.y()) * invD, B2.y() + k31 * (c23.x() - c12.x()) * invD);
-  return finish_fix(obs, dirs, R, landmark_scale(obs));
+  return finish_fix(obs, dirs0, R, landmark_scale(obs));
 }
 
 // ---------------------------------------------------------------------------------------------
