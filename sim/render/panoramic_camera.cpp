@@ -772,6 +772,27 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
 
 }  // namespace
 
+namespace {
+
+// One row of the sensor: value = radiance * per_unit (DN), plus noise of std
+// sqrt(var_read + var_shot * min(255, value)) times a standard normal from the noise table (steps
+// of kNoiseStep around kNoiseZero), rounded and clipped. This file is compiled with
+// -fno-math-errno (CMakeLists.txt; the square root's argument is never negative) so that the loop
+// vectorises.
+void expose_row(const float* rad, const std::uint8_t* nz, std::uint8_t* out, int n, float per_unit,
+                                                        float var_read, float var_shot) {
+  const float step = static_cast<float>(kNoiseStep), zero = static_cast<float>(kNoiseZero);
+  for (int i = 0; i < n; ++i) {
+    const float mean = rad[i] * per_unit;
+    const float sigma = std::sqrt(var_read + var_shot * (mean < 255.0f ? mean : 255.0f));
+    float val = mean + sigma * ((static_cast<float>(nz[i]) - zero) * step) + 0.5f;
+    val = val < 0.0f ? 0.0f : (val > 255.0f ? 255.0f : val);
+    out[i] = static_cast<std::uint8_t>(static_cast<int>(val));
+  }
+}
+
+}  // namespace
+
 Image PanoramicCamera::render(const WorldState& world, int robot_id, const CameraSettings& requested, Rng& rng) {
   PanoramicCameraImpl& m = *impl_;
   const RobotState* me = world.robot(robot_id);
@@ -834,17 +855,14 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
   if (m.smear) m.smear->apply(view, me->omega * exposure_s);
   if (m.defocus) m.defocus->apply(view);
 
-  // Photometry per pixel and channel from the full 16 bits (a table by 8-bit GL level, the way
-  // until photometry v3, put steps of up to 8 DN into a dimly lit carpet once exposure and gain
-  // were raised): value = radiance * K * exposure * gain, plus noise of std
-  // sqrt(read^2 (g/18)^2 + shot^2 * min(255, value) * g/18) times a standard normal from the
-  // table, rounded and clipped. Written as plain float arithmetic over one row so it vectorises.
+  // Photometry per pixel and channel from the full 16 bits (expose_row; a table by 8-bit GL
+  // level, the way until photometry v3, put steps of up to 8 DN into a dimly lit carpet once
+  // exposure and gain were raised).
   const int samples = m.ss * m.ss;
   const float per_unit = static_cast<float>(kRadianceScale / 65535.0 / samples * kResponse * st.exposure_ms * st.gain);
   const float gainf = static_cast<float>(st.gain / 18.0);
   const float var_read = static_cast<float>(cfg_.read_noise * cfg_.read_noise) * gainf * gainf;
   const float var_shot = static_cast<float>(cfg_.shot_noise * cfg_.shot_noise) * gainf;
-  const float step = static_cast<float>(kNoiseStep), zero = static_cast<float>(kNoiseZero);
   Image img;
   img.width = cfg_.width;
   img.height = cfg_.height;
@@ -880,12 +898,7 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
     const std::uint8_t* nz = &m.noise[k];
     std::uint8_t* out = img.row(v) + 3 * u0;
     const float* rad = radiance.data();
-    for (int i = 0; i < n; ++i) {
-      const float mean = rad[i] * per_unit;
-      const float sigma = std::sqrt(var_read + var_shot * std::min(mean, 255.0f));
-      const float val = mean + sigma * (static_cast<float>(nz[i]) - zero) * step + 0.5f;
-      out[i] = static_cast<std::uint8_t>(std::clamp(val, 0.0f, 255.0f));
-    }
+    expose_row(rad, nz, out, n, per_unit, var_read, var_shot);
     k = (k + static_cast<std::size_t>(n)) & mask;
   }
   return img;
