@@ -18,6 +18,7 @@ position in it) never matters.
 Statistics: mean over runs (seeds), Student-t 95 % interval only where n >= 2; Welch's t-test for
 two result sets. No SciPy: Debian's python3 and python3-matplotlib are the only dependencies.
 """
+import contextlib
 import csv
 import json
 import math
@@ -165,10 +166,32 @@ def same_value(a, b):
     return a == b
 
 
+SCENARIO_DEFAULT_PROFILE = "robot"  # what a scenario without "noise_profile" runs under
+DEFAULT_PROFILE = "robot"  # the profile published rows pair by default (pairing_profile changes it)
+
+
+@contextlib.contextmanager
+def pairing_profile(name):
+    """Within the block, keys without a /noise_profile pair runs of profile `name`."""
+    global DEFAULT_PROFILE
+    old, DEFAULT_PROFILE = DEFAULT_PROFILE, name
+    try:
+        yield
+    finally:
+        DEFAULT_PROFILE = old
+
+
 def key_matches(run, key, defaults=None, scenario=None):
+    """A published row's key matches runs of its scenario, localizer and configuration values; a key
+    that names no /noise_profile means the default profile ("robot"), so runs under another profile
+    (field_robot, ideal) never mix into the row."""
     defaults = defaults or {}
     if run.scenario != (scenario or key.get("scenario")):
         return False
+    if "/noise_profile" not in (key.get("config") or {}):
+        found, prof = pointer(run.config, "/noise_profile")
+        if (prof if found else SCENARIO_DEFAULT_PROFILE) != DEFAULT_PROFILE:
+            return False
     if "localizer" in key and run.localizer != key["localizer"]:
         return False
     for ptr, want in (key.get("config") or {}).items():

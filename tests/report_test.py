@@ -80,6 +80,23 @@ class Pairing(unittest.TestCase):
             self.assertAlmostEqual(got[label][0], OCCLUSION[frac] + 0.02, places=9, msg=label)  # mean of seeds 1..3: +0.02
             self.assertEqual(got[label][1], 3)
 
+    def test_runs_of_another_noise_profile_do_not_mix_into_the_rows(self):
+        # The published rows pair runs of the robot profile; the same rows under field_robot are a
+        # table of their own (report.py field_robot_tables), never averaged into the robot rows.
+        papers = R.load_papers()
+        with tempfile.TemporaryDirectory() as tmp:
+            write_occlusion_sweep(pathlib.Path(tmp) / "robot", [0.0], seeds=(1, 2))
+            write_run(pathlib.Path(tmp) / "field" / "tracking__field", "tracking", "matching", 1, {"noise_profile": "field_robot"}, robot(50.0))
+            runs, _, _ = R.discover([pathlib.Path(tmp)])
+            self.assertEqual(len(runs), 3)
+            row = C.pair_table(papers, "002_table1_occlusion", runs, labels=["0 %"])[0]
+            self.assertEqual(row["stats"]["x_cm/mean"]["n"], 2)
+            self.assertAlmostEqual(row["stats"]["x_cm/mean"]["mean"], OCCLUSION[0.0] + 0.015, places=9)
+            with R.pairing_profile("field_robot"):
+                row = C.pair_table(papers, "002_table1_occlusion", runs, labels=["0 %"])[0]
+            self.assertEqual(row["stats"]["x_cm/mean"]["n"], 1)
+            self.assertAlmostEqual(row["stats"]["x_cm/mean"]["mean"], 50.0, places=9)
+
     def test_missing_rows_say_not_run_with_the_command(self):
         papers = R.load_papers()
         with tempfile.TemporaryDirectory() as tmp:
