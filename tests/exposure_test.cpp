@@ -163,3 +163,24 @@ TEST(ExposureControl, SearchesOnceAtStartByDefault) {
   EXPECT_EQ(c.searches(), 1);
   for (int k = end + 1; k < end + 200; ++k) EXPECT_FALSE(c.update(k / 30.0, 200.0, -1.0).searching);  // steady afterwards
 }
+
+TEST(ExposureControl, LightChangingDuringTheSearchStartsAnother) {
+  // The lamps go off at 2 s and, while the robot searches, come back over 0.5 s (lighting_002_lamps
+  // does this at 40 s). The entropies the search compared were taken under changing light, so its
+  // result is measured under light that is gone; the body at the chosen setting then does not look
+  // as it did when that setting was measured, and a new search under the steady light must follow.
+  // Scene model: body brightness and the entropy peak follow light x exposure x gain (exposure = gain).
+  ExposureParams p = enabled();
+  ExposureController c(p, CameraSettings{18.0, 18.0});
+  auto light = [](double t) { return t < 2.0 ? 1.0 : (t < 2.3 ? 0.3 : std::min(1.0, 0.3 + 0.7 * (t - 2.3) / 0.5)); };
+  bool restarted = false;
+  for (int k = 0; k < 400; ++k) {
+    const double t = k / 30.0, l = light(t), g = c.current().gain;
+    const double body = std::min(255.0, 120.0 * l * g * g / (18.0 * 18.0));
+    const double peak = 18.0 / std::sqrt(l);
+    const ExposureDecision d = c.update(t, body, c.wants_entropy() ? 10.0 - 0.01 * (g - peak) * (g - peak) : -1.0);
+    if (d.event && d.event->find("light changed during the search") != std::string::npos) restarted = true;
+  }
+  EXPECT_TRUE(restarted);
+  EXPECT_NEAR(c.current().gain, 18.0, 1.0);  // the peak under the returned light
+}

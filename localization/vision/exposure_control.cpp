@@ -93,7 +93,28 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
       d.searching = true;
       return d;
     } else if (saved_brightness_ < 0) {
+      if (t + 1e-9 < settled_at_) {  // the final setting has not settled yet
+        d.settings = cur_;
+        return d;
+      }
       saved_brightness_ = brightness;
+      // The light changed while the search ran (lamps warming up over a second): the entropies it
+      // compared were taken under different light, and the chosen setting was measured under light
+      // that is gone. The body at the chosen setting must look as it did when that setting was
+      // measured; otherwise search again now (the normal trigger compares later frames with this
+      // frame, so it would never fire, e.g. with a body clipped at 255 in the returned light).
+      const double measured = check_brightness_;
+      check_brightness_ = -1.0;
+      if (measured >= 0 && std::fabs(brightness - measured) > p_.change_threshold) {
+        d.settings = cur_;
+        d.searching = true;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "search_start (light changed during the search: body brightness %.1f, %.1f when the setting was measured)",
+                      brightness, measured);
+        d.event = buf;
+        start(t, brightness - measured, -1.0);
+        return d;
+      }
     } else {
       const double change = brightness - saved_brightness_;
       over_ = std::fabs(change) > p_.change_threshold ? over_ + 1 : 0;
@@ -126,6 +147,7 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
   const double g = cur_.gain;
   if (best_h_ < 0) {  // the starting setting, measured on this frame
     best_h_ = entropy;
+    best_brightness_ = brightness;
     path_.assign(1, {g, entropy});
   } else {
     path_.push_back({g, entropy});
@@ -133,6 +155,7 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     if (better) {
       best_h_ = entropy;
       best_g_ = g;
+      best_brightness_ = brightness;
     }
     if (coarse_) {
       // Coarse phase: geometric steps in one direction; a plateau or a local dip (clipping makes the
@@ -168,6 +191,8 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     cur_ = on_line(best_g_);
     state_ = State::Idle;
     saved_brightness_ = -1.0;  // re-measured on the next frame, taken with the final setting
+    check_brightness_ = best_brightness_;
+    settled_at_ = t + p_.settle_s;
     char buf[160];
     std::snprintf(buf, sizeof buf, "search_end (gain %.2f, exposure %.2f ms, entropy %.3f, %d settings tried)", cur_.gain, cur_.exposure_ms, best_h_,
                   steps_);

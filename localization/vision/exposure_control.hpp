@@ -68,6 +68,8 @@ class ExposureController {
   State state_ = State::Idle;
   bool first_ = true;
   double saved_brightness_ = -1.0;
+  double best_brightness_ = -1.0;   // body brightness on the frame that measured the best setting
+  double check_brightness_ = -1.0;  // after a search: that value, to compare with the first settled frame
   int over_ = 0, searches_ = 0, steps_ = 0;
   double best_g_ = 0, best_h_ = 0, step_ = 0, settled_at_ = 0;
   int dir_ = 1;
