@@ -35,6 +35,9 @@ open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$spec" results/suites/pape
 fi
 ./build/omniloc sweep "$spec" -j "$jobs"
 results=(results/sweeps/paper_suite)
+# The same published rows under the field_robot profile (issue 17), shown beside them in the report.
+./build/omniloc sweep scenarios/sweeps/paper_suite_field_robot.json -j "$jobs"
+results+=(results/sweeps/paper_suite_field_robot)
 if [ $full -eq 1 ]; then
   for s in kidnap_random; do
     ./build/omniloc sweep "scenarios/sweeps/$s.json" -j "$jobs" --resume
