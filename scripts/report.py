@@ -399,7 +399,7 @@ def field_robot_tables(rep, papers, runs):
 def error_budget_section(rep, ctx):
     """Table and bar chart of `omniloc experiment error_budget` (issue 17)."""
     d = ctx.experiments.get("error_budget")
-    f = d / "budget.json" if d else None
+    f = d / "error_budget.json" if d else None
     if not f or not f.exists():
         return
     j = json.loads(f.read_text())

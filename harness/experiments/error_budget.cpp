@@ -210,7 +210,7 @@ int run_error_budget(const ExperimentArgs& args, std::ostream& out) {
         "profile's (docs/scenario.md, docs/camera.md), none tuned to the papers.\n";
   Json result{{"experiment", "error_budget"}, {"config_file", file}, {"quick", args.quick}, {"duration_s", duration},
               {"seeds", seeds}, {"first_seed", args.seed}, {"sweep", so.out_dir}, {"rows", table}};
-  dir.write("budget.json", result.dump(2) + "\n");
+  dir.write("error_budget.json", result.dump(2) + "\n");  // named after the experiment: scripts/report.py finds it so
   dir.write("budget.csv", csv.str());
   dir.write("README.md", md.str());
   dir.commit();
