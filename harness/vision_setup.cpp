@@ -187,8 +187,7 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
 CalibrationMap exact_calibration(const sim::CameraConfig& cfg) {
   // The simulator's own mirror, centre and mount, tabulated in the map's format (72 directions,
   // floor distances every 5 cm from the body's edge to 8 m, the model-free map's range).
-  const double rim = cfg.rim_fraction * std::min(cfg.width, cfg.height);
-  const sim::MirrorProfile mirror = sim::MirrorProfile::preset(cfg.mirror, rim, cfg.mount_height);
+  const sim::MirrorProfile mirror = sim::MirrorProfile::preset(cfg.mirror, cfg.rim_px(), cfg.mount_height);
   const double h = cfg.mount_height;
   const double d_body = h / std::tan(-mirror.elevation(mirror.body_radius()));
   std::vector<double> dist;
@@ -196,9 +195,8 @@ CalibrationMap exact_calibration(const sim::CameraConfig& cfg) {
   std::vector<double> radii;
   for (double d : dist) radii.push_back(mirror.radius(-std::atan2(h, d)));
   const int n = 72;
-  const Eigen::Vector2d centre = Eigen::Vector2d(0.5 * cfg.width, 0.5 * cfg.height) + cfg.centre_offset_px;
   CalibrationMap map;
-  map.set_tables(cfg.width, cfg.height, centre, std::vector<std::vector<double>>(n, radii), std::vector<std::vector<double>>(n, dist));
+  map.set_tables(cfg.width, cfg.height, cfg.mirror_centre_px(), std::vector<std::vector<double>>(n, radii), std::vector<std::vector<double>>(n, dist));
   map.tag = camera_tag(cfg);
   return map;
 }

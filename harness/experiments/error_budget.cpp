@@ -58,7 +58,7 @@ struct Cell {
 }  // namespace
 
 Json ErrorBudgetConfig::scenario_for(const ErrorSource* source, double dur) const {
-  Json s = read_json_strict(scenario_file, scenario_file);
+  Json s = scenario;
   apply(s, baseline, "/baseline");
   if (source) apply(s, source->set, "/sources/" + source->name);
   s["duration"] = dur;
@@ -75,6 +75,7 @@ ErrorBudgetConfig load_error_budget(const std::string& file) {
   c.description = r.string("description", std::string());
   c.scenario_file = (fs::path(file).parent_path() / r.string("scenario", std::nullopt)).lexically_normal().string();
   require_readable_file(c.scenario_file, "/scenario", "a scenario file (relative to the description file)");
+  c.scenario = read_json_strict(c.scenario_file, c.scenario_file);
   c.duration = r.positive("duration", 60.0, 3600.0);
   c.seeds = static_cast<int>(r.integer("seeds", 3, 1, 100));
   if (auto q = r.object("quick")) {

@@ -19,6 +19,7 @@ struct ErrorSource {
 struct ErrorBudgetConfig {
   std::string description;
   std::string scenario_file;  ///< resolved against the description file's folder
+  Json scenario;              ///< its contents, read once
   double duration = 60.0, quick_duration = 20.0;
   int seeds = 3, quick_seeds = 1;
   Json localizers;            ///< array of {"type": ...}

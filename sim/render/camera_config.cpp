@@ -25,7 +25,7 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
   // a mirror radius of 188 px calibrates all 36 directions, 172 px 21, 157 px fails; an offset that
   // pushes the mirror's disc 5 px past the image border costs half the directions, 16 px more fail.
   // So the mirror's radius must be at least 180 px and its disc may leave the picture by 10 px at most.
-  const double side = std::min(c.width, c.height), rim_px = c.rim_fraction * side;
+  const double side = std::min(c.width, c.height), rim_px = c.rim_px();
   if (rim_px < 180.0)
     // Blame rim_fraction when a larger one would do on this image, else the image size.
     throw ConfigError(r.child_path(0.5 * side >= 180.0 ? "rim_fraction" : c.width <= c.height ? "width" : "height"),

@@ -1,6 +1,7 @@
 #pragma once
 // Panoramic camera configuration (scenario key "camera"). Units: pixels, metres, radians (degrees
 // in the JSON where named *_deg), milliseconds for exposure.
+#include <algorithm>
 #include <string>
 
 #include <Eigen/Core>
@@ -34,6 +35,10 @@ struct CameraConfig {
   CameraSettings initial;               ///< settings of the first frame
   double exposure_min = 1.0, exposure_max = 60.0;  ///< ms
   double gain_min = 1.0, gain_max = 60.0;
+  /// The mirror's rim radius in the image, pixels (rim_fraction x the smaller side).
+  double rim_px() const { return rim_fraction * std::min(width, height); }
+  /// The true mirror axis in the image, pixels (the image centre plus centre_offset_px).
+  Eigen::Vector2d mirror_centre_px() const { return Eigen::Vector2d(0.5 * width, 0.5 * height) + centre_offset_px; }
   /// Strict reading (unknown keys, non-positive sizes or exposure are ConfigErrors naming the path).
   static CameraConfig from_json(const Json& j, const std::string& path, Json* effective = nullptr);
   Json to_json() const;

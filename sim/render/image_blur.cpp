@@ -118,10 +118,11 @@ RadialDefocus::RadialDefocus(int width, int height, const Eigen::Vector2d& centr
 void RadialDefocus::apply(const Rgba16View& img) {
   if (!active()) return;
   cv::Mat src(img.height, img.width, CV_16UC4, img.data);
-  src.copyTo(sharp_);
-  cv::GaussianBlur(sharp_, half_, cv::Size(0, 0), 0.5 * sigma_max_, 0.5 * sigma_max_, cv::BORDER_REPLICATE);
-  cv::GaussianBlur(sharp_, full_, cv::Size(0, 0), sigma_max_, sigma_max_, cv::BORDER_REPLICATE);
-  const cv::Mat* levels[3] = {&sharp_, &half_, &full_};
+  cv::GaussianBlur(src, half_, cv::Size(0, 0), 0.5 * sigma_max_, 0.5 * sigma_max_, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(src, full_, cv::Size(0, 0), sigma_max_, sigma_max_, cv::BORDER_REPLICATE);
+  // Level 0 is the buffer itself: each pixel is read before it is written, the blurred levels were
+  // taken before any was.
+  const cv::Mat* levels[3] = {&src, &half_, &full_};
   for (int y = 0; y < img.height; ++y) {
     std::uint16_t* o = src.ptr<std::uint16_t>(y);
     const std::uint8_t* lv = &level_[static_cast<std::size_t>(y) * width_];

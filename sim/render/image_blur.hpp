@@ -57,7 +57,7 @@ class RadialDefocus {
   double sigma_max_ = 0.0;
   std::vector<std::uint8_t> level_;   // per pixel: the lower level (0 or 1), 255 outside the rim
   std::vector<std::uint16_t> share_;  // per pixel: weight of the upper level, 1/65536 units
-  cv::Mat sharp_, half_, full_;
+  cv::Mat half_, full_;
 };
 
 }  // namespace omniloc::sim

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 
 #include "core/angles.hpp"
@@ -259,7 +257,7 @@ struct PanoramicCameraImpl {
 PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
     : impl_(std::make_unique<PanoramicCameraImpl>()),
       cfg_(config),
-      mirror_(MirrorProfile::preset(config.mirror, config.rim_fraction * std::min(config.width, config.height), config.mount_height)) {
+      mirror_(MirrorProfile::preset(config.mirror, config.rim_px(), config.mount_height)) {
   PanoramicCameraImpl& m = *impl_;
   m.field = field;
   m.ss = cfg_.quality == "high" ? 2 : 1;
@@ -455,7 +453,7 @@ PanoramicCamera::~PanoramicCamera() {
 const std::string& PanoramicCamera::backend() const { return impl_->ctx->backend(); }
 
 Eigen::Vector2d PanoramicCamera::centre() const {
-  return Eigen::Vector2d(0.5 * cfg_.width, 0.5 * cfg_.height) + cfg_.centre_offset_px;
+  return cfg_.mirror_centre_px();
 }
 
 double PanoramicCamera::response(double albedo, double illumination, const CameraSettings& s) {
