@@ -32,22 +32,23 @@ VisionConfig VisionConfig::from_json(const Json& j, const std::string& path, Jso
   return v;
 }
 
-CameraPerception::CameraPerception(const Scenario& s, std::uint64_t seed) : seed_(seed) {
-  const sim::CameraConfig cfg = sim::CameraConfig::from_json(s.camera, "/camera");
-  const VisionConfig vc = VisionConfig::from_json(s.vision, "/vision");
-  camera_ = std::make_unique<sim::PanoramicCamera>(cfg, s.field);
+CameraPerception::CameraPerception(const Scenario& s, std::uint64_t seed)
+    : CameraPerception(sim::CameraConfig::from_json(s.camera, "/camera"), s.field, VisionConfig::from_json(s.vision, "/vision"), seed) {}
+
+CameraPerception::CameraPerception(const sim::CameraConfig& cfg, const Field& field, const VisionConfig& vc, std::uint64_t seed) : seed_(seed) {
+  camera_ = std::make_unique<sim::PanoramicCamera>(cfg, field);
   map_ = calibration_for(cfg, vc.calibration, seed);
-  table_ = colour_table_for(cfg, s.field, vc.colour_table, seed);
+  table_ = colour_table_for(cfg, field, vc.colour_table, seed);
   detector_ = std::make_unique<LineDetector>(vc.scan, map_, table_);
   exposure_ = vc.exposure;
   exposure_.exposure_min = cfg.exposure_min;
   exposure_.exposure_max = cfg.exposure_max;
   exposure_.gain_min = cfg.gain_min;
   exposure_.gain_max = cfg.gain_max;
-  if (vc.detect_blobs(s.field)) {
+  if (vc.detect_blobs(field)) {
     BlobParams bp = vc.blobs;
     if (!vc.blob_edge_colours_given)
-      for (const auto& g : s.field.goals) {
+      for (const auto& g : field.goals) {
         const ColourClass c = landmark_colour_class(g.colour);
         if (c != kUnknown && std::find(bp.edge_colours.begin(), bp.edge_colours.end(), c) == bp.edge_colours.end())
           bp.edge_colours.push_back(c);

@@ -33,11 +33,21 @@ struct VisionConfig {
   static VisionConfig from_json(const Json& j, const std::string& path, Json* effective = nullptr);
 };
 
+/// The one assembly of camera + calibration map + colour table + detectors (the run loop, `render`
+/// and the experiments all build theirs here, so they see and process pixels alike).
 class CameraPerception : public Perception {
  public:
+  /// `seed` names the calibration and colour-table runs ("auto") and the camera noise streams.
+  CameraPerception(const sim::CameraConfig& camera, const Field& field, const VisionConfig& vision, std::uint64_t seed);
+  /// The scenario's camera, field and vision configuration.
   CameraPerception(const Scenario& s, std::uint64_t seed);
   PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) override;
   const sim::PanoramicCamera& camera() const { return *camera_; }
+  sim::PanoramicCamera& camera() { return *camera_; }
+  const CalibrationMap& calibration() const { return map_; }
+  const ColourTable& colour_table() const { return table_; }
+  /// The exposure controller's parameters with the camera's exposure and gain ranges filled in.
+  const ExposureParams& exposure_params() const { return exposure_; }
   const LineDetector& detector() const { return *detector_; }
   /// Null when the scenario does not detect blobs.
   const BlobDetector* blob_detector() const { return blob_detector_.get(); }

@@ -2,11 +2,14 @@
 // Scoring: the only place where ground truth meets estimates. Errors per frame, and the papers'
 // table layout (mean, std and max of |x|, |y| errors in cm and |theta| error in rad) plus position
 // RMSE and percentiles.
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/json_reader.hpp"
 #include "core/pose2.hpp"
+#include "harness/events.hpp"
+#include "harness/run_record.hpp"
 
 namespace omniloc::harness {
 
@@ -40,6 +43,19 @@ struct TableRow {
 /// The papers' layout: | case | mean x | mean y | mean th | std x | std y | std th | max x | max y | max th |
 /// followed by frames and position RMSE / p95. Plain text, fixed width.
 std::string paper_table(const std::vector<TableRow>& rows);
+
+/// The score of one localized robot over a run.
+struct RobotScore {
+  ErrorSummary all;                            ///< every frame with a valid estimate
+  std::optional<ErrorSummary> tracking_phase;  ///< with kidnaps or covers: the frames the papers' tables describe
+  Json json;                                   ///< the robot's entry of summary.json
+};
+
+/// Scores a robot's frames: the error statistics, vision statistics (line points, coasting), the
+/// failures stated rather than averaged away (relocalisations, wrong and point-mirrored frames),
+/// recovery from each kidnap and, with kidnaps or covers, the tracking phase (split_tracking_phase).
+/// `events`: the scenario's, in time order; `duration`: the run's, seconds.
+RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& events, double duration);
 
 /// Percentile (0..100) of a sample by linear interpolation between order statistics.
 double percentile(std::vector<double> v, double p);

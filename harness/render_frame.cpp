@@ -1,6 +1,7 @@
 #include "harness/render_frame.hpp"
 
-#include <map>
+#include <algorithm>
+#include <cmath>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -10,38 +11,38 @@
 #include "core/error.hpp"
 #include "harness/camera_perception.hpp"
 #include "harness/vision_setup.hpp"
-#include "sim/motion.hpp"
+#include "harness/simulation.hpp"
 #include "sim/render/panoramic_camera.hpp"
-#include "sim/world.hpp"
 
 namespace omniloc::harness {
 
 sim::WorldState world_at(const Scenario& s, double t, std::uint64_t seed) {
-  sim::World world(s.field, 1.0 / s.physics_rate);
-  std::map<int, std::unique_ptr<sim::MotionScript>> scripts;
-  for (const auto& rc : s.robots) {
-    world.add_robot(rc.spec);
-    scripts[rc.spec.id] = sim::MotionScript::from_json(rc.motion, rc.motion_path, derive_seed(seed, "motion/" + std::to_string(rc.spec.id)), &s.field);
-  }
-  if (s.has_ball) world.set_ball(s.ball_position, s.ball_velocity);
-  std::size_t next = 0;
-  Rng event_rng = Rng::stream(seed, "events");  // as in the run loop, so random targets agree
-  while (world.time() < t - 1e-9) {
-    while (next < s.events.size() && s.events[next].t <= world.time() + 1e-9) {
-      const auto& e = s.events[next++];
-      if (e.type == "teleport" || e.type == "kidnap") {
-        world.teleport(e.robot, s.event_target(e, event_rng));
-        scripts[e.robot]->on_teleport();
-      }
-    }
-    const sim::WorldState ws = world.state();
-    for (const auto& rc : s.robots) world.command(rc.spec.id, scripts[rc.spec.id]->command(ws, rc.spec.id, world.time()));
-    world.step();
-  }
-  sim::WorldState ws = world.state();
-  ws.lighting = s.lighting_at(ws.t);
-  return ws;
+  Simulation sim(s, seed);
+  sim.advance_to(t);
+  return sim.state();
 }
+
+namespace {
+
+// Replays the run's camera frames 0..k_last; returns robot's image of frame k_last.
+Image replayed_frame(const Scenario& s, long long k_last, int robot, std::uint64_t seed, CameraPerception& perception) {
+  Simulation sim(s, seed);
+  const std::vector<int> localized = s.localized_robots();
+  const bool is_localized = std::find(localized.begin(), localized.end(), robot) != localized.end();
+  for (long long k = 0; k <= k_last; ++k) {
+    sim.advance_to(static_cast<double>(k) / s.camera_rate);
+    const sim::WorldState now = sim.state();
+    for (int id : localized) {
+      const PerceptionOutput po = perception.observe(sim.camera_view(now), id, now.t, sim.conditions(id, now));
+      sim.set_paused(id, po.stop_robot);
+      if (k == k_last && id == robot) return *po.image;
+    }
+    if (k == k_last && !is_localized) return *perception.observe(sim.camera_view(now), robot, now.t, sim.conditions(robot, now)).image;
+  }
+  throw RuntimeFailure("no frame " + std::to_string(k_last));
+}
+
+}  // namespace
 
 void write_png(const Image& img, const std::string& path) {
   cv::Mat rgb(img.height, img.width, CV_8UC3, const_cast<std::uint8_t*>(img.rgb.data()));
@@ -60,19 +61,19 @@ void write_png(const Image& img, const std::string& path) {
 void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed, bool labels, const std::string& png_path, bool points) {
   if (!s.robot(robot_id)) throw ConfigError("--robot", std::to_string(robot_id), "the id of a robot in the scenario");
   if (t < 0 || t > s.duration) throw ConfigError("--t", std::to_string(t), "a time within the scenario's duration");
-  const sim::CameraConfig cfg = sim::CameraConfig::from_json(s.camera, "/camera");
-  sim::PanoramicCamera cam(cfg, s.field);
-  const sim::WorldState ws = world_at(s, t, seed);
-  Rng rng = Rng::stream(seed, "camera/" + std::to_string(robot_id));
-  Image img = labels ? cam.render_labels(ws, robot_id) : cam.render(ws, robot_id, cfg.initial, rng);
-  if (labels)  // spread the class ids over the grey range so the picture is readable
-    for (auto& v : img.rgb) v = static_cast<std::uint8_t>(std::min(255, v * 21));
+  const long long k = static_cast<long long>(std::floor(t * s.camera_rate + 1e-9));
+  CameraPerception perception(s, seed);
+  Image img;
+  if (labels) {
+    Simulation sim(s, seed);
+    sim.advance_to(static_cast<double>(k) / s.camera_rate);
+    img = perception.camera().render_labels(sim.camera_view(sim.state()), robot_id);
+    for (auto& v : img.rgb) v = static_cast<std::uint8_t>(std::min(255, v * 21));  // class ids spread over the grey range
+  } else {
+    img = replayed_frame(s, k, robot_id, seed, perception);
+  }
   if (points && !labels) {
-    const VisionConfig vc = VisionConfig::from_json(s.vision, "/vision");
-    const CalibrationMap map = calibration_for(cfg, vc.calibration, seed);
-    const ColourTable table = colour_table_for(cfg, s.field, vc.colour_table, seed);
-    const LineDetector det(vc.scan, map, table);
-    const ScanResult r = det.detect(img);
+    const ScanResult r = perception.detector().detect(img);
     cv::Mat m(img.height, img.width, CV_8UC3, img.rgb.data());
     for (const auto& p : r.pixels) cv::circle(m, cv::Point(static_cast<int>(p.x()), static_cast<int>(p.y())), 3, cv::Scalar(255, 0, 0), 1);
   }

@@ -1,7 +1,8 @@
 #pragma once
-// The run loop: steps the Box2D world at the physics rate, feeds sensors, and at the camera rate
-// runs perception + localizer for every localized robot; scores against truth; writes the results
-// directory atomically (everything goes to a temporary folder that is renamed at the end).
+// The run loop: at every camera frame the Simulation advances to the frame time, each localized
+// robot's camera frame goes through Perception and its localizer, and the frame is recorded; at the
+// end metrics score the records against truth and run_writer writes the results directory atomically
+// (everything goes to a temporary folder that is renamed at the end).
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -37,8 +38,5 @@ struct RunResult {
 };
 
 RunResult run_scenario(const Scenario& scenario, const RunOptions& options);
-
-/// TUM trajectory line: "t x y z qx qy qz qw" (z = 0, rotation about z).
-std::string tum_line(double t, const Pose2& p);
 
 }  // namespace omniloc::harness

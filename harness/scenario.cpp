@@ -100,27 +100,13 @@ NoiseProfile NoiseProfile::named(const std::string& name, const std::string& pat
   throw ConfigError(path, "\"" + name + "\"", "a noise profile: \"ideal\", \"robot\" or \"field_robot\"");
 }
 
-Pose2 Scenario::event_target(const EventConfig& e, Rng& rng) const {
-  if (!e.random_pose) return e.pose;
-  const double x = rng.uniform(-0.5 * field.length + 0.5, 0.5 * field.length - 0.5);
-  const double y = rng.uniform(-0.5 * field.width + 0.5, 0.5 * field.width - 0.5);
-  return Pose2(x, y, rng.uniform(-kPi, kPi));
-}
-
 sim::Lighting Scenario::lighting_at(double t) const {
   sim::Lighting l = lighting;
   for (std::size_t i = 0; i < l.sun.size(); ++i) l.sun[i].centre += sun_velocity[i] * t;
   // Events in time order; each moves its target (the global level, or each listed lamp's state)
   // linearly from where the earlier events left it to the new value over its transition.
-  for (const auto& e : events) {
-    if (e.type != "lights" || e.t > t) continue;
-    const double f = e.transition > 0 ? std::min(1.0, (t - e.t) / e.transition) : 1.0;
-    if (e.lamps.empty()) {
-      l.level += f * (e.level - l.level);
-    } else {
-      for (int k : e.lamps) l.lamps[static_cast<std::size_t>(k)].state += f * (e.level - l.lamps[static_cast<std::size_t>(k)].state);
-    }
-  }
+  for (const auto& e : events)
+    if (const auto* lights = e.as<Lights>(); lights && e.t <= t) lights->shade(l, e.t, t);
   return l;
 }
 
@@ -249,53 +235,12 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   // Events.
   if (const Json* ev = r.raw("events")) {
     if (!ev->is_array()) throw ConfigError("/events", json_brief(*ev), "an array of event objects");
-    for (std::size_t i = 0; i < ev->size(); ++i) {
-      const std::string ep = json_child("/events", i);
-      JsonReader er((*ev)[i], ep);
-      er.allow("comment");
-      EventConfig e;
-      e.path = ep;
-      e.type = er.string("type", std::nullopt, {"teleport", "cover", "kidnap", "occlude", "lights"});
-      e.t = er.number("t", std::nullopt, 0.0, s.duration);
-      e.robot = static_cast<int>(er.integer("robot", s.localized_robots().front(), 0, 99));
-      if (!s.robot(e.robot)) throw ConfigError(ep + "/robot", std::to_string(e.robot), "the id of a robot in /robots");
-      if (e.type == "teleport" || e.type == "kidnap") {
-        const Json* pj = er.raw("pose", true);
-        if (pj->is_string()) {
-          if (pj->get<std::string>() != "random") throw ConfigError(ep + "/pose", json_brief(*pj), "[x, y, theta] or \"random\"");
-          e.random_pose = true;
-        } else {
-          if (!pj->is_array() || pj->size() != 3 || !(*pj)[0].is_number() || !(*pj)[1].is_number() || !(*pj)[2].is_number())
-            throw ConfigError(ep + "/pose", json_brief(*pj), "[x, y, theta] or \"random\"");
-          e.pose = Pose2((*pj)[0].get<double>(), (*pj)[1].get<double>(), (*pj)[2].get<double>());
-          check_on_floor(s.field, e.pose.translation(), s.robot(e.robot)->spec.radius, ep + "/pose", "a target with the whole robot");
-        }
-      }
-      if (e.type == "cover" || e.type == "kidnap" || e.type == "occlude")
-        e.duration = er.positive("duration", e.type == "kidnap" ? 2.0 : 1.0, 3600.0);
-      if (e.type == "occlude") {
-        // The mask's keys sit beside the event's own keys.
-        Json mask = (*ev)[i];
-        for (const char* k : {"type", "t", "robot", "duration", "comment"}) mask.erase(k);
-        e.mask = sim::OcclusionMask::from_json(mask, ep);
-        for (auto it = mask.begin(); it != mask.end(); ++it) er.allow(it.key());
-      }
-      if (e.type == "lights") {
-        e.level = er.number("level", std::nullopt, 0.0, 20.0);
-        e.transition = er.number("transition", 0.5, 0.0, 600.0);
-        if (const Json* lamps = er.raw("lamps")) {  // indices checked against /lighting/lamps below
-          if (!lamps->is_array() || lamps->empty()) throw ConfigError(ep + "/lamps", json_brief(*lamps), "a non-empty array of lamp indices");
-          for (std::size_t k = 0; k < lamps->size(); ++k) {
-            const Json& v = (*lamps)[k];
-            if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 10000)
-              throw ConfigError(json_child(ep + "/lamps", k), json_brief(v), "a lamp index (an integer >= 0)");
-            e.lamps.push_back(v.get<int>());
-          }
-        }
-      }
-      er.finish();
-      s.events.push_back(e);
-    }
+    EventContext ctx;
+    ctx.field = &s.field;
+    ctx.run_duration = s.duration;
+    ctx.default_robot = s.localized_robots().front();
+    for (const auto& rc : s.robots) ctx.robots.emplace_back(rc.spec.id, rc.spec.radius);
+    for (std::size_t i = 0; i < ev->size(); ++i) s.events.push_back(parse_event((*ev)[i], json_child("/events", i), ctx));
     std::stable_sort(s.events.begin(), s.events.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
   }
 
@@ -369,10 +314,11 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
     l->finish();
   }
   for (const auto& e : s.events)
-    for (std::size_t k = 0; k < e.lamps.size(); ++k)
-      if (static_cast<std::size_t>(e.lamps[k]) >= s.lighting.lamps.size())
-        throw ConfigError(json_child(e.path + "/lamps", k), std::to_string(e.lamps[k]),
-                          "the index of a lamp in /lighting/lamps (" + std::to_string(s.lighting.lamps.size()) + " lamps)");
+    if (const auto* lights = e.as<Lights>())
+      for (std::size_t k = 0; k < lights->lamps.size(); ++k)
+        if (static_cast<std::size_t>(lights->lamps[k]) >= s.lighting.lamps.size())
+          throw ConfigError(json_child(e.path + "/lamps", k), std::to_string(lights->lamps[k]),
+                            "the index of a lamp in /lighting/lamps (" + std::to_string(s.lighting.lamps.size()) + " lamps)");
 
   const Json* loc = r.raw("localizer");
   s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};

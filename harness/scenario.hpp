@@ -10,6 +10,7 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
+#include "harness/events.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/sensors.hpp"
 #include "sim/world_state.hpp"
@@ -37,19 +38,6 @@ struct RobotConfig {
   sim::HeadingNoise heading;
 };
 
-struct EventConfig {
-  double t = 0.0;            ///< seconds
-  std::string type;          ///< "teleport", "cover", "kidnap", "occlude", "lights"
-  int robot = 0;
-  Pose2 pose;                ///< teleport / kidnap target
-  bool random_pose = false;  ///< "pose": "random": drawn from the run's seed (stream "events") on the field
-  double duration = 0.0;     ///< cover / kidnap / occlude: how long, seconds
-  sim::OcclusionMask mask;   ///< occlude
-  double level = 1.0;        ///< lights: new global illumination level, or with `lamps` those lamps' new state (0 off, 1 on)
-  double transition = 0.0;   ///< lights: seconds to reach it (lamps warming up / dimming)
-  std::vector<int> lamps;    ///< lights: indices into /lighting/lamps switched; empty = the global level
-  std::string path;          ///< JSON path, for messages
-};
 
 struct Scenario {
   std::string name;
@@ -65,7 +53,7 @@ struct Scenario {
   bool has_ball = false;
   Eigen::Vector2d ball_position = Eigen::Vector2d::Zero();
   Eigen::Vector2d ball_velocity = Eigen::Vector2d::Zero();
-  std::vector<EventConfig> events;  ///< sorted by time
+  std::vector<Event> events;       ///< sorted by time (harness/events.hpp)
   sim::OcclusionMask occlusion;     ///< for the whole run (paper 002 table 1)
   sim::Lighting lighting;           ///< at t = 0
   std::vector<Eigen::Vector2d> sun_velocity;  ///< m/s per sun patch (sun moving slowly)
@@ -77,9 +65,6 @@ struct Scenario {
   const RobotConfig* robot(int id) const;
   /// Lighting at time t: lamp events applied with their transitions, sun patches moved.
   sim::Lighting lighting_at(double t) const;
-  /// Target of a teleport / kidnap event: its pose, or for "random" a pose inside the lines (0.5 m
-  /// clear of them, any heading) drawn from `rng` (the run's stream "events", in event order).
-  Pose2 event_target(const EventConfig& e, Rng& rng) const;
   std::vector<int> localized_robots() const;
 };
 

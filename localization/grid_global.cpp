@@ -114,7 +114,7 @@ Estimate GridGlobalLocalizer::update(const Observations& obs, const Odometry& od
   Estimate e;
   if (!tracking_) {
     const auto pts = subsample(obs.line_points, p_.matching.max_points);
-    e.mode = "global";
+    e.mode = LocalizerMode::kGlobal;
     e.valid = false;
     if (obs.camera_ok && static_cast<int>(pts.size()) >= p_.matching.min_points) {
       // Paper 000 needs the MTi; without a heading, search eight headings (eight times the work).
@@ -136,14 +136,14 @@ Estimate GridGlobalLocalizer::update(const Observations& obs, const Odometry& od
       good_frames_ = 0;
       e.pose = ch.result;
       e.valid = true;
-      e.mode = best->accepted ? "converged" : "converged_weak";
+      e.mode = best->accepted ? LocalizerMode::kConverged : LocalizerMode::kConvergedWeak;
       e.match_error = ch.error;
       e.extra["global_passes"] = best->passes;
       last_ = std::move(best);
     }
   } else {
     e = tracker_.track(obs, odo);
-    if (e.mode == "tracking") {
+    if (e.mode == LocalizerMode::kTracking) {
       const auto pts = subsample(obs.line_points, p_.matching.max_points);
       const double dev = line_deviation(tracker_.map(), pts, e.pose, p_.detection.deviation_quantile);
       e.extra["deviation_m"] = dev;
@@ -162,7 +162,7 @@ Estimate GridGlobalLocalizer::update(const Observations& obs, const Odometry& od
         tracking_ = false;
         ++restarts_;
         e.valid = false;
-        e.mode = "restart";
+        e.mode = LocalizerMode::kRestart;
       }
     }
   }

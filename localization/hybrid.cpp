@@ -48,12 +48,12 @@ Estimate HybridLocalizer::update(const Observations& obs, const Odometry& odo, s
       e.pose = start;
       tracking_ = true;
       detector_.reset();
-      e.mode = "converged";
+      e.mode = LocalizerMode::kConverged;
     }
   } else {
     e = tracker_.track(obs, odo);
     // Wrong-localisation detection (paper 002).
-    if (e.mode == "tracking") {
+    if (e.mode == LocalizerMode::kTracking) {
       const double dev = line_deviation(tracker_.map(), subsample(obs.line_points, p_.matching.max_points), e.pose, p_.detection.deviation_quantile);
       e.extra["deviation_m"] = dev;
       if (detector_.update(dev, e.pose, heading)) {
@@ -61,7 +61,7 @@ Estimate HybridLocalizer::update(const Observations& obs, const Odometry& odo, s
         tracking_ = false;
         ++restarts_;
         e.valid = false;
-        e.mode = "restart";
+        e.mode = LocalizerMode::kRestart;
       }
     }
   }

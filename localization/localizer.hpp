@@ -2,6 +2,7 @@
 // The one interface every localizer implements. A localizer sees only robot-side data:
 // line points / blobs from the vision front end (robot frame), odometry and an optional absolute
 // heading. It never sees the simulator.
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -55,12 +56,46 @@ struct Observations {
   std::vector<Blob> blobs;
 };
 
+/// What a localizer is doing in a frame. Written as text (mode_name) only in frames.csv and
+/// events.jsonl; code compares the enum.
+enum class LocalizerMode : std::uint8_t {
+  kNone,           ///< no frame yet (written as an empty field)
+  kTracking,       ///< matching / MCL tracking a pose it stands behind
+  kCoasting,       ///< no usable vision: odometry only, no jump
+  kGlobal,         ///< searching the whole field (MCL spread out, grid search running)
+  kConverged,      ///< a global search has just settled on a pose
+  kConvergedWeak,  ///< grid_global: settled on the best candidate without the acceptance test
+  kRestart,        ///< the wrong-localisation detector gave the pose up
+  kFix,            ///< landmarks: a pose from this frame's bearings
+  kOdometry,       ///< landmarks: no fix this frame, odometry since the last one
+  kNoFix,          ///< landmarks: no fix yet
+  kDeadReckoning,  ///< odometry_only
+};
+
+/// The mode as written in frames.csv and events.jsonl ("tracking", "converged_weak", ...).
+inline const char* mode_name(LocalizerMode m) {
+  switch (m) {
+    case LocalizerMode::kNone: return "";
+    case LocalizerMode::kTracking: return "tracking";
+    case LocalizerMode::kCoasting: return "coasting";
+    case LocalizerMode::kGlobal: return "global";
+    case LocalizerMode::kConverged: return "converged";
+    case LocalizerMode::kConvergedWeak: return "converged_weak";
+    case LocalizerMode::kRestart: return "restart";
+    case LocalizerMode::kFix: return "fix";
+    case LocalizerMode::kOdometry: return "odometry";
+    case LocalizerMode::kNoFix: return "no_fix";
+    case LocalizerMode::kDeadReckoning: return "dead_reckoning";
+  }
+  return "";
+}
+
 /// A localizer's answer for one frame.
 struct Estimate {
   Pose2 pose;                                      ///< world frame
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  ///< (x, y, theta), m^2 / rad^2
   bool valid = false;       ///< false until the localizer has a pose it stands behind
-  std::string mode;         ///< e.g. "tracking", "global", "coasting" (written to frames.csv)
+  LocalizerMode mode = LocalizerMode::kNone;
   double match_error = 0.0; ///< localizer-specific quality figure (lower is better)
   /// Extra numbers for frames.csv (e.g. "global_ms", "particles"), stable keys per localizer.
   std::map<std::string, double> extra;

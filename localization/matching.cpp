@@ -180,7 +180,7 @@ Estimate MatchingLocalizer::track(const Observations& obs, const Odometry& odome
   const std::vector<Eigen::Vector2d> pts = subsample(obs.line_points, p_.max_points);
   e.extra["points"] = static_cast<double>(pts.size());
   if (!obs.camera_ok || static_cast<int>(pts.size()) < p_.min_points) {
-    e.mode = "coasting";  // no usable vision: odometry only, no jump
+    e.mode = LocalizerMode::kCoasting;  // no usable vision: odometry only, no jump
     e.pose = kf_.pose();
     e.covariance = kf_.covariance();
     e.valid = started_;
@@ -200,7 +200,7 @@ Estimate MatchingLocalizer::track(const Observations& obs, const Odometry& odome
   e.pose = kf_.pose();
   e.covariance = kf_.covariance();
   e.valid = started_;
-  e.mode = "tracking";
+  e.mode = LocalizerMode::kTracking;
   e.match_error = m.error;
   e.extra["iterations"] = m.iterations;
   e.extra["match_sd_xy"] = std::sqrt(0.5 * (m.covariance(0, 0) + m.covariance(1, 1)));

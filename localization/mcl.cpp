@@ -180,7 +180,7 @@ Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std:
   e.pose = Pose2(mx, my, std::atan2(ss, sc));
   e.covariance = Eigen::Vector3d(vx / n, vy / n, theta_std * theta_std).asDiagonal();
   e.valid = converged_;
-  e.mode = converged_ ? "converged" : "global";
+  e.mode = converged_ ? LocalizerMode::kConverged : LocalizerMode::kGlobal;
   e.match_error = see ? match_error(map_, pts, e.pose, 0.25) : 1.0;
   e.extra["particles"] = n;
   e.extra["spread_m"] = spread;

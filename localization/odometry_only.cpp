@@ -12,7 +12,7 @@ Estimate OdometryOnlyLocalizer::update(const Observations&, const Odometry& odom
   Estimate e;
   e.pose = pose_;
   e.valid = started_;
-  e.mode = "dead_reckoning";
+  e.mode = LocalizerMode::kDeadReckoning;
   e.covariance.setZero();
   return e;
 }

@@ -170,7 +170,7 @@ TEST_F(BlobsTest, LocalizerRecoversThePoseFromTheFrame) {
   loc.reset(std::nullopt);
   const Estimate e = loc.update(obs, Odometry{}, std::nullopt);
   ASSERT_TRUE(e.valid) << no_fix_reason_name(loc.last_frame().reason) << ": " << loc.last_frame().detail;
-  EXPECT_EQ(e.mode, "fix");
+  EXPECT_EQ(e.mode, LocalizerMode::kFix);
   EXPECT_LT((e.pose.translation() - kPose.translation()).norm(), 0.2);
   EXPECT_LT(std::fabs(angle_diff(e.pose.theta, kPose.theta)), 0.05);
   EXPECT_EQ(e.extra.at("landmarks_used"), 4.0);
@@ -197,7 +197,7 @@ TEST_F(BlobsTest, FewerThanThreeLandmarksGiveNoFixWithAReason) {
   loc.reset(std::nullopt);
   const Estimate e = loc.update(obs, Odometry{}, std::nullopt);
   EXPECT_FALSE(e.valid);
-  EXPECT_EQ(e.mode, "no_fix");
+  EXPECT_EQ(e.mode, LocalizerMode::kNoFix);
   EXPECT_EQ(e.extra.at("no_fix_reason"), static_cast<double>(NoFixReason::kTooFewLandmarks));
   EXPECT_EQ(e.extra.at("no_fix_total"), 1.0);
   EXPECT_FALSE(loc.last_frame().detail.empty());
@@ -360,10 +360,10 @@ TEST(LandmarkLocalizerTest, OdometryPredictionBetweenFixes) {
     EXPECT_EQ(e.extra.at("no_fix_reason"), static_cast<double>(NoFixReason::kTooFewLandmarks));
     if (k <= 2) {
       EXPECT_TRUE(e.valid) << k;
-      EXPECT_EQ(e.mode, "odometry");
+      EXPECT_EQ(e.mode, LocalizerMode::kOdometry);
     } else {
       EXPECT_FALSE(e.valid) << "0.3 s after the fix, beyond max_prediction_time";
-      EXPECT_EQ(e.mode, "no_fix");
+      EXPECT_EQ(e.mode, LocalizerMode::kNoFix);
     }
   }
 }

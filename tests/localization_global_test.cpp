@@ -63,7 +63,7 @@ TEST(Hybrid, DetectsAKidnapAndRecovers) {
   h.reset(a);  // tracking from a known pose
   Estimate e;
   for (int k = 0; k < 10; ++k) e = h.update(see(f, a, world), Odometry{}, a.theta);
-  EXPECT_EQ(e.mode, "tracking");
+  EXPECT_EQ(e.mode, LocalizerMode::kTracking);
   EXPECT_LT(std::hypot(e.pose.x - a.x, e.pose.y - a.y), 0.05);
   // Kidnapped to b: no odometry of the move. Detection must fire and MCL find b.
   bool restarted = false;
@@ -72,7 +72,7 @@ TEST(Hybrid, DetectsAKidnapAndRecovers) {
     restarted = restarted || e.extra["restarts"] > 0;
   }
   EXPECT_TRUE(restarted);
-  EXPECT_EQ(e.mode, "tracking");
+  EXPECT_EQ(e.mode, LocalizerMode::kTracking);
   EXPECT_LT(std::hypot(e.pose.x - b.x, e.pose.y - b.y), 0.1);
   EXPECT_LT(std::fabs(angle_diff(e.pose.theta, b.theta)), 0.05);
 }
@@ -118,15 +118,15 @@ TEST(GridGlobal, DetectsAKidnapAndRelocalises) {
   g.reset(std::nullopt);
   const Pose2 a(-4.0, -2.0, 0.3), b(3.0, 2.5, 2.0);
   Estimate e = g.update(see(f, a, world), Odometry{}, a.theta);
-  EXPECT_EQ(e.mode, "converged");
+  EXPECT_EQ(e.mode, LocalizerMode::kConverged);
   EXPECT_LT(std::hypot(e.pose.x - a.x, e.pose.y - a.y), 0.1);
   for (int k = 0; k < 10; ++k) e = g.update(see(f, a, world), Odometry{}, a.theta);
-  EXPECT_EQ(e.mode, "tracking");
+  EXPECT_EQ(e.mode, LocalizerMode::kTracking);
   // Kidnapped to b (no odometry of the move): the detector fires, the grid search runs again.
   bool restarted = false;
   for (int k = 0; k < 60; ++k) {
     e = g.update(see(f, b, world), Odometry{}, b.theta);
-    restarted = restarted || e.mode == "restart";
+    restarted = restarted || e.mode == LocalizerMode::kRestart;
   }
   EXPECT_TRUE(restarted);
   EXPECT_LT(std::hypot(e.pose.x - b.x, e.pose.y - b.y), 0.1);

@@ -105,12 +105,12 @@ TEST(Matching, NoPointsCoastsOnOdometryWithoutJumpOrNaN) {
   Odometry o;
   o.delta = Pose2(0.05, 0, 0);
   const Estimate e = loc.update(none, o, std::nullopt);
-  EXPECT_EQ(e.mode, "coasting");
+  EXPECT_EQ(e.mode, LocalizerMode::kCoasting);
   EXPECT_NEAR(e.pose.x, 1.05, 1e-12);
   EXPECT_TRUE(std::isfinite(e.pose.y) && std::isfinite(e.pose.theta) && std::isfinite(e.match_error));
   Observations few;
   few.line_points = {{1, 0}, {2, 0}};
-  EXPECT_EQ(loc.update(few, o, std::nullopt).mode, "coasting");
+  EXPECT_EQ(loc.update(few, o, std::nullopt).mode, LocalizerMode::kCoasting);
 }
 
 // Cold starts (issue 17: after a kidnap or from the grid search): from the true pose offset by

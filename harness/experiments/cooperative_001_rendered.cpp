@@ -19,6 +19,7 @@
 #include "harness/localizer_registry.hpp"
 #include "harness/plot.hpp"
 #include "harness/run_directory.hpp"
+#include "harness/camera_perception.hpp"
 #include "harness/vision_setup.hpp"
 #include "localization/cooperative/ball_trackers.hpp"
 #include "localization/cooperative/hough_ball.hpp"
@@ -237,17 +238,17 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
 
   // Off-line set-up as a team does it (cached in results/cache): mirror calibration and colour table
   // for this camera and this field, then the robot-side detectors.
-  sim::PanoramicCamera cam(g.camera, g.field);
-  const CalibrationMap map = calibration_for(g.camera, "auto", seed);
-  const ColourTable table = colour_table_for(g.camera, g.field, "auto", seed);
-  BlobParams bp;
-  bp.colours = {kBallOrange};
-  bp.edge_colours.clear();
-  bp.min_area_px = g.min_area_px;
-  const BlobDetector blobs(bp, map, table);
-  ScanLineParams sp;
-  sp.line_width = g.field.line_width;
-  const LineDetector lines(sp, map, table);
+  VisionConfig vc;
+  vc.scan.line_width = g.field.line_width;
+  vc.blobs_detect = "on";
+  vc.blobs.colours = {kBallOrange};
+  vc.blobs.edge_colours.clear();
+  vc.blobs.min_area_px = g.min_area_px;
+  vc.blob_edge_colours_given = true;  // the ball only: no goal edges
+  CameraPerception rig(g.camera, g.field, vc, seed);
+  sim::PanoramicCamera& cam = rig.camera();
+  const BlobDetector& blobs = *rig.blob_detector();
+  const LineDetector& lines = rig.detector();
   const auto t_setup = Clock::now();
 
   // True poses (field frame). Default heading: each robot faces the middle of the ball path, as a

@@ -39,11 +39,11 @@ int run_entropy_maps(const ExperimentArgs& args, std::ostream& out) {
   std::vector<Case> cases = {{"normal", load_scenario(dir_s + "lighting_002.json")}, {"sun", load_scenario(dir_s + "lighting_002_sun.json")}};
   const Scenario& base = cases[0].sc;
   const sim::CameraConfig cfg = sim::CameraConfig::from_json(base.camera, "/camera");
-  sim::PanoramicCamera cam(cfg, base.field);
-  const CalibrationMap map = calibration_for(cfg, "auto", args.seed);
-  const ColourTable table = colour_table_for(cfg, base.field, "auto", args.seed);
   const VisionConfig vc = VisionConfig::from_json(base.vision, "/vision");
-  const LineDetector det(vc.scan, map, table);
+  CameraPerception rig(cfg, base.field, vc, args.seed);
+  sim::PanoramicCamera& cam = rig.camera();
+  const CalibrationMap& map = rig.calibration();
+  const LineDetector& det = rig.detector();
   const int robot = base.localized_robots().front();
   RunDirectory dir(args.out_dir);
   const double step = args.quick ? 6.0 : 2.0, lo = 2.0, hi = 40.0;
@@ -80,10 +80,9 @@ int run_entropy_maps(const ExperimentArgs& args, std::ostream& out) {
     }
     line_series.push_back(line);
     // The controller on this scene: settled under normal light at 18 / 18, then this case's light.
-    ExposureParams ep = vc.exposure;
+    ExposureParams ep = rig.exposure_params();
     ep.enabled = true;
     ep.search_at_start = false;  // settled under normal light first; the change of light triggers the search
-    ep.exposure_min = cfg.exposure_min, ep.exposure_max = cfg.exposure_max, ep.gain_min = cfg.gain_min, ep.gain_max = cfg.gain_max;
     ExposureController ctl(ep, cfg.initial);
     const sim::Lighting target = ws.lighting;
     const Image before = [&] {

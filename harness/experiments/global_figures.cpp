@@ -28,10 +28,10 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 
 
 int run_global_figures(const ExperimentArgs& args, std::ostream& out) {
   const Scenario sc = load_scenario(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/kidnap_000.json");
-  const EventConfig& kidnap = sc.events.front();
+  const Event& kidnap = sc.events.front();
   const int robot = kidnap.robot;
   // The robot stands at the first kidnap target, camera uncovered: what the localizer sees then.
-  const double t = kidnap.t + kidnap.duration;
+  const double t = kidnap.t + kidnap.duration();
   const sim::WorldState ws = world_at(sc, t, args.seed);
   const Pose2 truth = ws.robot(robot)->pose;
   CameraPerception perception(sc, args.seed);

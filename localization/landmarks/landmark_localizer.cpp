@@ -298,7 +298,7 @@ Estimate LandmarkLocalizer::update(const Observations& obs, const Odometry& odom
     since_fix_ = 0.0;
     e.pose = pose_;
     e.valid = true;
-    e.mode = "fix";
+    e.mode = LocalizerMode::kFix;
     const double sp = sb / std::max(last_.fix.reliability, 1e-9);
     e.covariance = Eigen::Vector3d(0.5 * sp * sp, 0.5 * sp * sp, sb * sb).asDiagonal();
   } else {
@@ -307,13 +307,13 @@ Estimate LandmarkLocalizer::update(const Observations& obs, const Odometry& odom
     e.pose = pose_;
     if (p_.odometry_prediction && recent) {
       e.valid = true;
-      e.mode = "odometry";
+      e.mode = LocalizerMode::kOdometry;
       // Odometry error grows roughly with time since the fix; a plain, documented inflation.
       const double s = 0.1 + 0.2 * since_fix_;
       e.covariance = Eigen::Vector3d(s * s, s * s, 0.05 + 0.1 * since_fix_).asDiagonal();
     } else {
       e.valid = false;
-      e.mode = "no_fix";
+      e.mode = LocalizerMode::kNoFix;
       e.covariance = Eigen::Matrix3d::Identity() * 1e6;
     }
   }

@@ -1,0 +1,33 @@
+#pragma once
+// What a run records per camera frame of each localized robot: the truth (for scoring only), the
+// localizer's answer, the vision statistics and the wall-clock stage times. The scoring
+// (harness/metrics) and the result files (harness/run_writer) are computed from these records alone.
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/pose2.hpp"
+#include "localization/localizer.hpp"
+
+namespace omniloc::harness {
+
+struct FrameRecord {
+  double t = 0.0;         ///< seconds
+  Pose2 truth, est;       ///< world frame
+  bool valid = false;     ///< the localizer stood behind `est`
+  bool camera_ok = false; ///< the image was usable
+  bool contact = false;   ///< the robot touched another body in the physics step
+  LocalizerMode mode = LocalizerMode::kNone;
+  std::size_t points = 0; ///< line points found in the image
+  double match_error = 0.0;
+  std::map<std::string, double> extra;  ///< localizer extras and the camera settings (frames.csv columns)
+  double render_ms = 0.0, vision_ms = 0.0, localize_ms = 0.0;  ///< wall time: timing.csv only
+};
+
+struct RobotRecord {
+  int id = 0;
+  std::vector<FrameRecord> frames;
+};
+
+}  // namespace omniloc::harness

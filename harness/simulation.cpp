@@ -1,0 +1,117 @@
+#include "harness/simulation.hpp"
+
+#include "harness/events.hpp"
+
+namespace omniloc::harness {
+
+Simulation::Simulation(const Scenario& s, std::uint64_t seed, EventLog* log)
+    : sc_(s), log_(log), world_(s.field, 1.0 / s.physics_rate), event_rng_(Rng::stream(seed, "events")) {
+  for (const auto& rc : s.robots) {
+    world_.add_robot(rc.spec);
+    const std::string id = std::to_string(rc.spec.id);
+    scripts_[rc.spec.id] = sim::MotionScript::from_json(rc.motion, rc.motion_path, derive_seed(seed, "motion/" + id), &s.field);
+  }
+  if (s.has_ball) world_.set_ball(s.ball_position, s.ball_velocity);
+  for (int id : s.localized_robots()) {
+    const RobotConfig& rc = *s.robot(id);
+    Sensors& se = sensors_[id];
+    se.odometry = std::make_unique<sim::OdometrySensor>(rc.odometry, Rng::stream(seed, "odometry/" + std::to_string(id)));
+    se.heading = std::make_unique<sim::HeadingSensor>(rc.heading, Rng::stream(seed, "heading/" + std::to_string(id)));
+    se.has_heading = rc.has_heading_sensor;
+  }
+  // Camera latency: the image shows the world as it was `latency` seconds before the frame time.
+  latency_ = s.camera.value("latency_ms", 0.0) * 1e-3;
+}
+
+Simulation::~Simulation() = default;
+
+double Simulation::time() const { return world_.time(); }
+
+void Simulation::advance_to(double t) {
+  const double dt = world_.dt();
+  while (world_.time() < t - 1e-9) {
+    while (next_event_ < sc_.events.size() && sc_.events[next_event_].t <= world_.time() + 1e-9) {
+      const Json record = apply_event(sc_.events[next_event_++], *this);
+      if (log_) log_->add(record);
+    }
+    const sim::WorldState ws = world_.state();
+    for (const auto& rc : sc_.robots)
+      world_.command(rc.spec.id, paused(rc.spec.id) ? sim::DriveCommand{} : scripts_[rc.spec.id]->command(ws, rc.spec.id, world_.time()));
+    world_.step();
+    if (latency_ > 0) {
+      history_.push_back(world_.state());
+      while (history_.size() > 1 && history_[1].t <= world_.time() - latency_ - 1e-9) history_.pop_front();
+    }
+    for (auto& [id, se] : sensors_) {
+      se.odometry->accumulate(world_.wheel_motion(id));
+      se.heading->advance(dt);
+    }
+  }
+}
+
+sim::WorldState Simulation::state() const {
+  sim::WorldState ws = world_.state();
+  ws.lighting = sc_.lighting_at(ws.t);
+  return ws;
+}
+
+sim::WorldState Simulation::camera_view(const sim::WorldState& now) const {
+  if (!(latency_ > 0) || history_.empty() || history_.front().t > now.t - latency_ + 1e-9) return now;
+  const sim::WorldState* past = &history_.front();
+  for (const auto& h : history_)
+    if (h.t <= now.t - latency_ + 1e-9) past = &h;
+  sim::WorldState seen = *past;
+  seen.lighting = now.lighting;
+  return seen;
+}
+
+FrameConditions Simulation::conditions(int robot, const sim::WorldState& now) const {
+  FrameConditions cond;
+  const double theta = now.robot(robot)->pose.theta;
+  // Whole-run mask and event masks together (event masks may overlap the run's mask).
+  cond.occlusion = sc_.occlusion.robot_frame(theta);
+  auto it = cameras_.find(robot);
+  if (it == cameras_.end()) return cond;
+  cond.covered = now.t < it->second.covered_until;
+  if (now.t < it->second.occluded_until)
+    for (const auto& sector : it->second.mask.robot_frame(theta)) cond.occlusion.push_back(sector);
+  return cond;
+}
+
+SensorReadings Simulation::read_sensors(int robot, const sim::WorldState& now) {
+  Sensors& se = sensors_.at(robot);
+  SensorReadings r;
+  r.odometry = se.odometry->read(now.t);
+  if (se.has_heading) r.heading = se.heading->read(now.t, now.robot(robot)->pose.theta).heading;
+  return r;
+}
+
+bool Simulation::in_contact(int robot) const { return world_.in_contact(robot); }
+
+void Simulation::set_paused(int robot, bool p) { paused_[robot] = p; }
+
+bool Simulation::paused(int robot) const {
+  auto it = paused_.find(robot);
+  return it != paused_.end() && it->second;
+}
+
+void Simulation::teleport(int robot, const Pose2& pose) {
+  world_.teleport(robot, pose);
+  scripts_[robot]->on_teleport();
+}
+
+void Simulation::cover_camera(int robot, double until) { cameras_[robot].covered_until = until; }
+
+void Simulation::occlude_camera(int robot, double until, const sim::OcclusionMask& mask) {
+  cameras_[robot].occluded_until = until;
+  cameras_[robot].mask = mask;
+}
+
+Pose2 Simulation::random_pose_on_field() {
+  const Field& f = sc_.field;
+  const double x = event_rng_.uniform(-0.5 * f.length + 0.5, 0.5 * f.length - 0.5);
+  const double y = event_rng_.uniform(-0.5 * f.width + 0.5, 0.5 * f.width - 0.5);
+  return Pose2(x, y, event_rng_.uniform(-kPi, kPi));
+}
+
+}  // namespace omniloc::harness
