@@ -4,10 +4,11 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/angles.hpp"
 #include "core/error.hpp"
-#include "sim/render/image_blur.hpp"
+#include "sim/render/photometry.hpp"
 
 namespace omniloc::sim {
 
@@ -24,19 +25,6 @@ const Eigen::Vector3f kPost(0.85f, 0.85f, 0.85f);
 const Eigen::Vector3f kNet(0.50f, 0.52f, 0.50f);
 const Eigen::Vector3f kBody(0.35f, 0.35f, 0.35f);
 const Eigen::Vector3f kBlack(0.03f, 0.03f, 0.03f);
-
-// GL colours carry albedo * illumination / kRadianceScale, so illumination up to 4x normal fits.
-constexpr float kRadianceScale = 4.0f;
-// Camera response: value (DN) = kResponse * albedo * illumination * exposure_ms * gain. The sensor's
-// sensitivity is set so that, under normal light, the image entropy along exposure = gain peaks at
-// 18 / 18 as paper 002 reports for its camera (measured with `omniloc experiment entropy_maps`):
-// the carpet's green channel then sits near 180 DN and the white lines clip, as on many robot cameras.
-// (v1 put the lines at 200 DN at 18 / 18; its entropy peak lay at 26-30.)
-constexpr double kResponse = 2.25 * 200.0 / (0.85 * 18.0 * 18.0);
-// Pixel noise: standard normals kept in 1/32 steps from -4 to +4 (one byte each); the step is a
-// thirtieth of a DN at the largest noise (about 5 DN), well below the output's rounding.
-constexpr double kNoiseStep = 1.0 / 32.0;
-constexpr double kNoiseZero = 127.5;  // index of 0 (halfway, so the steps are symmetric)
 
 // Floor markings from a distance field: each texel holds the distance from its centre to the nearest
 // marking's centre line (a 16-bit fraction of kDistanceRange metres). The shader takes the pixel's
@@ -239,14 +227,7 @@ struct PanoramicCameraImpl {
   SharedTris walls;                    // the hall's walls
   SharedTris statics;                  // goals, landmarks
   std::vector<unsigned char> readback;      // labels, RGBA8
-  std::vector<std::uint16_t> readback16;   // radiance, RGBA16
-  std::vector<std::uint16_t> subframe;     // one sub-frame of a motion-blurred exposure
-  std::vector<std::uint32_t> accumulate;   // the sum of the sub-frames
-  std::unique_ptr<RadialDefocus> defocus;  // null: sharp
-  std::unique_ptr<RotationSmear> smear;    // null: no motion blur
-  double finest_floor_m_per_px = 0.0;      // the smallest floor extent of an image pixel (at the body's edge)
-  std::vector<std::uint8_t> noise;     // standard normals in steps of kNoiseStep, drawn once from the first render's Rng
-  std::vector<float> row_radiance;     // photometry scratch: one row's linear values
+  std::optional<Photometry> photometry;    // radiance to pixels, and the optics before it
   // Per-draw scratch.
   std::vector<float> pos, col, tex;
   std::vector<float> shared_xyz;       // this frame's projections of a SharedTris' vertices
@@ -415,29 +396,7 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
   m.walls = share_vertices(std::move(wall_tris));
   m.statics = share_vertices(std::move(static_tris));
 
-  // Defocus (docs/camera.md "Optical blur"): the camera focuses on the mirror's virtual image at
-  // focus_radius; elsewhere the virtual image lies off the focused surface by a depth that grows
-  // with the squared image radius (a curved image surface), so the blur circle's diameter is
-  // b(r) = optical_blur_px |r^2 - rf^2| / (rim^2 - rf^2); a uniform disc of diameter b has a
-  // per-axis std of b / 4, used as the Gaussian's sigma.
-  if (cfg_.optical_blur_px > 0) {
-    const double rim = mirror_.rim(), rf = cfg_.focus_radius_fraction * rim;
-    const int n = static_cast<int>(std::ceil(rim * m.ss)) + 2;
-    std::vector<double> sigma(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) {
-      const double r = static_cast<double>(i) / m.ss;
-      sigma[static_cast<std::size_t>(i)] = m.ss * 0.25 * cfg_.optical_blur_px * std::fabs(r * r - rf * rf) / (rim * rim - rf * rf);
-    }
-    m.defocus = std::make_unique<RadialDefocus>(m.W, m.H, centre() * m.ss, rim * m.ss, sigma);
-  }
-  if (cfg_.motion_blur) m.smear = std::make_unique<RotationSmear>(m.W, m.H, centre() * m.ss, mirror_.rim() * m.ss);
-  // The floor's finest sampling sets how many sub-frames an exposure of a moving robot needs.
-  m.finest_floor_m_per_px = 1e9;
-  for (double r = mirror_.body_radius(); r + 1.0 <= mirror_.rim(); r += 1.0) {
-    const double e0 = mirror_.elevation(r), e1 = mirror_.elevation(r + 1.0);
-    if (e1 >= -1e-6) break;
-    m.finest_floor_m_per_px = std::min(m.finest_floor_m_per_px, cfg_.mount_height / std::tan(-e1) - cfg_.mount_height / std::tan(-e0));
-  }
+  m.photometry.emplace(cfg_, mirror_, m.ss);
 }
 
 PanoramicCamera::~PanoramicCamera() {
@@ -770,42 +729,12 @@ void draw_scene(PanoramicCameraImpl& m, const CameraConfig& cfg, const MirrorPro
 
 }  // namespace
 
-namespace {
-
-// One row of the sensor: value = radiance * per_unit (DN), plus noise of std
-// sqrt(var_read + var_shot * min(255, value)) times a standard normal from the noise table (steps
-// of kNoiseStep around kNoiseZero), rounded and clipped. This file is compiled with
-// -fno-math-errno (CMakeLists.txt; the square root's argument is never negative) so that the loop
-// vectorises.
-void expose_row(const float* rad, const std::uint8_t* nz, std::uint8_t* out, int n, float per_unit,
-                                                        float var_read, float var_shot) {
-  const float step = static_cast<float>(kNoiseStep), zero = static_cast<float>(kNoiseZero);
-  for (int i = 0; i < n; ++i) {
-    const float mean = rad[i] * per_unit;
-    const float sigma = std::sqrt(var_read + var_shot * (mean < 255.0f ? mean : 255.0f));
-    float val = mean + sigma * ((static_cast<float>(nz[i]) - zero) * step) + 0.5f;
-    val = val < 0.0f ? 0.0f : (val > 255.0f ? 255.0f : val);
-    out[i] = static_cast<std::uint8_t>(static_cast<int>(val));
-  }
-}
-
-}  // namespace
-
 Image PanoramicCamera::render(const WorldState& world, int robot_id, const CameraSettings& requested, Rng& rng) {
   PanoramicCameraImpl& m = *impl_;
   const RobotState* me = world.robot(robot_id);
   if (!me) throw RuntimeFailure("render: no robot with id " + std::to_string(robot_id));
   const CameraSettings st = clamp(requested);
-  if (m.noise.empty()) {
-    // 2^20 standard normals, stored as steps of kNoiseStep (index kNoiseZero = 0), plus a copy of
-    // the first row's worth at the end, so that a row's samples are one contiguous run of the table
-    // (a strided walk of a float table missed the cache on every sample).
-    const std::size_t n = std::size_t{1} << 20;
-    m.noise.resize(n + 3 * static_cast<std::size_t>(cfg_.width));
-    for (std::size_t i = 0; i < n; ++i)
-      m.noise[i] = static_cast<std::uint8_t>(std::clamp(std::lround(kNoiseZero + rng.normal() / kNoiseStep), 0L, 255L));
-    std::copy(m.noise.begin(), m.noise.begin() + static_cast<std::ptrdiff_t>(m.noise.size() - n), m.noise.begin() + static_cast<std::ptrdiff_t>(n));
-  }
+  m.photometry->draw_noise_table(rng);  // first: the order of the draws from `rng` shapes every frame after
   // Tilt: per-frame vibration plus the body's pitch and roll on its suspension under the drive's
   // acceleration (forward acceleration tips the top backwards, acceleration to the left tips it
   // to the right; docs/camera.md "Tilt").
@@ -819,87 +748,31 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
   const Eigen::Matrix3d R = camera_rotation(roll, pitch);
   // Motion blur: the sensor integrates over the exposure [t - T, t]. Translation (of this robot and
   // everything else moving) by sub-frames along constant velocities, as many as the fastest image
-  // motion needs at the floor's finest sampling (one per pixel of smear, at most kMaxSubframes);
-  // this robot's rotation about the mirror axis as an exact polar smear of omega * T below.
+  // motion needs at the floor's finest sampling; this robot's rotation about the mirror axis as an
+  // exact polar smear of omega * T below.
   const double exposure_s = cfg_.motion_blur ? 1e-3 * st.exposure_ms : 0.0;
-  constexpr int kMaxSubframes = 3;
-  int subframes = 1;
-  if (exposure_s > 0) {
-    const double px = me->velocity.norm() * exposure_s / m.finest_floor_m_per_px;
-    subframes = std::clamp(static_cast<int>(std::ceil(px)), 1, kMaxSubframes);
-  }
+  const int subframes = m.photometry->subframes(me->velocity.norm(), exposure_s);
   if (subframes == 1) {
     draw_scene(m, cfg_, mirror_, centre(), world, *me, R, false);
-    m.ctx->read_rgba16(m.readback16);
+    m.ctx->read_rgba16(m.photometry->radiance());
   } else {
-    m.accumulate.assign(static_cast<std::size_t>(m.W) * m.H * 4, 0u);
+    m.photometry->clear_sum();
     for (int k = 0; k < subframes; ++k) {
       const double back = exposure_s * (1.0 - (k + 0.5) / subframes);  // seconds before t
       WorldState w = world;
       for (auto& r : w.robots) r.pose = Pose2(r.pose.x - back * r.velocity.x(), r.pose.y - back * r.velocity.y(), r.pose.theta);
       w.ball.position -= back * w.ball.velocity;
       draw_scene(m, cfg_, mirror_, centre(), w, *w.robot(robot_id), R, false);
-      m.ctx->read_rgba16(m.subframe);
-      for (std::size_t i = 0; i < m.subframe.size(); ++i) m.accumulate[i] += m.subframe[i];
+      m.ctx->read_rgba16(m.photometry->subframe());
+      m.photometry->add_subframe();
     }
-    m.readback16.resize(m.accumulate.size());
-    for (std::size_t i = 0; i < m.accumulate.size(); ++i)
-      m.readback16[i] = static_cast<std::uint16_t>((m.accumulate[i] + static_cast<std::uint32_t>(subframes / 2)) / static_cast<std::uint32_t>(subframes));
+    m.photometry->average(subframes);
   }
-  const Rgba16View view{m.readback16.data(), m.W, m.H};
   // Over the exposure the robot turned by omega * T; the image at time t - s is the final one turned
   // back by omega * s about the mirror axis (robot forward up, left left: a left turn moves the
   // scene clockwise on the image).
-  if (m.smear) m.smear->apply(view, me->omega * exposure_s);
-  if (m.defocus) m.defocus->apply(view);
-
-  // Photometry per pixel and channel from the full 16 bits (expose_row; a table by 8-bit GL
-  // level, the way until photometry v3, put steps of up to 8 DN into a dimly lit carpet once
-  // exposure and gain were raised).
-  const int samples = m.ss * m.ss;
-  const float per_unit = static_cast<float>(kRadianceScale / 65535.0 / samples * kResponse * st.exposure_ms * st.gain);
-  const float gainf = static_cast<float>(st.gain / 18.0);
-  const float var_read = static_cast<float>(cfg_.read_noise * cfg_.read_noise) * gainf * gainf;
-  const float var_shot = static_cast<float>(cfg_.shot_noise * cfg_.shot_noise) * gainf;
-  Image img;
-  img.width = cfg_.width;
-  img.height = cfg_.height;
-  img.rgb.resize(static_cast<std::size_t>(img.width) * img.height * 3);
-  const std::size_t mask = (std::size_t{1} << 20) - 1;
-  std::size_t k = off & mask;
-  const Eigen::Vector2d c = centre();
-  const double rim = mirror_.rim();
-  std::fill(img.rgb.begin(), img.rgb.end(), std::uint8_t{0});  // outside the mirror: black
-  std::vector<float>& radiance = m.row_radiance;
-  for (int v = 0; v < img.height; ++v) {
-    // The span of this row inside the mirror rim.
-    const double dv = v + 0.5 - c.y();
-    if (std::fabs(dv) >= rim) continue;
-    const double half = std::sqrt(rim * rim - dv * dv);
-    const int u0 = std::max(0, static_cast<int>(std::ceil(c.x() - half - 0.5)));
-    const int u1 = std::min(img.width - 1, static_cast<int>(std::floor(c.x() + half - 0.5)));
-    if (u1 < u0) continue;
-    const int n = 3 * (u1 - u0 + 1);
-    radiance.resize(static_cast<std::size_t>(n));
-    const std::uint16_t* r0 = &m.readback16[static_cast<std::size_t>(m.H - 1 - v * m.ss) * m.W * 4];  // GL rows bottom-up
-    if (m.ss == 1) {
-      for (int u = u0; u <= u1; ++u)
-        for (int ch = 0; ch < 3; ++ch) radiance[static_cast<std::size_t>(3 * (u - u0) + ch)] = r0[u * 4 + ch];
-    } else {
-      const std::uint16_t* r1 = r0 - static_cast<std::ptrdiff_t>(m.W) * 4;
-      for (int u = u0; u <= u1; ++u)
-        for (int ch = 0; ch < 3; ++ch) {
-          const int a = (2 * u) * 4 + ch, b = a + 4;
-          radiance[static_cast<std::size_t>(3 * (u - u0) + ch)] = static_cast<float>(r0[a] + r0[b] + r1[a] + r1[b]);
-        }
-    }
-    const std::uint8_t* nz = &m.noise[k];
-    std::uint8_t* out = img.row(v) + 3 * u0;
-    const float* rad = radiance.data();
-    expose_row(rad, nz, out, n, per_unit, var_read, var_shot);
-    k = (k + static_cast<std::size_t>(n)) & mask;
-  }
-  return img;
+  m.photometry->apply_optics(me->omega * exposure_s);
+  return m.photometry->expose(st, off);
 }
 
 Image PanoramicCamera::render_labels(const WorldState& world, int robot_id) {
