@@ -82,6 +82,13 @@ Lights parse(std::in_place_type_t<Lights>, JsonReader& r, const Json&, const std
   return k;
 }
 
+Slip parse(std::in_place_type_t<Slip>, JsonReader& r, const Json&, const std::string&, int, const EventContext&) {
+  Slip k;
+  k.duration = r.positive("duration", 1.0, 3600.0);
+  k.scale = r.number("scale", 1.5, 0.0, 10.0);
+  return k;
+}
+
 // --- apply: what the kind does to the running simulation, and what events.jsonl records ------------
 
 void apply(const Teleport& k, const Event& e, Simulation& sim, Json& log) {
@@ -113,6 +120,12 @@ void apply(const Occlude& k, const Event& e, Simulation& sim, Json& log) {
 void apply(const Lights& k, const Event&, Simulation&, Json& log) {
   log["level"] = k.level;
   log["transition"] = k.transition;
+}
+
+void apply(const Slip& k, const Event& e, Simulation& sim, Json& log) {
+  sim.slip_wheels(e.robot, sim.time() + k.duration, k.scale);
+  log["duration"] = k.duration;
+  log["scale"] = k.scale;
 }
 
 template <std::size_t... I>
@@ -152,6 +165,7 @@ double Event::duration() const {
   if (const auto* k = as<Kidnap>()) return k->duration;
   if (const auto* k = as<Cover>()) return k->duration;
   if (const auto* k = as<Occlude>()) return k->duration;
+  if (const auto* k = as<Slip>()) return k->duration;
   return 0.0;
 }
 

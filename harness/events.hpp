@@ -58,7 +58,15 @@ struct Lights {
   void shade(sim::Lighting& l, double t_event, double t) const;
 };
 
-using EventKind = std::variant<Teleport, Kidnap, Cover, Occlude, Lights>;
+/// The wheels slip for `duration` seconds: odometry reports `scale` times the wheel motion (above 1:
+/// wheels spinning on the carpet while the robot is held; 0: a lifted robot's encoders see nothing).
+struct Slip {
+  static constexpr const char* kName = "slip";
+  double duration = 1.0;
+  double scale = 1.5;
+};
+
+using EventKind = std::variant<Teleport, Kidnap, Cover, Occlude, Lights, Slip>;
 
 struct Event {
   double t = 0.0;    ///< seconds
@@ -72,7 +80,7 @@ struct Event {
   std::string type() const;
   /// Kidnaps and covers interrupt tracking: the papers' tables describe the frames between them.
   bool disrupts_tracking() const { return as<Kidnap>() || as<Cover>(); }
-  /// Seconds the event lasts (cover, kidnap, occlude), else 0.
+  /// Seconds the event lasts (cover, kidnap, occlude, slip), else 0.
   double duration() const;
 };
 

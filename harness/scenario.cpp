@@ -62,44 +62,6 @@ void check_data_file(const std::string& file, const std::string& where, const st
 
 }  // namespace
 
-std::vector<std::string> NoiseProfile::names() { return {"ideal", "robot", "field_robot"}; }
-
-NoiseProfile NoiseProfile::named(const std::string& name, const std::string& path) {
-  NoiseProfile p;
-  p.name = name;
-  if (name == "ideal") {
-    p.camera = Json{{"vibration_deg", 0.0}, {"read_noise", 0.0}, {"shot_noise", 0.0}, {"latency_ms", 0.0}};
-    return p;
-  }
-  if (name == "robot") {
-    // Physically plausible values for an MSL robot on carpet (not tuned to the papers' table):
-    // odometry random walk 1.5 cm/sqrt(m) with 1 % wheel-scale error and 2 deg/sqrt(rad) turn noise;
-    // an MTi-class heading: 1 deg white noise, bias random walk 0.1 deg/sqrt(s).
-    p.odometry = {0.015, 0.035, 0.01, 0.01};
-    p.heading = {deg2rad(1.0), deg2rad(0.1), 0.0, 0.0, 0.0};
-    // The camera's own defaults (vibration, pixel noise) plus one frame of latency at 30 Hz: the
-    // image is exposed and transferred before the odometry it is fused with.
-    p.camera = Json{{"latency_ms", 33.0}};
-    return p;
-  }
-  if (name == "field_robot") {
-    // `robot` plus what a real robot's camera adds (issue 17; magnitudes argued in docs/camera.md):
-    // defocus growing to a 2.5 px blur circle at the rim (thin lens, f = 6 mm at f/2, mirror 14 cm
-    // away, virtual image 2 cm deep across the mirror), motion blur over the exposure, 0.1 deg of
-    // body tilt per m/s^2 of drive acceleration (tyre and mast compliance), and a mirror 9 px off
-    // the image centre (NuBot's calibrated corrections are 1.5-12.5 px), which calibration estimates.
-    p = named("robot", path);
-    p.name = name;
-    p.camera["optical_blur_px"] = 2.5;
-    p.camera["focus_radius_fraction"] = 0.5;
-    p.camera["motion_blur"] = true;
-    p.camera["tilt_deg_per_mps2"] = 0.1;
-    p.camera["centre_offset_px"] = Json::array({6.4, -6.4});
-    return p;
-  }
-  throw ConfigError(path, "\"" + name + "\"", "a noise profile: \"ideal\", \"robot\" or \"field_robot\"");
-}
-
 sim::Lighting Scenario::lighting_at(double t) const {
   sim::Lighting l = lighting;
   for (std::size_t i = 0; i < l.sun.size(); ++i) l.sun[i].centre += sun_velocity[i] * t;

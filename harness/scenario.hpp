@@ -18,7 +18,8 @@
 
 namespace omniloc::harness {
 
-/// Sensor-noise defaults a scenario starts from (explicit values override them).
+/// Sensor-noise defaults a scenario starts from (explicit values override them). The named profiles
+/// and the argument for each value are data: data/noise_profiles.json (harness/noise_profile.cpp).
 struct NoiseProfile {
   std::string name;
   sim::OdometryNoise odometry;

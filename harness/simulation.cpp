@@ -43,7 +43,10 @@ void Simulation::advance_to(double t) {
       while (history_.size() > 1 && history_[1].t <= world_.time() - latency_ - 1e-9) history_.pop_front();
     }
     for (auto& [id, se] : sensors_) {
-      se.odometry->accumulate(world_.wheel_motion(id));
+      const Pose2 wheels = world_.wheel_motion(id);
+      // The step that ends at world_.time() started before slip_until: it slipped.
+      const bool slipping = world_.time() - dt < se.slip_until - 1e-9;
+      se.odometry->accumulate(slipping ? Pose2(wheels.x * se.slip_scale, wheels.y * se.slip_scale, wheels.theta * se.slip_scale) : wheels);
       se.heading->advance(dt);
     }
   }
@@ -105,6 +108,13 @@ void Simulation::cover_camera(int robot, double until) { cameras_[robot].covered
 void Simulation::occlude_camera(int robot, double until, const sim::OcclusionMask& mask) {
   cameras_[robot].occluded_until = until;
   cameras_[robot].mask = mask;
+}
+
+void Simulation::slip_wheels(int robot, double until, double scale) {
+  auto it = sensors_.find(robot);
+  if (it == sensors_.end()) return;  // a robot that is not localized has no odometry to fool
+  it->second.slip_until = until;
+  it->second.slip_scale = scale;
 }
 
 Pose2 Simulation::random_pose_on_field() {

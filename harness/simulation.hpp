@@ -71,6 +71,8 @@ class Simulation {
   void teleport(int robot, const Pose2& pose);
   void cover_camera(int robot, double until);
   void occlude_camera(int robot, double until, const sim::OcclusionMask& mask);
+  /// Until `until`, the robot's odometry accumulates `scale` times its wheel motion.
+  void slip_wheels(int robot, double until, double scale);
   /// A pose 0.5 m inside the lines, any heading, from the run's stream "events" (in event order).
   Pose2 random_pose_on_field();
 
@@ -79,6 +81,8 @@ class Simulation {
     std::unique_ptr<sim::OdometrySensor> odometry;
     std::unique_ptr<sim::HeadingSensor> heading;
     bool has_heading = true;
+    double slip_until = -1.0;  ///< seconds
+    double slip_scale = 1.0;
   };
   struct CameraState {
     double covered_until = -1.0;

@@ -39,7 +39,7 @@ std::string error_path(const Json& events) {
 }  // namespace
 
 TEST(Events, TypeNamesFollowTheVariant) {
-  EXPECT_EQ(event_type_names(), (std::vector<std::string>{"teleport", "kidnap", "cover", "occlude", "lights"}));
+  EXPECT_EQ(event_type_names(), (std::vector<std::string>{"teleport", "kidnap", "cover", "occlude", "lights", "slip"}));
 }
 
 TEST(Events, EveryKindParsesWithItsDefaults) {
@@ -148,4 +148,28 @@ TEST(Events, RandomTargetsComeFromTheRunSeedInEventOrder) {
     EXPECT_LE(std::fabs(p.x), 8.5 + 1e-9);
     EXPECT_LE(std::fabs(p.y), 5.5 + 1e-9);
   }
+}
+
+TEST(Events, SlipScalesTheOdometryForItsDuration) {
+  // Exact sensors (ideal profile), the robot driving straight at 1 m/s: odometry = wheel motion.
+  Json j = scenario_with(Json::array());
+  j["robots"][0]["motion"] = Json::parse(R"({"type": "constant", "velocity": [1.0, 0.0]})");
+  const Scenario plain = parse_scenario(j, "t");
+  j["events"] = Json::parse(R"([{"type": "slip", "t": 1.0, "duration": 0.5, "scale": 1.5}])");
+  const Scenario slipping = parse_scenario(j, "t");
+  EXPECT_DOUBLE_EQ(slipping.events[0].duration(), 0.5);
+  auto odometry = [](const Scenario& s) {
+    Simulation sim(s, 1);
+    std::vector<double> dx;
+    for (double t : {1.0, 1.5, 2.0}) {
+      sim.advance_to(t);
+      dx.push_back(sim.read_sensors(0, sim.state()).odometry.delta.x);
+    }
+    return dx;
+  };
+  const auto a = odometry(plain), b = odometry(slipping);
+  EXPECT_DOUBLE_EQ(b[0], a[0]);             // before the slip
+  EXPECT_NEAR(b[1], 1.5 * a[1], 1e-12);     // during it: 1.5 x the wheel motion
+  EXPECT_NEAR(a[1], 0.5, 0.01);
+  EXPECT_DOUBLE_EQ(b[2], a[2]);             // after it
 }
