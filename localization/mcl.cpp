@@ -105,10 +105,13 @@ double McLLocalizer::injection_rate() {
 void McLLocalizer::resample(double sum, double inject, std::optional<double> heading) {
   std::vector<Particle> next;
   if (p_.kld.enabled) {
-    const auto drawn = filter::kld_resample(w_, sum, p_.particles, p_.kld, [&](std::size_t i) -> const Pose2& { return ps_[i].pose; }, rng_);
+    // Fox 2003: as many independent draws as the bins they fill call for (no injection).
+    const auto pose_of = [&](std::size_t i) -> const Pose2& { return ps_[i].pose; };
+    const auto drawn = filter::kld_resample(w_, sum, p_.particles, p_.kld, pose_of, rng_);
     next.reserve(drawn.size());
     for (std::size_t i : drawn) next.push_back({ps_[i].pose, 0.0});
   } else {
+    // Low-variance resampling; augmented MCL replaces some slots by random poses.
     next.reserve(ps_.size());
     filter::LowVarianceSampler sampler(w_, sum, ps_.size(), rng_);
     for (std::size_t m = 0; m < ps_.size(); ++m) {
