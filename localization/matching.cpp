@@ -26,11 +26,7 @@ MatchingParams MatchingParams::from_json(JsonReader& r) {
   p.heading_prior = r.number("heading_prior", p.heading_prior, 0.0, 1000.0);
   p.point_sigma = r.positive("point_sigma", p.point_sigma, 2.0);
   p.cell = r.number("cell", p.cell, 0.005, 0.5);
-  p.odo_trans_frac = r.number("odo_trans_frac", p.odo_trans_frac, 0.0, 2.0);
-  p.odo_rot_frac = r.number("odo_rot_frac", p.odo_rot_frac, 0.0, 2.0);
-  p.odo_rot_per_m = r.number("odo_rot_per_m", p.odo_rot_per_m, 0.0, 2.0);
-  p.odo_floor_xy = r.number("odo_floor_xy", p.odo_floor_xy, 0.0, 1.0);
-  p.odo_floor_theta = r.number("odo_floor_theta", p.odo_floor_theta, 0.0, 1.0);
+  p.odometry = filter::OdometryNoiseParams::from_json(r, p.odometry, filter::OdometryNoiseParams::Keys::WithRotPerMetre);
   return p;
 }
 
@@ -143,29 +139,6 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
   return r;
 }
 
-void PoseKalman::predict(const Pose2& d, const MatchingParams& p) {
-  const double th = x_.theta, c = std::cos(th), s = std::sin(th);
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-  F(0, 2) = -s * d.x - c * d.y;
-  F(1, 2) = c * d.x - s * d.y;
-  const double dist = std::hypot(d.x, d.y);
-  const double sxy = p.odo_trans_frac * dist + p.odo_floor_xy;
-  const double sth = p.odo_rot_frac * std::fabs(d.theta) + p.odo_rot_per_m * dist + p.odo_floor_theta;
-  Eigen::Matrix3d Q = Eigen::Vector3d(sxy * sxy, sxy * sxy, sth * sth).asDiagonal();
-  x_ = x_.compose(d);
-  P_ = F * P_ * F.transpose() + Q;
-}
-
-void PoseKalman::update(const Pose2& z, const Eigen::Matrix3d& R) {
-  const Eigen::Matrix3d S = P_ + R;
-  const Eigen::Matrix3d K = P_ * S.inverse();
-  const Eigen::Vector3d innov(z.x - x_.x, z.y - x_.y, angle_diff(z.theta, x_.theta));
-  const Eigen::Vector3d dx = K * innov;
-  x_ = Pose2(x_.x + dx.x(), x_.y + dx.y(), x_.theta + dx.z());
-  P_ = (Eigen::Matrix3d::Identity() - K) * P_;
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
-}
-
 MatchingLocalizer::MatchingLocalizer(const Field& field, const MatchingParams& p, const std::string& cache_dir)
     : p_(p), map_(field, p.cell, cache_dir) {}
 
@@ -175,7 +148,7 @@ void MatchingLocalizer::reset(const std::optional<Pose2>& start) {
 }
 
 Estimate MatchingLocalizer::track(const Observations& obs, const Odometry& odometry) {
-  kf_.predict(odometry.delta, p_);
+  kf_.predict(odometry.delta, p_.odometry);
   Estimate e;
   const std::vector<Eigen::Vector2d> pts = subsample(obs.line_points, p_.max_points);
   e.extra["points"] = static_cast<double>(pts.size());

@@ -1,7 +1,8 @@
 #pragma once
 // Matching-optimisation tracking (paper 002; Lauer, Lange, Riedmiller 2005 "Calculating the perfect
 // match"): minimise sum_i e(d(o_i)) with e(t) = 1 - c^2 / (c^2 + t^2) over the pose by RPROP, take the
-// uncertainty from the error's second derivatives, and fuse with odometry in a Kalman filter.
+// uncertainty from the error's second derivatives, and fuse with odometry in a Kalman filter
+// (filter/pose_kalman.hpp).
 #include <optional>
 #include <vector>
 
@@ -9,6 +10,8 @@
 
 #include "core/json_reader.hpp"
 #include "localization/field_map.hpp"
+#include "localization/filter/odometry_noise.hpp"
+#include "localization/filter/pose_kalman.hpp"
 #include "localization/localizer.hpp"
 
 namespace omniloc {
@@ -36,12 +39,9 @@ struct MatchingParams {
   double heading_prior = 2.5;    ///< weight of (theta - predicted theta)^2 (Tribots: 2.5)
   double point_sigma = 0.05;     ///< m, line-point noise used to turn curvature into covariance
   double cell = 0.05;            ///< m, distance-map cell (Tribots: 50 mm)
-  // Odometry process noise of the Kalman filter (per frame): std = fraction * motion + floor.
-  double odo_trans_frac = 0.05;  ///< of the distance travelled
-  double odo_rot_frac = 0.05;    ///< of the angle turned
-  double odo_rot_per_m = 0.02;   ///< rad per metre travelled
-  double odo_floor_xy = 0.002;   ///< m
-  double odo_floor_theta = 0.002;  ///< rad
+  /// Odometry process noise of the Kalman filter per frame (JSON odo_trans_frac 0.05, odo_rot_frac
+  /// 0.05, odo_rot_per_m 0.02 rad/m, odo_floor_xy 0.002 m, odo_floor_theta 0.002 rad).
+  filter::OdometryNoiseParams odometry{0.05, 0.05, 0.02, 0.002, 0.002};
   static MatchingParams from_json(JsonReader& r);
 };
 
@@ -64,23 +64,6 @@ double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& poin
 MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& start, const MatchingParams& p,
                         int max_iterations, std::optional<double> prior_theta = std::nullopt, std::vector<double>* trace = nullptr);
 
-/// (x, y, theta) Kalman filter: odometry prediction, pose measurement update.
-class PoseKalman {
- public:
-  void reset(const Pose2& pose, const Eigen::Matrix3d& cov) {
-    x_ = pose;
-    P_ = cov;
-  }
-  void predict(const Pose2& delta, const MatchingParams& p);
-  void update(const Pose2& z, const Eigen::Matrix3d& R);
-  const Pose2& pose() const { return x_; }
-  const Eigen::Matrix3d& covariance() const { return P_; }
-
- private:
-  Pose2 x_;
-  Eigen::Matrix3d P_ = Eigen::Matrix3d::Identity();
-};
-
 /// Localizer "matching": tracking from a given start pose.
 class MatchingLocalizer : public Localizer {
  public:
@@ -91,12 +74,12 @@ class MatchingLocalizer : public Localizer {
   /// Tracking step usable by other localizers (hybrid, grid_global).
   Estimate track(const Observations& obs, const Odometry& odometry);
   const FieldMap& map() const { return map_; }
-  PoseKalman& filter() { return kf_; }
+  filter::PoseKalman& filter() { return kf_; }
 
  private:
   MatchingParams p_;
   FieldMap map_;
-  PoseKalman kf_;
+  filter::PoseKalman kf_;
   bool started_ = false;
 };
 

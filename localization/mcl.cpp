@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_set>
 
+#include "localization/filter/particle_set.hpp"
 #include "localization/matching.hpp"
 
 namespace omniloc {
@@ -18,21 +18,13 @@ McLParams McLParams::from_json(JsonReader& r) {
   p.min_points = static_cast<int>(r.integer("min_points", p.min_points, 1, 10000));
   p.evidence_points = r.number("evidence_points", p.evidence_points, 0.0, 10000.0);
   p.heading_sigma = r.positive("heading_sigma", p.heading_sigma, 10.0);
-  p.odo_trans_frac = r.number("odo_trans_frac", p.odo_trans_frac, 0.0, 2.0);
-  p.odo_rot_frac = r.number("odo_rot_frac", p.odo_rot_frac, 0.0, 2.0);
-  p.odo_floor_xy = r.number("odo_floor_xy", p.odo_floor_xy, 0.0, 1.0);
-  p.odo_floor_theta = r.number("odo_floor_theta", p.odo_floor_theta, 0.0, 1.0);
+  p.odometry = filter::OdometryNoiseParams::from_json(r, p.odometry, filter::OdometryNoiseParams::Keys::Planar);
   p.converged_std = r.positive("converged_std", p.converged_std, 10.0);
   p.converged_theta_std = r.positive("converged_theta_std", p.converged_theta_std, 10.0);
   p.alpha_slow = r.number("alpha_slow", p.alpha_slow, 0.0, 1.0);
   p.alpha_fast = r.number("alpha_fast", p.alpha_fast, 0.0, 1.0);
   p.cell = r.number("cell", p.cell, 0.005, 0.5);
-  p.kld = r.boolean("kld", p.kld);
-  p.kld_epsilon = r.positive("kld_epsilon", p.kld_epsilon, 1.0);
-  p.kld_z = r.positive("kld_z", p.kld_z, 10.0);
-  p.kld_bin_xy = r.positive("kld_bin_xy", p.kld_bin_xy, 10.0);
-  p.kld_bin_theta = r.positive("kld_bin_theta", p.kld_bin_theta, 3.2);
-  p.kld_min_particles = static_cast<int>(r.integer("kld_min_particles", p.kld_min_particles, 1, 100000));
+  p.kld = filter::KldParams::from_json(r);
   return p;
 }
 
@@ -45,118 +37,93 @@ void McLLocalizer::reset(const std::optional<Pose2>& start) {
   initialised_ = false;
   w_slow_ = w_fast_ = 0.0;
   if (start) {
-    for (int i = 0; i < p_.particles; ++i)
-      ps_.push_back({Pose2(start->x + rng_.normal(0, 0.05), start->y + rng_.normal(0, 0.05), start->theta + rng_.normal(0, 0.02)), 0.0});
+    // A known start: a tight cloud around it (5 cm, 0.02 rad).
+    for (int i = 0; i < p_.particles; ++i) ps_.push_back({filter::perturb(*start, {0.05, 0.02}, rng_), 0.0});
     initialised_ = true;
   }
 }
 
-void McLLocalizer::init_uniform(std::optional<double> heading) {
-  // Uniform over the field (inside the lines plus half a metre), headings from the compass.
+Pose2 McLLocalizer::random_pose(std::optional<double> heading) {
+  // Inside the lines plus half a metre (a robot on the line sees the field too). Draw order heading,
+  // y, x: the order of the expression this replaced (see filter::perturb), so runs reproduce.
   const double hx = 0.5 * field_.length + 0.5, hy = 0.5 * field_.width + 0.5;
+  const double th = heading ? *heading + rng_.normal(0, p_.heading_sigma) : rng_.uniform(-kPi, kPi);
+  const double y = rng_.uniform(-hy, hy);
+  const double x = rng_.uniform(-hx, hx);
+  return Pose2(x, y, th);
+}
+
+void McLLocalizer::init_uniform(std::optional<double> heading) {
   ps_.clear();
-  for (int i = 0; i < p_.particles; ++i) {
-    const double th = heading ? *heading + rng_.normal(0, p_.heading_sigma) : rng_.uniform(-kPi, kPi);
-    ps_.push_back({Pose2(rng_.uniform(-hx, hx), rng_.uniform(-hy, hy), th), 0.0});
-  }
+  for (int i = 0; i < p_.particles; ++i) ps_.push_back({random_pose(heading), 0.0});
   initialised_ = true;
 }
 
-std::vector<McLLocalizer::Particle> McLLocalizer::kld_resample(const std::vector<double>& w, double sum) {
-  // Fox 2003: draw one particle at a time (with replacement, by weight) and count the histogram bins
-  // they fall in; stop once n >= (k - 1) / (2 eps) * (1 - 2 / (9 (k - 1)) + sqrt(2 / (9 (k - 1))) z)^3.
-  std::vector<double> cum(w.size());
-  double acc = 0;
-  for (std::size_t i = 0; i < w.size(); ++i) cum[i] = (acc += w[i]);
-  std::vector<Particle> next;
-  std::unordered_set<std::uint64_t> bins;
-  const int max_n = p_.particles;
-  for (int m = 0; m < max_n; ++m) {
-    const double u = rng_.uniform(0, sum);
-    const std::size_t i = std::min(w.size() - 1, static_cast<std::size_t>(std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()));
-    const Pose2& q = ps_[i].pose;
-    next.push_back({q, 0.0});
-    const auto bx = static_cast<std::int64_t>(std::floor(q.x / p_.kld_bin_xy)), by = static_cast<std::int64_t>(std::floor(q.y / p_.kld_bin_xy));
-    const auto bt = static_cast<std::int64_t>(std::floor(wrap_angle(q.theta) / p_.kld_bin_theta));
-    bins.insert((static_cast<std::uint64_t>(bx & 0xFFFFF) << 40) | (static_cast<std::uint64_t>(by & 0xFFFFF) << 20) | static_cast<std::uint64_t>(bt & 0xFFFFF));
-    const double k = static_cast<double>(bins.size());
-    if (k > 1 && static_cast<int>(next.size()) >= p_.kld_min_particles) {
-      const double a = 2.0 / (9.0 * (k - 1));
-      const double bound = (k - 1) / (2 * p_.kld_epsilon) * std::pow(1 - a + std::sqrt(a) * p_.kld_z, 3);
-      if (static_cast<double>(next.size()) >= bound) break;
-    }
-  }
-  return next;
+void McLLocalizer::predict(const Pose2& delta) {
+  // Each particle follows the odometry with its own noise, proportional to the motion.
+  const filter::OdometrySigmas s = filter::odometry_sigmas(delta, p_.odometry);
+  for (auto& q : ps_) q.pose = q.pose.compose(filter::perturb(delta, s, rng_));
 }
 
-Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std::optional<double> heading) {
-  if (!initialised_) init_uniform(heading);
-  // Motion model: each particle follows the odometry with noise proportional to the motion.
-  const double dist = std::hypot(odo.delta.x, odo.delta.y);
-  const double sxy = p_.odo_trans_frac * dist + p_.odo_floor_xy;
-  const double sth = p_.odo_rot_frac * std::fabs(odo.delta.theta) + p_.odo_floor_theta;
-  for (auto& q : ps_)
-    q.pose = q.pose.compose(Pose2(odo.delta.x + rng_.normal(0, sxy), odo.delta.y + rng_.normal(0, sxy), odo.delta.theta + rng_.normal(0, sth)));
+double McLLocalizer::log_likelihood(const Pose2& q, const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading) const {
+  // Log domain: a sum over points, no underflow however many there are.
+  double lw = 0;
+  if (pts) {
+    const double inv2s2 = 1.0 / (2 * p_.sigma * p_.sigma);
+    const double c = std::cos(q.theta), s = std::sin(q.theta);
+    for (const auto& o : *pts) {
+      const double d = std::min(p_.clamp, map_.distance({q.x + c * o.x() - s * o.y(), q.y + s * o.x() + c * o.y()}));
+      lw -= d * d * inv2s2;
+    }
+    if (p_.evidence_points > 0) lw *= p_.evidence_points / static_cast<double>(pts->size());
+  }
+  if (heading) {
+    const double inv2h2 = 1.0 / (2 * p_.heading_sigma * p_.heading_sigma);
+    lw -= std::pow(angle_diff(q.theta, *heading), 2) * inv2h2;
+  }
+  return lw;
+}
 
-  const auto pts = subsample(obs.line_points, p_.max_points);
-  const bool see = obs.camera_ok && static_cast<int>(pts.size()) >= p_.min_points;
-  if (see || heading) {
-    // Log-domain weights: no underflow however many points.
-    const double inv2s2 = 1.0 / (2 * p_.sigma * p_.sigma), inv2h2 = 1.0 / (2 * p_.heading_sigma * p_.heading_sigma);
-    double maxlw = -1e300;
-    double mean_lik = 0;
-    for (auto& q : ps_) {
-      double lw = 0;
-      if (see) {
-        const double c = std::cos(q.pose.theta), s = std::sin(q.pose.theta);
-        for (const auto& o : pts) {
-          const double d = std::min(p_.clamp, map_.distance({q.pose.x + c * o.x() - s * o.y(), q.pose.y + s * o.x() + c * o.y()}));
-          lw -= d * d * inv2s2;
-        }
-        if (p_.evidence_points > 0) lw *= p_.evidence_points / static_cast<double>(pts.size());
-      }
-      if (heading) lw -= std::pow(angle_diff(q.pose.theta, *heading), 2) * inv2h2;
-      q.logw = lw;
-      maxlw = std::max(maxlw, lw);
-    }
-    std::vector<double> w(ps_.size());
-    double sum = 0;
-    for (std::size_t i = 0; i < ps_.size(); ++i) {
-      w[i] = std::exp(ps_[i].logw - maxlw);
-      sum += w[i];
-      mean_lik += std::exp(ps_[i].logw) / ps_.size();
-    }
-    // Augmented MCL: inject random particles when the average likelihood drops (off by default).
-    double inject = 0.0;
-    if (p_.alpha_slow > 0 && p_.alpha_fast > 0) {
-      w_slow_ += p_.alpha_slow * (mean_lik - w_slow_);
-      w_fast_ += p_.alpha_fast * (mean_lik - w_fast_);
-      inject = w_slow_ > 0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
-    }
-    if (p_.kld) {
-      ps_ = kld_resample(w, sum);
-    } else {
-    // Low-variance resampling.
-    std::vector<Particle> next;
+double McLLocalizer::weigh(const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading) {
+  logw_.resize(ps_.size());
+  for (std::size_t i = 0; i < ps_.size(); ++i) logw_[i] = ps_[i].logw = log_likelihood(ps_[i].pose, pts, heading);
+  filter::weights_from_log(logw_, w_);
+  return filter::weight_sum(w_);
+}
+
+double McLLocalizer::injection_rate() {
+  if (!(p_.alpha_slow > 0 && p_.alpha_fast > 0)) return 0.0;
+  // Thrun et al., Probabilistic Robotics, table 8.3: short- and long-term averages of the mean
+  // likelihood; inject when the short one drops below the long one.
+  double mean_lik = 0;
+  for (const auto& q : ps_) mean_lik += std::exp(q.logw) / ps_.size();
+  w_slow_ += p_.alpha_slow * (mean_lik - w_slow_);
+  w_fast_ += p_.alpha_fast * (mean_lik - w_fast_);
+  return w_slow_ > 0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+}
+
+void McLLocalizer::resample(double sum, double inject, std::optional<double> heading) {
+  std::vector<Particle> next;
+  if (p_.kld.enabled) {
+    // Fox 2003: as many independent draws as the bins they fill call for (no injection).
+    const auto pose_of = [&](std::size_t i) -> const Pose2& { return ps_[i].pose; };
+    const auto drawn = filter::kld_resample(w_, sum, p_.particles, p_.kld, pose_of, rng_);
+    next.reserve(drawn.size());
+    for (std::size_t i : drawn) next.push_back({ps_[i].pose, 0.0});
+  } else {
+    // Low-variance resampling; augmented MCL replaces some slots by random poses.
     next.reserve(ps_.size());
-    const double step = sum / ps_.size();
-    double u = rng_.uniform(0, step), acc = w[0];
-    std::size_t i = 0;
-    const double hx = 0.5 * field_.length + 0.5, hy = 0.5 * field_.width + 0.5;
+    filter::LowVarianceSampler sampler(w_, sum, ps_.size(), rng_);
     for (std::size_t m = 0; m < ps_.size(); ++m) {
-      if (inject > 0 && rng_.uniform() < inject) {
-        const double th = heading ? *heading + rng_.normal(0, p_.heading_sigma) : rng_.uniform(-kPi, kPi);
-        next.push_back({Pose2(rng_.uniform(-hx, hx), rng_.uniform(-hy, hy), th), 0.0});
-        continue;
-      }
-      const double target = u + m * step;
-      while (acc < target && i + 1 < ps_.size()) acc += w[++i];
-      next.push_back({ps_[i].pose, 0.0});
-    }
-    ps_ = std::move(next);
+      if (inject > 0 && rng_.uniform() < inject) next.push_back({random_pose(heading), 0.0});
+      else next.push_back({ps_[sampler.index(m)].pose, 0.0});
     }
   }
-  // Estimate: mean position and circular mean heading; spread decides convergence.
+  ps_ = std::move(next);
+}
+
+Estimate McLLocalizer::estimate(bool see, const std::vector<Eigen::Vector2d>& pts) {
+  // Mean position and circular mean heading; their spread decides convergence.
   double mx = 0, my = 0, sc = 0, ss = 0;
   for (const auto& q : ps_) {
     mx += q.pose.x;
@@ -185,6 +152,19 @@ Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std:
   e.extra["particles"] = n;
   e.extra["spread_m"] = spread;
   return e;
+}
+
+Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std::optional<double> heading) {
+  if (!initialised_) init_uniform(heading);
+  predict(odo.delta);
+  const auto pts = subsample(obs.line_points, p_.max_points);
+  const bool see = obs.camera_ok && static_cast<int>(pts.size()) >= p_.min_points;
+  // Without points or compass there is nothing to weigh by: the set only moves.
+  if (see || heading) {
+    const double sum = weigh(see ? &pts : nullptr, heading);
+    resample(sum, injection_rate(), heading);
+  }
+  return estimate(see, pts);
 }
 
 }  // namespace omniloc

@@ -1,14 +1,19 @@
 #pragma once
 // Monte Carlo localization (paper 002): particles uniform on the field with compass headings, an
-// odometry motion model, the sensor model prod_i exp(-d(o_i)^2 / (2 sigma^2)) through the distance
-// map (evaluated in the log domain), low-variance resampling, and convergence when the particle
-// spread falls below a threshold. Optional augmented-MCL random injection (alpha_slow / alpha_fast,
-// as in ROS amcl), off by default.
+// odometry motion model (filter/odometry_noise.hpp), the sensor model
+// prod_i exp(-d(o_i)^2 / (2 sigma^2)) through the distance map (evaluated in the log domain),
+// low-variance resampling (filter/particle_set.hpp), and convergence when the particle spread falls
+// below a threshold. Optional, off by default: augmented-MCL random injection (alpha_slow /
+// alpha_fast, as in ROS amcl) and KLD-adaptive sample sizes (filter/kld.hpp).
+// Units: metres and radians; particle poses and the estimate in the world frame, line points in the
+// robot frame.
 #include <vector>
 
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
 #include "localization/field_map.hpp"
+#include "localization/filter/kld.hpp"
+#include "localization/filter/odometry_noise.hpp"
 #include "localization/localizer.hpp"
 
 namespace omniloc {
@@ -24,21 +29,15 @@ struct McLParams {
   /// log-likelihoods is scaled to this many points' worth (0: the paper's plain product).
   double evidence_points = 4.0;
   double heading_sigma = 0.15;    ///< rad: compass term in the weight and spread of initial headings
-  double odo_trans_frac = 0.1, odo_rot_frac = 0.1;  ///< motion noise, fraction of the motion
-  double odo_floor_xy = 0.03, odo_floor_theta = 0.02;  ///< m, rad per frame (keeps the set diverse)
+  /// Motion noise per frame (JSON odo_trans_frac 0.1, odo_rot_frac 0.1, odo_floor_xy 0.03 m,
+  /// odo_floor_theta 0.02 rad; no odo_rot_per_m). The floors keep the set diverse.
+  filter::OdometryNoiseParams odometry{0.1, 0.1, 0.0, 0.03, 0.02};
   double converged_std = 0.15;    ///< m: position spread below this = converged
   double converged_theta_std = 0.1;  ///< rad
   double alpha_slow = 0.0, alpha_fast = 0.0;  ///< augmented MCL (0 = off)
-  // KLD-adaptive sample size (Fox 2003; ROS amcl's pf_err / pf_z), off by default: particles are drawn
-  // until their number bounds the KL distance between the sample and the true posterior by
-  // kld_epsilon with probability given by kld_z (upper standard-normal quantile), histogram bins of
-  // kld_bin_xy x kld_bin_xy x kld_bin_theta, between kld_min_particles and `particles`.
-  bool kld = false;
-  double kld_epsilon = 0.05;      ///< amcl pf_err
-  double kld_z = 2.326;           ///< amcl pf_z = 0.99
-  double kld_bin_xy = 0.5;        ///< m (amcl: 0.5 m)
-  double kld_bin_theta = 0.1745;  ///< rad (amcl: 10 degrees)
-  int kld_min_particles = 100;
+  /// KLD-adaptive sample size (filter/kld.hpp; JSON kld, kld_epsilon, kld_z, kld_bin_xy,
+  /// kld_bin_theta, kld_min_particles), off by default; `particles` is then the maximum.
+  filter::KldParams kld;
   double cell = 0.05;
   static McLParams from_json(JsonReader& r);
 };
@@ -59,13 +58,26 @@ class McLLocalizer : public Localizer {
   const std::vector<Particle>& particles() const { return ps_; }
 
  private:
+  // One update is: predict (motion model) -> weigh (sensor model) -> resample -> estimate.
   void init_uniform(std::optional<double> heading);
-  std::vector<Particle> kld_resample(const std::vector<double>& w, double sum);
+  /// A pose uniform over the field plus half a metre, heading from the compass if there is one.
+  Pose2 random_pose(std::optional<double> heading);
+  void predict(const Pose2& delta);
+  /// Log-likelihood of particle pose q: the line points' clamped distances (`pts`, robot frame;
+  /// null when the camera saw too little) and the compass.
+  double log_likelihood(const Pose2& q, const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading) const;
+  /// Sets every particle's logw and fills w_ with the relative weights; returns their sum.
+  double weigh(const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading);
+  /// Augmented MCL: the fraction of random particles to inject (0 unless alpha_slow, alpha_fast set).
+  double injection_rate();
+  void resample(double sum, double inject, std::optional<double> heading);
+  Estimate estimate(bool see, const std::vector<Eigen::Vector2d>& pts);
   McLParams p_;
   Field field_;
   FieldMap map_;
   Rng rng_;
   std::vector<Particle> ps_;
+  std::vector<double> logw_, w_;  ///< per-update scratch (kept to avoid reallocation)
   bool initialised_ = false, converged_ = false;
   double w_slow_ = 0.0, w_fast_ = 0.0;
 };

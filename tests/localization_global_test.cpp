@@ -195,7 +195,7 @@ TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
   const Field f = Field::preset("msl2012");
   Rng world(31);
   McLParams p;
-  p.kld = true;
+  p.kld.enabled = true;
   McLLocalizer mcl(f, p, 7, "");
   mcl.reset(std::nullopt);
   const Pose2 truth(2.5, -1.5, 1.0);
@@ -210,5 +210,5 @@ TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
   // Spread over the field the bound needs (nearly) all 600; concentrated, a few hundred at most.
   EXPECT_GE(first_n, 300.0);
   EXPECT_LE(e.extra.at("particles"), 300.0);
-  EXPECT_GE(e.extra.at("particles"), p.kld_min_particles);
+  EXPECT_GE(e.extra.at("particles"), p.kld.min_particles);
 }

@@ -75,7 +75,7 @@ TEST(Matching, KalmanFusionBeatsEitherSource) {
   // lower than both.
   MatchingParams p;
   Rng rng(3);
-  PoseKalman kf;
+  filter::PoseKalman kf;
   Pose2 truth(0, 0, 0), odo_only(0, 0, 0);
   kf.reset(truth, Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal());
   double e_odo = 0, e_meas = 0, e_fused = 0;
@@ -85,7 +85,7 @@ TEST(Matching, KalmanFusionBeatsEitherSource) {
     truth = truth.compose(step);
     const Pose2 noisy(step.x * (1 + rng.normal(0, 0.05)), rng.normal(0, 0.002), step.theta + rng.normal(0, 0.003));
     odo_only = odo_only.compose(noisy);
-    kf.predict(noisy, p);
+    kf.predict(noisy, p.odometry);
     const Pose2 z(truth.x + rng.normal(0, 0.05), truth.y + rng.normal(0, 0.05), truth.theta + rng.normal(0, 0.02));
     kf.update(z, Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.02 * 0.02).asDiagonal());
     e_odo += std::hypot(odo_only.x - truth.x, odo_only.y - truth.y);

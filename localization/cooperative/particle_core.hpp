@@ -9,9 +9,10 @@
 // A filter cycle is: predict() -> update() -> (read the weighted estimate) -> post(). The estimate is
 // read before post() because the paper outputs it before SFN / resampling (5.1 step 3, 5.2 step 2).
 //
-// Weights are handled in the log domain and rescaled by their maximum before exponentiating; this
-// multiplies every weight by the same constant, so N_eff, the normalised weights and every decision
-// below are unchanged, but a sharp likelihood cannot underflow all weights to zero.
+// Weights are handled in the log domain and rescaled by their maximum before exponentiating
+// (filter::weights_from_log); this multiplies every weight by the same constant, so N_eff, the
+// normalised weights and every decision below are unchanged, but a sharp likelihood cannot underflow
+// all weights to zero.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "core/rng.hpp"
+#include "localization/filter/particle_set.hpp"
 
 namespace omniloc {
 
@@ -34,39 +36,18 @@ const char* to_string(ParticleFilterKind k);
 
 namespace pfcore {
 
-template <class S>
-struct ParticleSet {
-  std::vector<S> x;
-  std::vector<double> w;  ///< not necessarily normalised (MFBPF keeps S_k = sum w explicit)
-  std::size_t size() const { return x.size(); }
-};
+// The set, weights, N_eff and systematic resampling are the ones MCL uses (filter/particle_set.hpp).
+using filter::effective_sample_size;
+using filter::normalise;
+using filter::ParticleSet;
+using filter::systematic_resample;
+using filter::weight_sum;
 
 /// What post() did (for diagnostics and tests).
 struct PostInfo {
   bool resampled = false;  ///< systematic or overwrite resampling ran
   bool fission = false;    ///< SFN pre-processing ran
 };
-
-inline double weight_sum(const std::vector<double>& w) { return std::accumulate(w.begin(), w.end(), 0.0); }
-
-/// N_eff = (sum w)^2 / sum w^2 (paper 001 5.2 step 3; equals 1 / sum w~^2 for normalised w~).
-inline double effective_sample_size(const std::vector<double>& w) {
-  double s = 0.0, s2 = 0.0;
-  for (double v : w) {
-    s += v;
-    s2 += v * v;
-  }
-  return s2 > 0.0 ? s * s / s2 : 0.0;
-}
-
-inline void normalise(std::vector<double>& w) {
-  const double s = weight_sum(w);
-  if (!(s > 0.0) || !std::isfinite(s)) {
-    std::fill(w.begin(), w.end(), 1.0 / static_cast<double>(w.size()));
-    return;
-  }
-  for (double& v : w) v /= s;
-}
 
 /// Indices sorted by weight, heaviest first; ties keep index order (deterministic everywhere).
 inline std::vector<std::size_t> order_heaviest_first(const std::vector<double>& w) {
@@ -100,42 +81,14 @@ template <class S, class LogLik>
 bool update(ParticleFilterKind kind, ParticleSet<S>& p, LogLik&& loglik) {
   const std::size_t n = p.size();
   std::vector<double> lw(n);
-  double mx = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
     double l = loglik(p.x[i]);
     if (std::isnan(l)) l = -std::numeric_limits<double>::infinity();
     if (kind != ParticleFilterKind::Fission)
       l += p.w[i] > 0.0 ? std::log(p.w[i]) : -std::numeric_limits<double>::infinity();
     lw[i] = l;
-    mx = std::max(mx, l);
   }
-  if (!std::isfinite(mx)) {
-    std::fill(p.w.begin(), p.w.end(), 1.0 / static_cast<double>(n));
-    return false;
-  }
-  for (std::size_t i = 0; i < n; ++i) p.w[i] = std::exp(lw[i] - mx);
-  return true;
-}
-
-/// Systematic resampling: one uniform draw, N evenly spaced pointers into the cumulative weights.
-/// Output weights 1/N.
-template <class S>
-void systematic_resample(ParticleSet<S>& p, Rng& rng) {
-  const std::size_t n = p.size();
-  normalise(p.w);
-  std::vector<S> out;
-  out.reserve(n);
-  const double step = 1.0 / static_cast<double>(n);
-  const double u0 = rng.uniform() * step;
-  double cum = p.w[0];
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double u = u0 + static_cast<double>(i) * step;
-    while (u > cum && j + 1 < n) cum += p.w[++j];
-    out.push_back(p.x[j]);
-  }
-  p.x = std::move(out);
-  std::fill(p.w.begin(), p.w.end(), step);
+  return std::isfinite(filter::weights_from_log(lw, p.w));
 }
 
 /// SFN pre-processing (paper 001 5.1 step 5, after its ref. [9]): Sorting, Fission, Normalising.
