@@ -4,12 +4,20 @@
 
 namespace omniloc::sim {
 
+const ParamList<OdometryNoise>& OdometryNoise::params() {
+  using P = OdometryNoise;
+  static const ParamList<P> list = {
+      number_param("trans_sigma", &P::trans_sigma, 0.0, 1.0, "m/sqrt(m)", "random walk per square root of the distance travelled, along each robot axis"),
+      number_param("rot_sigma", &P::rot_sigma, 0.0, 1.0, "rad/sqrt(rad)", "random walk per square root of the angle turned"),
+      number_param("rot_per_trans", &P::rot_per_trans, 0.0, 1.0, "rad/sqrt(m)", "heading random walk from driving"),
+      number_param("scale_sigma", &P::scale_sigma, 0.0, 0.5, "", "std of the per-run wheel scale error (0.01 = 1 %)"),
+  };
+  return list;
+}
+
 OdometryNoise OdometryNoise::from_json(JsonReader& r, const OdometryNoise& d) {
-  OdometryNoise n;
-  n.trans_sigma = r.number("trans_sigma", d.trans_sigma, 0.0, 1.0);
-  n.rot_sigma = r.number("rot_sigma", d.rot_sigma, 0.0, 1.0);
-  n.rot_per_trans = r.number("rot_per_trans", d.rot_per_trans, 0.0, 1.0);
-  n.scale_sigma = r.number("scale_sigma", d.scale_sigma, 0.0, 0.5);
+  OdometryNoise n = d;
+  read_params(r, n, params());
   return n;
 }
 
@@ -41,13 +49,21 @@ Odometry OdometrySensor::read(double t) {
   return o;
 }
 
+const ParamList<HeadingNoise>& HeadingNoise::params() {
+  using P = HeadingNoise;
+  static const ParamList<P> list = {
+      number_param("noise_sigma", &P::noise_sigma, 0.0, 3.2, "rad", "white noise per reading"),
+      number_param("bias_walk", &P::bias_walk, 0.0, 1.0, "rad/sqrt(s)", "random-walk intensity of the bias"),
+      number_param("drift_rate", &P::drift_rate, -1.0, 1.0, "rad/s", "deterministic drift"),
+      number_param("initial_bias", &P::initial_bias, -kPi, kPi, "rad", "bias at the start"),
+      number_param("offset", &P::offset, -kTwoPi, kTwoPi, "rad", "fixed mounting error"),
+  };
+  return list;
+}
+
 HeadingNoise HeadingNoise::from_json(JsonReader& r, const HeadingNoise& d) {
-  HeadingNoise n;
-  n.noise_sigma = r.number("noise_sigma", d.noise_sigma, 0.0, 3.2);
-  n.bias_walk = r.number("bias_walk", d.bias_walk, 0.0, 1.0);
-  n.drift_rate = r.number("drift_rate", d.drift_rate, -1.0, 1.0);
-  n.initial_bias = r.number("initial_bias", d.initial_bias, -kPi, kPi);
-  n.offset = r.number("offset", d.offset, -kTwoPi, kTwoPi);
+  HeadingNoise n = d;
+  read_params(r, n, params());
   return n;
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/messages.hpp"
 #include "core/rng.hpp"
 
@@ -18,6 +19,8 @@ struct OdometryNoise {
   double rot_per_trans = 0.0;    ///< rad per sqrt(m) travelled (heading drift from driving)
   double scale_sigma = 0.0;      ///< std of the per-run wheel scale error (fraction, e.g. 0.01 = 1 %)
   static OdometryNoise from_json(JsonReader& r, const OdometryNoise& defaults);
+  /// The JSON keys (a robot's "odometry", data/noise_profiles.json), ranges and meanings.
+  static const ParamList<OdometryNoise>& params();
 };
 
 class OdometrySensor {
@@ -44,6 +47,8 @@ struct HeadingNoise {
   double initial_bias = 0.0;  ///< rad
   double offset = 0.0;        ///< rad, fixed mounting error
   static HeadingNoise from_json(JsonReader& r, const HeadingNoise& defaults);
+  /// The JSON keys (a robot's "heading", data/noise_profiles.json), ranges and meanings.
+  static const ParamList<HeadingNoise>& params();
 };
 
 class HeadingSensor {

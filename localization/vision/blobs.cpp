@@ -39,14 +39,22 @@ BlobParams BlobParams::from_json(JsonReader& r) {
   BlobParams p;
   p.colours = to_classes(r.strings("colours", kBlobColourNames, kBlobColourNames));
   if (r.has("edge_colours")) p.edge_colours = to_classes(r.strings("edge_colours", std::nullopt, kBlobColourNames));
-  p.min_area_px = static_cast<int>(r.integer("min_area_px", 25, 1, 1000000));
-  p.outer_radius_px = r.number("outer_radius_px", 0.0, 0.0, 100000.0);
-  p.dark_mean = r.number("dark_mean", 15.0, 0.0, 255.0);
-  p.edge_extend_px = r.number("edge_extend_px", 0.0, 0.0, 10.0);
-  p.edge_band_px = static_cast<int>(r.integer("edge_band_px", 3, 1, 50));
-  p.occluded_fraction = r.number("occluded_fraction", 0.3, 0.0, 1.0);
-  p.edge_contact_deg = r.number("edge_contact_deg", 1.5, 0.0, 45.0);
+  read_params(r, p, params());
   return p;
+}
+
+const ParamList<BlobParams>& BlobParams::params() {
+  using P = BlobParams;
+  static const ParamList<P> list = {
+      integer_param("min_area_px", &P::min_area_px, 1, 1000000, "smaller regions (pixels) are ignored"),
+      number_param("outer_radius_px", &P::outer_radius_px, 0.0, 100000.0, "px", "pixels searched out to this radius; 0 = the image's inscribed circle"),
+      number_param("dark_mean", &P::dark_mean, 0.0, 255.0, "grey level", "mean grey of the annulus below this: camera covered, no blobs"),
+      number_param("edge_extend_px", &P::edge_extend_px, 0.0, 10.0, "px", "widening of a region's angular extent on each side (0 by measurement)"),
+      integer_param("edge_band_px", &P::edge_band_px, 1, 50, "pixels beyond an edge checked for an occluder"),
+      number_param("occluded_fraction", &P::occluded_fraction, 0.0, 1.0, "", "fraction of those pixels that must be black (or off-image) for an occluded edge"),
+      number_param("edge_contact_deg", &P::edge_contact_deg, 0.0, 45.0, "deg", "an edge's distance: nearest region pixel within this angle of it"),
+  };
+  return list;
 }
 
 BlobDetector::BlobDetector(const BlobParams& p, const CalibrationMap& map, const ColourTable& table)

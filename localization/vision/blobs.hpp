@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/messages.hpp"
 #include "localization/localizer.hpp"
 #include "localization/vision/calibration_map.hpp"
@@ -49,6 +50,8 @@ struct BlobParams {
   double occluded_fraction = 0.3;  ///< fraction of those pixels that must be black (or off-image)
   double edge_contact_deg = 1.5;   ///< an edge's distance: nearest region pixel within this angle of it
   static BlobParams from_json(JsonReader& r);
+  /// The numeric JSON keys (scenario /vision/blobs); "colours" and "edge_colours" are lists of names.
+  static const ParamList<BlobParams>& params();
 };
 
 class BlobDetector {

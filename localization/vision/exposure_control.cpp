@@ -6,19 +6,27 @@
 
 namespace omniloc {
 
+const ParamList<ExposureParams>& ExposureParams::params() {
+  using P = ExposureParams;
+  static const ParamList<P> list = {
+      bool_param("enabled", &P::enabled, "run paper 002's entropy auto-adjustment of exposure and gain"),
+      positive_param("a", &P::a, 100.0, "ms per gain unit", "the search line exposure_ms = a * gain + b (paper 002)"),
+      number_param("b", &P::b, -100.0, 100.0, "ms", "the search line's offset"),
+      positive_param("change_threshold", &P::change_threshold, 255.0, "grey levels", "body brightness change against the saved value that starts a search"),
+      integer_param("confirm_frames", &P::confirm_frames, 1, 1000, "frames in a row over the threshold before a search (noise, passing shadows)"),
+      number_param("coarse_ratio", &P::coarse_ratio, 1.01, 4.0, "", "coarse phase: each probe multiplies (or divides) the gain by this"),
+      integer_param("patience", &P::patience, 1, 20, "coarse phase: worse probes in a row before a direction is given up"),
+      positive_param("min_step", &P::min_step, 100.0, "gain units", "fine phase (additive, halving) ends below this step"),
+      integer_param("max_steps", &P::max_steps, 1, 1000, "hard bound on settings tried per search (reported when hit)"),
+      number_param("settle_s", &P::settle_s, 0.0, 10.0, "s", "time a new setting needs before its frame counts (paper 002: about 40 ms)"),
+      bool_param("search_at_start", &P::search_at_start, "also search on the first frame (the robot adjusts once when it starts)"),
+  };
+  return list;
+}
+
 ExposureParams ExposureParams::from_json(JsonReader& r) {
   ExposureParams p;
-  p.enabled = r.boolean("enabled", p.enabled);
-  p.a = r.positive("a", p.a, 100.0);
-  p.b = r.number("b", p.b, -100.0, 100.0);
-  p.change_threshold = r.positive("change_threshold", p.change_threshold, 255.0);
-  p.confirm_frames = static_cast<int>(r.integer("confirm_frames", p.confirm_frames, 1, 1000));
-  p.coarse_ratio = r.number("coarse_ratio", p.coarse_ratio, 1.01, 4.0);
-  p.patience = static_cast<int>(r.integer("patience", p.patience, 1, 20));
-  p.min_step = r.positive("min_step", p.min_step, 100.0);
-  p.max_steps = static_cast<int>(r.integer("max_steps", p.max_steps, 1, 1000));
-  p.settle_s = r.number("settle_s", p.settle_s, 0.0, 10.0);
-  p.search_at_start = r.boolean("search_at_start", p.search_at_start);
+  read_params(r, p, params());
   return p;
 }
 

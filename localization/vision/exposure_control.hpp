@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/messages.hpp"
 
 namespace omniloc {
@@ -30,6 +31,8 @@ struct ExposureParams {
   double settle_s = 0.04;           ///< s a new setting needs before its frame counts (paper: ~40 ms)
   bool search_at_start = true;      ///< also search on the first frame (the robot adjusts once when it starts)
   static ExposureParams from_json(JsonReader& r);
+  /// The JSON keys (scenario /vision/exposure_control); the camera ranges come from /camera.
+  static const ParamList<ExposureParams>& params();
 };
 
 /// What the controller wants after one frame.

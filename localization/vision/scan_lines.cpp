@@ -6,15 +6,23 @@
 
 namespace omniloc {
 
+const ParamList<ScanLineParams>& ScanLineParams::params() {
+  using P = ScanLineParams;
+  static const ParamList<P> list = {
+      integer_param("rays", &P::rays, 4, 720, "radial scan lines (paper 002: 72)"),
+      positive_param("max_distance", &P::max_distance, 20.0, "m", "farther floor is not scanned (points too unreliable)"),
+      positive_param("line_width", &P::line_width, 1.0, "m", "the field's painted line width"),
+      number_param("width_factor", &P::width_factor, 1.0, 20.0, "", "a white run may be this many times the expected width (oblique crossings)"),
+      number_param("width_slack_px", &P::width_slack_px, 0.0, 20.0, "px", "... plus this many pixels (blur)"),
+      integer_param("max_gap", &P::max_gap, 0, 10, "unknown pixels allowed between green and white (anti-aliasing)"),
+      number_param("dark_mean", &P::dark_mean, 0.0, 255.0, "grey level", "mean grey below this: the camera is covered, no observation"),
+  };
+  return list;
+}
+
 ScanLineParams ScanLineParams::from_json(JsonReader& r) {
   ScanLineParams p;
-  p.rays = static_cast<int>(r.integer("rays", 72, 4, 720));
-  p.max_distance = r.positive("max_distance", 7.5, 20.0);
-  p.line_width = r.positive("line_width", 0.125, 1.0);
-  p.width_factor = r.number("width_factor", 3.0, 1.0, 20.0);
-  p.width_slack_px = r.number("width_slack_px", 2.0, 0.0, 20.0);
-  p.max_gap = static_cast<int>(r.integer("max_gap", 2, 0, 10));
-  p.dark_mean = r.number("dark_mean", 15.0, 0.0, 255.0);
+  read_params(r, p, params());
   return p;
 }
 

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/messages.hpp"
 #include "localization/localizer.hpp"
 #include "localization/vision/calibration_map.hpp"
@@ -25,6 +26,8 @@ struct ScanLineParams {
   int max_gap = 2;               ///< unknown pixels allowed between green and white (anti-aliasing)
   double dark_mean = 15.0;       ///< mean grey below this: the camera is covered, no observation
   static ScanLineParams from_json(JsonReader& r);
+  /// The JSON keys (scenario /vision/scan_lines), ranges and meanings (core/params.hpp).
+  static const ParamList<ScanLineParams>& params();
 };
 
 struct ScanResult {
