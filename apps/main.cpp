@@ -21,7 +21,9 @@
 #include "core/version.hpp"
 #include "harness/experiment.hpp"
 #include "harness/localizer_registry.hpp"
+#include "core/atomic_file.hpp"
 #include "harness/render_frame.hpp"
+#include "harness/scenario_schema.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "harness/slurm.hpp"
@@ -52,6 +54,9 @@ commands:
   validate FILE...       check a scenario, a sweep file or an experiment description (scenarios/experiments/);
                          exit 2 with the JSON path of the first problem
   list                   field presets, motion scripts, localizers, noise profiles, experiments
+  schema [--markdown] [-o FILE]
+                         the JSON Schema of scenario files (for editors), or the parameter
+                         reference docs/localizers.md generated from the same lists
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
@@ -106,6 +111,9 @@ const cli::Command kValidate{"validate", "FILE...", 1, 1000000,
                              "code is then 0 when all passed, 2 when some had input errors, 1 when any failed otherwise.",
                              {}};
 const cli::Command kList{"list", "", 0, 0, "Field presets, motion scripts, localizers, noise profiles, experiments.", {}};
+const cli::Command kSchema{"schema", "", 0, 0, "The JSON Schema of scenario files, or (--markdown) the parameter reference docs/localizers.md.",
+                           {{"--markdown", "", "the parameter reference instead of the schema"},
+                            {"-o", "FILE", "write to FILE (atomically) instead of standard output"}}};
 const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                           "Scenarios x localizers x parameters x seeds, in parallel; aggregate with mean and 95 % interval\n"
                           "in results/sweeps/<name>/aggregate.{csv,json}.",
@@ -340,6 +348,18 @@ int cmd_colour_calibrate(const cli::Args& a) {
   return 0;
 }
 
+int cmd_schema(const cli::Args& a) {
+  const std::string text = a.has("--markdown") ? harness::parameter_reference() : harness::scenario_schema().dump(2) + "\n";
+  const std::string out = a.value("-o");
+  if (out.empty()) {
+    std::cout << text;
+  } else {
+    write_file_atomic(out, text);
+    std::cerr << "wrote " << out << "\n";
+  }
+  return 0;
+}
+
 int cmd_list() {
   std::cout << "field presets:";
   for (const auto& n : Field::preset_names()) std::cout << " " << n;
@@ -400,6 +420,7 @@ int main(int argc, char** argv) {
   const Entry commands[] = {{&kValidate, cmd_validate},
                             {&kRun, cmd_run},
                             {&kList, [](const cli::Args&) { return cmd_list(); }},
+                            {&kSchema, cmd_schema},
                             {&kCalibrate, cmd_calibrate},
                             {&kColourCalibrate, cmd_colour_calibrate},
                             {&kRender, cmd_render},

@@ -2,9 +2,9 @@
 // One list per parameter struct: each field's JSON key, the member it fills, its range, unit and
 // meaning, written once. The list drives strict JSON reading (JsonReader, so errors name the JSON
 // path and the effective configuration records every value, defaults included), the JSON Schema of
-// scenario files (`omniloc schema`) and the generated parameter reference (docs/localizers.md).
+// scenario files (`omniloc schema`), and through it the generated parameter reference
+// (docs/localizers.md).
 // After Drake's camera_config.h: one field list with Serialize and ValidateOrThrow.
-#include <cstdio>
 #include <limits>
 #include <string>
 #include <variant>
@@ -69,6 +69,16 @@ void read_params(JsonReader& r, T& p, const ParamList<T>& list) {
   }
 }
 
+/// Reads the one listed parameter `key` (for a default that depends on it, e.g. matching's c_start).
+template <class T>
+void read_param(JsonReader& r, T& p, const ParamList<T>& list, const char* key) {
+  for (const auto& q : list)
+    if (std::string(q.key) == key) {
+      read_params(r, p, ParamList<T>{q});
+      return;
+    }
+}
+
 /// The value of one parameter of `p` as JSON.
 template <class T>
 Json param_value(const Param<T>& q, const T& p) {
@@ -95,30 +105,6 @@ Json params_schema(const ParamList<T>& list, const T& defaults = T{}) {
     props[q.key] = s;
   }
   return props;
-}
-
-/// Markdown rows "| key | default | range | unit | meaning |" for the parameter reference.
-template <class T>
-std::string params_markdown(const ParamList<T>& list, const T& defaults = T{}) {
-  auto num = [](double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", v);
-    return std::string(b);
-  };
-  std::string md = "| key | default | range | unit | meaning |\n|---|---|---|---|---|\n";
-  for (const auto& q : list) {
-    std::string range;
-    switch (q.kind) {
-      case ParamKind::kBoolean: range = "true / false"; break;
-      case ParamKind::kInteger: range = num(q.lo) + " .. " + num(q.hi); break;
-      case ParamKind::kPositive: range = "> 0, <= " + num(q.hi); break;
-      case ParamKind::kNumber: range = num(q.lo) + " .. " + num(q.hi); break;
-    }
-    const Json v = param_value(q, defaults);
-    md += std::string("| `") + q.key + "` | " + (v.is_number_float() ? num(v.get<double>()) : v.dump()) + " | " + range + " | " + q.unit +
-          " | " + q.doc + " |\n";
-  }
-  return md;
 }
 
 }  // namespace omniloc

@@ -12,25 +12,30 @@ namespace omniloc::harness {
 const std::vector<LocalizerInfo>& localizers() {
   static const std::vector<LocalizerInfo> list = {
       {"odometry_only", "dead reckoning from the true start pose (odometry drift baseline)", true, false,
-       [](JsonReader&, const LocalizerContext&) { return std::make_unique<OdometryOnlyLocalizer>(); }},
+       [](JsonReader&, const LocalizerContext&) { return std::make_unique<OdometryOnlyLocalizer>(); }, [] { return Json::object(); }},
       {"matching", "matching-optimisation tracking (RPROP on the distance map) fused with odometry by a Kalman filter (paper 002)", true, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<MatchingLocalizer>(*ctx.field, MatchingParams::from_json(r), ctx.cache_dir);
-       }},
+       },
+       &MatchingParams::schema},
       {"mcl", "Monte Carlo localization, 600 particles, compass headings, distance-map sensor model (paper 002)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<McLLocalizer>(*ctx.field, McLParams::from_json(r), ctx.seed, ctx.cache_dir);
-       }},
+       },
+       &McLParams::schema},
       {"hybrid", "MCL until converged, then matching tracking; wrong-localisation detection restarts MCL (paper 002)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<HybridLocalizer>(*ctx.field, HybridParams::from_json(r), ctx.seed, ctx.cache_dir);
-       }},
+       },
+       &HybridParams::schema},
       {"grid_global", "MTi-heading grid search (315 samples, best 5 refined by RPROP, up to 3 shifted passes), then matching tracking with MTi drift correction (paper 000)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<GridGlobalLocalizer>(*ctx.field, GridGlobalParams::from_json(r), ctx.cache_dir);
-       }},
+       },
+       &GridGlobalParams::schema},
       {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); }},
+       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },
+       [] { return params_schema(LandmarkLocalizerParams::params()); }},
   };
   return list;
 }

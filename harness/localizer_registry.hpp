@@ -29,6 +29,8 @@ struct LocalizerInfo {
   /// Reads parameters strictly (params reader at the localizer's JSON object; "type" already read)
   /// and builds the localizer.
   std::function<std::unique_ptr<Localizer>(JsonReader& params, const LocalizerContext& ctx)> make;
+  /// JSON Schema properties of its parameters (from the parameter structs' field lists).
+  std::function<Json()> schema;
 };
 
 const std::vector<LocalizerInfo>& localizers();

@@ -7,23 +7,38 @@
 
 namespace omniloc {
 
+const ParamList<GridGlobalParams>& GridGlobalParams::params() {
+  using P = GridGlobalParams;
+  static const ParamList<P> list = {
+      number_param("spacing", &P::spacing, 0.1, 10.0, "m", "between grid samples (paper 000: 1 m)"),
+      number_param("outside", &P::outside, 0.0, 5.0, "m", "the grid reaches this far beyond the outer lines (paper 000: 21 x 15 = 315 samples)"),
+      number_param("shift", &P::shift, 0.0, 5.0, "m", "(x, y) shift of the grid between passes (paper 000; NuBot: 0, 35, 70 cm)"),
+      integer_param("passes", &P::passes, 1, 20, "grid passes (paper 000: 3)"),
+      integer_param("candidates", &P::candidates, 1, 100, "best samples refined by RPROP (paper 000: 5)"),
+      positive_param("c_grid", &P::c_grid, 20.0, "m", "error scale of E_k on the grid (paper 000: c = 255 cm)"),
+      integer_param("grid_points", &P::grid_points, 3, 10000, "line points (evenly subsampled) used for E_k"),
+      integer_param("refine_iterations", &P::refine_iterations, 1, 1000, "at most this many RPROP iterations per candidate (paper 000: converges in about 10)"),
+      positive_param("refine_c_start", &P::refine_c_start, 20.0, "m", "continuation of c from here down to matching.c while refining"),
+      positive_param("accept_error", &P::accept_error, 1.0, "", "mean e(d) at matching.c under which a candidate is accepted at once"),
+      number_param("min_separation", &P::min_separation, 0.0, 20.0, "m", "the candidates are distinct samples at least this far apart"),
+      bool_param("record_traces", &P::record_traces, "keep each candidate's error per RPROP iteration (figures; costs time)"),
+      positive_param("good_deviation", &P::good_deviation, 5.0, "m", "MTi drift correction: median point deviation under which a frame counts as good"),
+      integer_param("drift_frames", &P::drift_frames, 1, 100000, "MTi drift correction: good frames averaged per correction"),
+      number_param("drift_gain", &P::drift_gain, 0.0, 1.0, "", "MTi drift correction: fraction of the measured offset applied"),
+  };
+  return list;
+}
+
+Json GridGlobalParams::schema() {
+  Json s = params_schema(params());
+  s.update(params_schema(DetectionParams::params()));
+  s["matching"] = {{"type", "object"}, {"description", "the matching tracker after the fix"}, {"properties", MatchingParams::schema()}, {"additionalProperties", false}};
+  return s;
+}
+
 GridGlobalParams GridGlobalParams::from_json(JsonReader& r) {
   GridGlobalParams p;
-  p.spacing = r.number("spacing", p.spacing, 0.1, 10.0);
-  p.outside = r.number("outside", p.outside, 0.0, 5.0);
-  p.shift = r.number("shift", p.shift, 0.0, 5.0);
-  p.passes = static_cast<int>(r.integer("passes", p.passes, 1, 20));
-  p.candidates = static_cast<int>(r.integer("candidates", p.candidates, 1, 100));
-  p.c_grid = r.positive("c_grid", p.c_grid, 20.0);
-  p.grid_points = static_cast<int>(r.integer("grid_points", p.grid_points, 3, 10000));
-  p.refine_iterations = static_cast<int>(r.integer("refine_iterations", p.refine_iterations, 1, 1000));
-  p.refine_c_start = r.positive("refine_c_start", p.refine_c_start, 20.0);
-  p.accept_error = r.positive("accept_error", p.accept_error, 1.0);
-  p.min_separation = r.number("min_separation", p.min_separation, 0.0, 20.0);
-  p.record_traces = r.boolean("record_traces", p.record_traces);
-  p.good_deviation = r.positive("good_deviation", p.good_deviation, 5.0);
-  p.drift_frames = static_cast<int>(r.integer("drift_frames", p.drift_frames, 1, 100000));
-  p.drift_gain = r.number("drift_gain", p.drift_gain, 0.0, 1.0);
+  read_params(r, p, params());
   if (auto m = r.object("matching")) {
     p.matching = MatchingParams::from_json(*m);
     m->finish();

@@ -12,6 +12,7 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "localization/matching.hpp"
 #include "localization/wrong_localisation.hpp"
 
@@ -40,6 +41,8 @@ struct GridGlobalParams {
   MatchingParams matching;
   DetectionParams detection;
   static GridGlobalParams from_json(JsonReader& r);
+  static const ParamList<GridGlobalParams>& params();
+  static Json schema();
 };
 
 /// Everything one global localisation did, for the pictures of paper 000 (figures 7 and 9).

@@ -4,6 +4,13 @@
 
 namespace omniloc {
 
+Json HybridParams::schema() {
+  Json s = params_schema(DetectionParams::params());
+  s["mcl"] = {{"type", "object"}, {"description", "the global MCL stage"}, {"properties", McLParams::schema()}, {"additionalProperties", false}};
+  s["matching"] = {{"type", "object"}, {"description", "the matching tracker"}, {"properties", MatchingParams::schema()}, {"additionalProperties", false}};
+  return s;
+}
+
 HybridParams HybridParams::from_json(JsonReader& r) {
   HybridParams p;
   if (auto m = r.object("mcl")) {

@@ -3,6 +3,7 @@
 // from its mean. Wrong-localisation detection: the deviation (upper quartile) of the line points from the field
 // lines above a threshold AND |heading - compass| above a threshold for 5 consecutive frames
 // restarts MCL.
+#include "core/params.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
 #include "localization/wrong_localisation.hpp"
@@ -16,6 +17,7 @@ struct HybridParams {
   /// wrong_localisation.hpp), which catch the point-mirrored pose the AND misses.
   DetectionParams detection;
   static HybridParams from_json(JsonReader& r);
+  static Json schema();
 };
 
 class HybridLocalizer : public Localizer {

@@ -7,25 +7,42 @@
 
 namespace omniloc {
 
+const ParamList<MatchingParams>& MatchingParams::params() {
+  using P = MatchingParams;
+  static const ParamList<P> list = {
+      positive_param("c", &P::c, 5.0, "m", "error scale of e(d) = 1 - c^2 / (c^2 + d^2) (Tribots: 250 mm)"),
+      positive_param("c_start", &P::c_start, 10.0, "m", "continuation: c halves from c_start down to c (JSON default: 2 c, one smoothing stage)"),
+      positive_param("step_xy", &P::step_xy, 2.0, "m", "RPROP initial step in x and y (Tribots: 40 mm)"),
+      positive_param("step_theta", &P::step_theta, 1.0, "rad", "RPROP initial step in theta (Tribots: 0.1)"),
+      number_param("grow", &P::grow, 1.0, 3.0, "", "RPROP step growth factor (Tribots: 1.2)"),
+      number_param("shrink", &P::shrink, 0.05, 1.0, "", "RPROP step shrink factor (Tribots: 0.5)"),
+      number_param("step_tol", &P::step_tol, 1e-6, 0.1, "m, rad", "RPROP stops when its steps in x, y and theta are all below this"),
+      integer_param("max_iterations", &P::max_iterations, 1, 1000, "cap on RPROP iterations over all stages (Tribots 10-20, NuBot 25)"),
+      integer_param("min_points", &P::min_points, 1, 10000, "fewer line points: no match, coast on odometry (NuBot > 15, CAMBADA > 5)"),
+      integer_param("max_points", &P::max_points, 3, 100000, "line points evenly subsampled beyond this"),
+      number_param("heading_prior", &P::heading_prior, 0.0, 1000.0, "", "weight of (theta - predicted theta)^2 (Tribots: 2.5)"),
+      positive_param("point_sigma", &P::point_sigma, 2.0, "m", "line-point noise that turns the error's curvature into a covariance"),
+      number_param("cell", &P::cell, 0.005, 0.5, "m", "distance-map cell (Tribots: 50 mm)"),
+  };
+  return list;
+}
+
+Json MatchingParams::schema() {
+  const MatchingParams d;
+  Json s = params_schema(params(), d);
+  s.update(params_schema(filter::OdometryNoiseParams::params(filter::OdometryNoiseParams::Keys::WithRotPerMetre), d.odometry));
+  return s;
+}
+
 MatchingParams MatchingParams::from_json(JsonReader& r) {
   MatchingParams p;
-  p.c = r.positive("c", p.c, 5.0);
-  p.c_start = r.positive("c_start", 2.0 * p.c, 10.0);  // one smoothing stage unless set
-  p.step_xy = r.positive("step_xy", p.step_xy, 2.0);
-  p.step_theta = r.positive("step_theta", p.step_theta, 1.0);
-  p.grow = r.number("grow", p.grow, 1.0, 3.0);
-  p.shrink = r.number("shrink", p.shrink, 0.05, 1.0);
   for (const char* old : {"iterations", "iterations_few", "many_points"})
     if (r.has(old))
       throw ConfigError(r.child_path(old), json_brief(*r.raw(old)),
                         "no such key (removed): RPROP runs until its steps are below step_tol, at most max_iterations times");
-  p.step_tol = r.number("step_tol", p.step_tol, 1e-6, 0.1);
-  p.max_iterations = static_cast<int>(r.integer("max_iterations", p.max_iterations, 1, 1000));
-  p.min_points = static_cast<int>(r.integer("min_points", p.min_points, 1, 10000));
-  p.max_points = static_cast<int>(r.integer("max_points", p.max_points, 3, 100000));
-  p.heading_prior = r.number("heading_prior", p.heading_prior, 0.0, 1000.0);
-  p.point_sigma = r.positive("point_sigma", p.point_sigma, 2.0);
-  p.cell = r.number("cell", p.cell, 0.005, 0.5);
+  read_param(r, p, params(), "c");
+  p.c_start = 2.0 * p.c;  // one smoothing stage unless set
+  read_params(r, p, params());
   p.odometry = filter::OdometryNoiseParams::from_json(r, p.odometry, filter::OdometryNoiseParams::Keys::WithRotPerMetre);
   return p;
 }

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "localization/field_map.hpp"
 #include "localization/filter/odometry_noise.hpp"
 #include "localization/filter/pose_kalman.hpp"
@@ -43,6 +44,10 @@ struct MatchingParams {
   /// 0.05, odo_rot_per_m 0.02 rad/m, odo_floor_xy 0.002 m, odo_floor_theta 0.002 rad).
   filter::OdometryNoiseParams odometry{0.05, 0.05, 0.02, 0.002, 0.002};
   static MatchingParams from_json(JsonReader& r);
+  /// Its own keys (the odo_* keys are filter::OdometryNoiseParams::params(Keys::WithRotPerMetre)).
+  static const ParamList<MatchingParams>& params();
+  /// JSON Schema properties of every key it reads.
+  static Json schema();
 };
 
 struct MatchResult {

@@ -9,21 +9,37 @@
 
 namespace omniloc {
 
+const ParamList<McLParams>& McLParams::params() {
+  using P = McLParams;
+  static const ParamList<P> list = {
+      integer_param("particles", &P::particles, 10, 100000, "particles (paper 002: 600); with kld the maximum"),
+      positive_param("sigma", &P::sigma, 5.0, "m", "sensor model std of a point's distance to the nearest line"),
+      positive_param("clamp", &P::clamp, 10.0, "m", "distances beyond count as this (points on robots, noise)"),
+      integer_param("max_points", &P::max_points, 1, 10000, "line points evenly subsampled per frame, for speed"),
+      integer_param("min_points", &P::min_points, 1, 10000, "fewer line points: no sensor update"),
+      number_param("evidence_points", &P::evidence_points, 0.0, 10000.0, "", "the log-likelihood sum is scaled to this many points' worth (0: the paper's plain product)"),
+      positive_param("heading_sigma", &P::heading_sigma, 10.0, "rad", "compass term in the weight and spread of the initial headings"),
+      positive_param("converged_std", &P::converged_std, 10.0, "m", "position spread below this = converged"),
+      positive_param("converged_theta_std", &P::converged_theta_std, 10.0, "rad", "heading spread below this = converged"),
+      number_param("alpha_slow", &P::alpha_slow, 0.0, 1.0, "", "augmented MCL: slow average of the likelihood (0 = off)"),
+      number_param("alpha_fast", &P::alpha_fast, 0.0, 1.0, "", "augmented MCL: fast average of the likelihood (0 = off)"),
+      number_param("cell", &P::cell, 0.005, 0.5, "m", "distance-map cell"),
+  };
+  return list;
+}
+
+Json McLParams::schema() {
+  const McLParams d;
+  Json s = params_schema(params(), d);
+  s.update(params_schema(filter::OdometryNoiseParams::params(filter::OdometryNoiseParams::Keys::Planar), d.odometry));
+  s.update(params_schema(filter::KldParams::params(), d.kld));
+  return s;
+}
+
 McLParams McLParams::from_json(JsonReader& r) {
   McLParams p;
-  p.particles = static_cast<int>(r.integer("particles", p.particles, 10, 100000));
-  p.sigma = r.positive("sigma", p.sigma, 5.0);
-  p.clamp = r.positive("clamp", p.clamp, 10.0);
-  p.max_points = static_cast<int>(r.integer("max_points", p.max_points, 1, 10000));
-  p.min_points = static_cast<int>(r.integer("min_points", p.min_points, 1, 10000));
-  p.evidence_points = r.number("evidence_points", p.evidence_points, 0.0, 10000.0);
-  p.heading_sigma = r.positive("heading_sigma", p.heading_sigma, 10.0);
+  read_params(r, p, params());
   p.odometry = filter::OdometryNoiseParams::from_json(r, p.odometry, filter::OdometryNoiseParams::Keys::Planar);
-  p.converged_std = r.positive("converged_std", p.converged_std, 10.0);
-  p.converged_theta_std = r.positive("converged_theta_std", p.converged_theta_std, 10.0);
-  p.alpha_slow = r.number("alpha_slow", p.alpha_slow, 0.0, 1.0);
-  p.alpha_fast = r.number("alpha_fast", p.alpha_fast, 0.0, 1.0);
-  p.cell = r.number("cell", p.cell, 0.005, 0.5);
   p.kld = filter::KldParams::from_json(r);
   return p;
 }

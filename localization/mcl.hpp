@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/rng.hpp"
 #include "localization/field_map.hpp"
 #include "localization/filter/kld.hpp"
@@ -40,6 +41,9 @@ struct McLParams {
   filter::KldParams kld;
   double cell = 0.05;
   static McLParams from_json(JsonReader& r);
+  /// Its own keys (plus filter::OdometryNoiseParams' planar odo_* keys and filter::KldParams').
+  static const ParamList<McLParams>& params();
+  static Json schema();
 };
 
 class McLLocalizer : public Localizer {

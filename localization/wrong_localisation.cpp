@@ -7,14 +7,22 @@
 
 namespace omniloc {
 
+const ParamList<DetectionParams>& DetectionParams::params() {
+  using P = DetectionParams;
+  static const ParamList<P> list = {
+      positive_param("deviation_threshold", &P::deviation_threshold, 10.0, "m", "wrong pose: the deviation_quantile of the points' distances to the nearest line above this"),
+      number_param("deviation_quantile", &P::deviation_quantile, 0.0, 1.0, "", "which quantile of the distances is the deviation (0.5 = median; 0.75 by measurement)"),
+      positive_param("heading_threshold", &P::heading_threshold, 3.2, "rad", "wrong pose: |tracked heading - compass| above this"),
+      integer_param("consecutive", &P::consecutive, 1, 1000, "both conditions for this many frames (papers 000 / 002: 5)"),
+      integer_param("heading_only_frames", &P::heading_only_frames, 0, 100000, "the heading condition alone for this many frames (extension; 0 = off)"),
+      integer_param("deviation_only_frames", &P::deviation_only_frames, 0, 100000, "the deviation condition alone for this many frames (extension; 0 = off)"),
+  };
+  return list;
+}
+
 DetectionParams DetectionParams::from_json(JsonReader& r) {
   DetectionParams p;
-  p.deviation_threshold = r.positive("deviation_threshold", p.deviation_threshold, 10.0);
-  p.deviation_quantile = r.number("deviation_quantile", p.deviation_quantile, 0.0, 1.0);
-  p.heading_threshold = r.positive("heading_threshold", p.heading_threshold, 3.2);
-  p.consecutive = static_cast<int>(r.integer("consecutive", p.consecutive, 1, 1000));
-  p.heading_only_frames = static_cast<int>(r.integer("heading_only_frames", p.heading_only_frames, 0, 100000));
-  p.deviation_only_frames = static_cast<int>(r.integer("deviation_only_frames", p.deviation_only_frames, 0, 100000));
+  read_params(r, p, params());
   return p;
 }
 

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/pose2.hpp"
 #include "localization/field_map.hpp"
 
@@ -29,6 +30,7 @@ struct DetectionParams {
   int deviation_only_frames = 30;     ///< extension (0 = off)
   /// Reads the keys above from `r` (same level as the localizer's other keys).
   static DetectionParams from_json(JsonReader& r);
+  static const ParamList<DetectionParams>& params();
 };
 
 /// The `quantile` (0..1) of the distances (metres) of the points (robot frame) from the nearest marking

@@ -6,14 +6,22 @@
 
 namespace omniloc::filter {
 
+const ParamList<KldParams>& KldParams::params() {
+  using P = KldParams;
+  static const ParamList<P> list = {
+      bool_param("kld", &P::enabled, "KLD-adaptive sample size (Fox 2003); the particle count is then the maximum"),
+      positive_param("kld_epsilon", &P::epsilon, 1.0, "", "bound on the KL distance (Fox 2003's epsilon; amcl pf_err 0.05)"),
+      positive_param("kld_z", &P::z, 10.0, "", "upper standard-normal quantile z_(1-delta); 2.326: delta = 0.01 (amcl pf_z 0.99)"),
+      positive_param("kld_bin_xy", &P::bin_xy, 10.0, "m", "histogram bin in x and y (amcl: 0.5 m)"),
+      positive_param("kld_bin_theta", &P::bin_theta, 3.2, "rad", "histogram bin in heading (amcl: 10 degrees)"),
+      integer_param("kld_min_particles", &P::min_particles, 1, 100000, "never fewer particles"),
+  };
+  return list;
+}
+
 KldParams KldParams::from_json(JsonReader& r) {
   KldParams p;
-  p.enabled = r.boolean("kld", p.enabled);
-  p.epsilon = r.positive("kld_epsilon", p.epsilon, 1.0);
-  p.z = r.positive("kld_z", p.z, 10.0);
-  p.bin_xy = r.positive("kld_bin_xy", p.bin_xy, 10.0);
-  p.bin_theta = r.positive("kld_bin_theta", p.bin_theta, 3.2);
-  p.min_particles = static_cast<int>(r.integer("kld_min_particles", p.min_particles, 1, 100000));
+  read_params(r, p, params());
   return p;
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/pose2.hpp"
 #include "core/rng.hpp"
 
@@ -29,6 +30,7 @@ struct KldParams {
   int min_particles = 100;   ///< never fewer (the bound is meaningless for k = 1 bin)
   /// Reads the flat keys kld, kld_epsilon, kld_z, kld_bin_xy, kld_bin_theta, kld_min_particles.
   static KldParams from_json(JsonReader& r);
+  static const ParamList<KldParams>& params();
 };
 
 /// Fox 2003 (the KLD bound): the number of particles n such that, with probability 1 - delta, the KL

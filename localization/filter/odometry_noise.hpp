@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "core/pose2.hpp"
 #include "core/rng.hpp"
 
@@ -29,6 +30,7 @@ struct OdometryNoiseParams {
   /// Reads odo_trans_frac, odo_rot_frac, [odo_rot_per_m,] odo_floor_xy, odo_floor_theta, each
   /// defaulting to the field of `defaults`.
   static OdometryNoiseParams from_json(JsonReader& r, const OdometryNoiseParams& defaults, Keys keys);
+  static const ParamList<OdometryNoiseParams>& params(Keys keys);
 };
 
 /// Standard deviations of one frame's motion noise.

@@ -14,20 +14,28 @@ namespace omniloc {
 using landmarks::BearingObs;
 using landmarks::Fix;
 
+const ParamList<LandmarkLocalizerParams>& LandmarkLocalizerParams::params() {
+  using P = LandmarkLocalizerParams;
+  static const ParamList<P> list = {
+      integer_param("min_landmarks", &P::min_landmarks, 3, 100, "fewer matched bearings: no fix (3 is the minimum for any solver)"),
+      positive_param("bearing_sigma_deg", &P::bearing_sigma_deg, 45.0, "deg", "expected bearing noise: assignment cost and covariance"),
+      positive_param("max_bearing_rms_deg", &P::max_bearing_rms_deg, 90.0, "deg", "a fix whose RMS bearing residual is larger is refused (>= 4 bearings)"),
+      number_param("distance_sigma", &P::distance_sigma, 0.0, 10.0, "", "relative error of blob distances in the cost; 0: distances unused"),
+      number_param("prediction_sigma", &P::prediction_sigma, 0.0, 100.0, "m", "predicted position's weight in the cost; 0: prediction unused"),
+      positive_param("prediction_sigma_theta_deg", &P::prediction_sigma_theta_deg, 360.0, "deg", "predicted heading's weight in the cost"),
+      number_param("ambiguity_margin", &P::ambiguity_margin, 0.0, 1e6, "chi-square", "closer rivals make the frame ambiguous"),
+      number_param("floor_slack", &P::floor_slack, 0.0, 100.0, "m", "a fix may lie this far outside the floor (walls) before it is discarded"),
+      bool_param("skip_occluded", &P::skip_occluded, "blobs whose edge may be cut by an occluder are not used"),
+      bool_param("odometry_prediction", &P::odometry_prediction, "report the odometry-predicted pose on frames without a fix"),
+      number_param("max_prediction_time", &P::max_prediction_time, 0.0, 1e6, "s", "after the last fix, prediction is used this long (cost and output)"),
+      integer_param("max_assignments", &P::max_assignments, 1, 100000, "assignments tried per frame at most"),
+  };
+  return list;
+}
+
 LandmarkLocalizerParams LandmarkLocalizerParams::from_json(JsonReader& r) {
   LandmarkLocalizerParams p;
-  p.min_landmarks = static_cast<int>(r.integer("min_landmarks", 3, 3, 100));
-  p.bearing_sigma_deg = r.positive("bearing_sigma_deg", 1.0, 45.0);
-  p.max_bearing_rms_deg = r.positive("max_bearing_rms_deg", 3.0, 90.0);
-  p.distance_sigma = r.number("distance_sigma", 0.15, 0.0, 10.0);
-  p.prediction_sigma = r.number("prediction_sigma", 0.5, 0.0, 100.0);
-  p.prediction_sigma_theta_deg = r.positive("prediction_sigma_theta_deg", 15.0, 360.0);
-  p.ambiguity_margin = r.number("ambiguity_margin", 1.0, 0.0, 1e6);
-  p.floor_slack = r.number("floor_slack", 0.5, 0.0, 100.0);
-  p.skip_occluded = r.boolean("skip_occluded", true);
-  p.odometry_prediction = r.boolean("odometry_prediction", false);
-  p.max_prediction_time = r.number("max_prediction_time", 2.0, 0.0, 1e6);
-  p.max_assignments = static_cast<int>(r.integer("max_assignments", 256, 1, 100000));
+  read_params(r, p, params());
   return p;
 }
 

@@ -37,6 +37,7 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
+#include "core/params.hpp"
 #include "localization/landmarks/landmark_fix.hpp"
 #include "localization/localizer.hpp"
 
@@ -56,6 +57,7 @@ struct LandmarkLocalizerParams {
   double max_prediction_time = 2.0;    ///< s after the last fix that prediction is used (cost and output)
   int max_assignments = 256;           ///< assignments tried per frame at most
   static LandmarkLocalizerParams from_json(JsonReader& r);
+  static const ParamList<LandmarkLocalizerParams>& params();
 };
 
 /// Why a frame has no fix (extra["no_fix_reason"]; 0 = fix).
