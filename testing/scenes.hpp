@@ -43,7 +43,7 @@ struct LinePointOptions {
 };
 
 /// The benchmarks' scene (bench/localization_bench.cpp and bench/icount.cpp measure the same inputs).
-inline constexpr LinePointOptions kBenchmarkLinePoints{6.0, LinePointOptions::Area::kSquare, 0.03, nullptr, 3000000};
+inline constexpr LinePointOptions kBenchmarkLinePoints{.area = LinePointOptions::Area::kSquare, .noise = 0.03};
 
 /// `n` points on the field's markings (within 4 mm of a line's centre) seen from `pose`, in the
 /// robot frame, drawn uniformly over the area around the robot.
