@@ -22,18 +22,19 @@
 #include <span>
 #include <string>
 
-#include "bench/bench_scenes.hpp"
 #include "core/field.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "harness/vision_setup.hpp"
 #include "localization/field_map.hpp"
 #include "localization/grid_global.hpp"
+#include "localization/landmarks/landmark_solvers.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
 #include "localization/vision/blobs.hpp"
 #include "localization/vision/scan_lines.hpp"
 #include "sim/render/panoramic_camera.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 
@@ -77,7 +78,7 @@ Frame rendered(const std::string& field_name, const Pose2& pose) {
 template <typename Solver>
 Workload closed_form(Solver solve, const char* what) {
   return {1024, what, [solve] {
-            const auto& cs = bench_scenes::landmark_configs(3, 0.0);
+            const auto& cs = scenes::landmark_configs(3, 0.0);
             auto i = std::make_shared<std::size_t>(0);
             return std::function<double()>([&cs, i, solve] {
               const auto f = solve(std::span<const landmarks::BearingObs>(cs[(*i)++ % cs.size()]));
@@ -94,7 +95,7 @@ std::map<std::string, Workload> workloads() {
                      Rng rng(1);
                      const Pose2 truth(-3.0, 1.0, 0.4);
                      auto obs = std::make_shared<Observations>();
-                     obs->line_points = bench_scenes::line_points(*f, truth, 200, rng);
+                     obs->line_points = scenes::line_points(*f, truth, 200, rng, scenes::kBenchmarkLinePoints);
                      return std::function<double()>([f, loc, obs, truth] {
                        loc->reset(Pose2(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.01));
                        return loc->update(*obs, Odometry{}, std::nullopt).pose.x;
@@ -117,7 +118,7 @@ std::map<std::string, Workload> workloads() {
                        Rng rng(3);
                        const Pose2 truth(2.0, -1.0, 0.7);
                        auto obs = std::make_shared<Observations>();
-                       obs->line_points = bench_scenes::line_points(*f, truth, 200, rng);
+                       obs->line_points = scenes::line_points(*f, truth, 200, rng, scenes::kBenchmarkLinePoints);
                        mcl->reset(std::nullopt);
                        return std::function<double()>([f, mcl, obs, truth] {
                          Odometry odo;
@@ -130,7 +131,7 @@ std::map<std::string, Workload> workloads() {
                         auto map = std::make_shared<FieldMap>(*f, 0.05, "");
                         Rng rng(5);
                         const Pose2 truth(-3.2, 2.1, -0.4);
-                        auto pts = std::make_shared<std::vector<Eigen::Vector2d>>(bench_scenes::line_points(*f, truth, 200, rng));
+                        auto pts = std::make_shared<std::vector<Eigen::Vector2d>>(scenes::line_points(*f, truth, 200, rng, scenes::kBenchmarkLinePoints));
                         return std::function<double()>([f, map, pts, truth] {
                           GridGlobalParams p;
                           p.accept_error = 0.0;

@@ -11,12 +11,12 @@
 
 #include "core/angles.hpp"
 #include "core/rng.hpp"
-#include "bench/bench_scenes.hpp"
 #include "localization/landmarks/landmark_solvers.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::landmarks;
-using bench_scenes::landmark_configs;
+using scenes::landmark_configs;
 
 namespace {
 

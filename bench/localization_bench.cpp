@@ -1,16 +1,14 @@
 // Localizer steps on synthetic line points (targets: matching + Kalman <= 0.1 ms with 200 points).
 #include <benchmark/benchmark.h>
 
-#include "bench/bench_scenes.hpp"
 #include "core/field.hpp"
 #include "core/rng.hpp"
 #include "localization/grid_global.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
-using bench_scenes::line_points;
-
 
 static void BM_MatchingUpdate(benchmark::State& state) {
   const Field f = Field::preset("msl2012");
@@ -18,7 +16,7 @@ static void BM_MatchingUpdate(benchmark::State& state) {
   Rng rng(1);
   const Pose2 truth(-3.0, 1.0, 0.4);
   Observations obs;
-  obs.line_points = line_points(f, truth, static_cast<int>(state.range(0)), rng);
+  obs.line_points = scenes::line_points(f, truth, static_cast<int>(state.range(0)), rng, scenes::kBenchmarkLinePoints);
   Odometry odo;
   for (auto _ : state) {
     state.PauseTiming();
@@ -49,7 +47,7 @@ static void BM_McLUpdate(benchmark::State& state) {
   Rng rng(3);
   const Pose2 truth(2.0, -1.0, 0.7);
   Observations obs;
-  obs.line_points = line_points(f, truth, 200, rng);
+  obs.line_points = scenes::line_points(f, truth, 200, rng, scenes::kBenchmarkLinePoints);
   Odometry odo;
   odo.delta = Pose2(0.03, 0.0, 0.01);
   mcl.reset(std::nullopt);
@@ -64,7 +62,7 @@ static void BM_GridGlobalAttempt(benchmark::State& state) {
   const FieldMap map(f, 0.05, "");
   Rng rng(5);
   const Pose2 truth(-3.2, 2.1, -0.4);
-  const auto pts = line_points(f, truth, 200, rng);
+  const auto pts = scenes::line_points(f, truth, 200, rng, scenes::kBenchmarkLinePoints);
   GridGlobalParams p;
   p.accept_error = 0.0;
   for (auto _ : state) benchmark::DoNotOptimize(grid_search(f, map, pts, truth.theta, p));

@@ -14,7 +14,10 @@ add_library(omniloc::opencv INTERFACE IMPORTED)
 target_include_directories(omniloc::opencv SYSTEM INTERFACE ${OPENCV_INCLUDE_DIR})
 target_link_libraries(omniloc::opencv INTERFACE ${OPENCV_imgcodecs_LIB} ${OPENCV_imgproc_LIB} ${OPENCV_core_LIB})
 
-# OSMesa and EGL are loaded at run time with dlopen (sim/gl_backend_*.cpp): each back-end resolves its
-# own GL entry points, so neither glvnd's libGL nor libOSMesa is linked and their gl* symbols never clash.
+# OSMesa and EGL are loaded at run time with dlopen (sim/render/gl_context.cpp, one back-end class
+# each): each back-end resolves its own GL entry points, so neither glvnd's libGL nor libOSMesa is
+# linked and their gl* symbols never clash. Only their headers are needed to build (libosmesa6-dev,
+# libegl-dev); they sit in the compiler's default search path, so these two look-ups only stop the
+# configuration early, with the header's name, when a package is missing.
 find_path(OSMESA_INCLUDE_DIR GL/osmesa.h REQUIRED)
 find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)

@@ -1,9 +1,8 @@
 #pragma once
 // What flows from the simulated robot to the localization side: exactly what a real robot has
 // (images, odometry, compass, team messages), never ground truth.
+#include <cstddef>
 #include <cstdint>
-#include <memory>
-#include <optional>
 #include <vector>
 
 #include "core/pose2.hpp"
@@ -36,16 +35,6 @@ struct Odometry {
 struct HeadingReading {
   double t = 0.0;        ///< seconds
   double heading = 0.0;  ///< radians
-};
-
-/// Everything one robot's sensors deliver at one camera frame.
-struct SensorFrame {
-  double t = 0.0;                         ///< seconds since scenario start
-  int robot_id = 0;
-  Odometry odometry;                      ///< accumulated since the previous SensorFrame
-  std::optional<HeadingReading> heading;  ///< absent when the robot has no compass
-  std::shared_ptr<const Image> image;     ///< null when the scenario renders no images
-  CameraSettings camera;                  ///< the settings the image was taken with
 };
 
 }  // namespace omniloc

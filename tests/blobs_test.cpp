@@ -13,16 +13,16 @@
 #include "localization/vision/blobs.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/render/panoramic_camera.hpp"
-#include "test_scenes.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
 
 namespace {
 
-using testing_scenes::quiet_camera;
+using scenes::quiet_camera;
 
-using testing_scenes::one_robot;
+using scenes::one_robot;
 
 double bearing_to(const Pose2& robot, const Eigen::Vector2d& target) {
   const Eigen::Vector2d d = target - robot.translation();

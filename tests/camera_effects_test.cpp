@@ -10,12 +10,12 @@
 #include "core/angles.hpp"
 #include "core/field.hpp"
 #include "sim/render/panoramic_camera.hpp"
-#include "test_scenes.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
-using testing_scenes::one_robot;
-using testing_scenes::quiet_camera;
+using scenes::one_robot;
+using scenes::quiet_camera;
 
 namespace {
 

@@ -7,14 +7,14 @@
 #include "core/error.hpp"
 #include "core/field.hpp"
 #include "sim/render/panoramic_camera.hpp"
-#include "test_scenes.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
 
 namespace {
-using testing_scenes::quiet_camera;
-using testing_scenes::one_robot;
+using scenes::quiet_camera;
+using scenes::one_robot;
 }  // namespace
 
 class CameraTest : public ::testing::Test {

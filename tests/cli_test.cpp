@@ -1,17 +1,29 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <set>
+#include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/atomic_file.hpp"
 
-// Runs the real omniloc binary (the tests' working directory is the build folder).
+// Runs the real omniloc binary (the tests' working directory is the build folder); `out` and `err`
+// receive what it printed when given.
 namespace {
-int run(const std::string& args) {
-  const int st = std::system(("./omniloc " + args + " >/dev/null 2>&1").c_str());
+int run(const std::string& args, std::string* out = nullptr, std::string* err = nullptr) {
+  const auto tmp = std::filesystem::temp_directory_path() / ("omniloc_cli_" + std::to_string(::getpid()));
+  const std::string o = tmp.string() + ".out", e = tmp.string() + ".err";
+  const int st = std::system(("./omniloc " + args + " >" + o + " 2>" + e).c_str());
+  if (out) *out = omniloc::read_file(o);
+  if (err) *err = omniloc::read_file(e);
+  std::filesystem::remove(o);
+  std::filesystem::remove(e);
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 const std::string kScenario = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/quickstart.json";
@@ -36,4 +48,55 @@ TEST(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(run("run " + kScenario + " --seed abc"), 2);
   EXPECT_EQ(run("validate /nonexistent.json"), 2);
   EXPECT_EQ(run("list"), 0);
+}
+
+// A number option given a word exits 2 before any work, and the message names the option (atoi
+// once turned "--robot abc" into robot 0 and "--frames-every abc" into 0). Every option whose value
+// is a number in some command's --help must have a case here, so a new one cannot skip the strict parser.
+TEST(Cli, EveryNumberOptionRejectsAWordAndNamesIt) {
+  const std::string q = kScenario;
+  const std::string sweep = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/sweeps/odometry_drift.json";
+  const auto out = std::filesystem::temp_directory_path() / ("omniloc_cli_numbers_" + std::to_string(::getpid()));
+  const std::string o = " -o " + out.string();
+  struct Case {
+    std::string command, option, args;
+  };
+  const std::vector<Case> cases = {
+      {"run", "--seed", "run " + q + " --seed abc" + o},
+      {"run", "--frames-every", "run " + q + " --frames-every abc" + o},
+      {"render", "--t", "render " + q + " --t abc -o x.png"},
+      {"render", "--robot", "render " + q + " --robot abc -o x.png"},
+      {"render", "--seed", "render " + q + " --seed abc -o x.png"},
+      {"calibrate", "--seed", "calibrate " + q + " --seed abc" + o},
+      {"colour-calibrate", "--seed", "colour-calibrate " + q + " --seed abc" + o},
+      {"sweep", "-j", "sweep " + sweep + " -j abc" + o},
+      {"sweep", "--shard", "sweep " + sweep + " --shard abc" + o},
+      {"sweep", "--stop-after", "sweep " + sweep + " --stop-after abc" + o},
+      {"sweep", "--tasks", "sweep " + sweep + " --slurm --dry-run --tasks abc" + o},
+      {"sweep", "--cpus-per-task", "sweep " + sweep + " --slurm --dry-run --tasks 2 --cpus-per-task abc" + o},
+      {"sweep", "--time", "sweep " + sweep + " --slurm --dry-run --tasks 2 --time abc" + o},
+      {"experiment", "--seed", "experiment cooperative_001 --seed abc" + o},
+  };
+  std::set<std::pair<std::string, std::string>> covered;
+  for (const auto& c : cases) {
+    std::string err;
+    EXPECT_EQ(run(c.args, nullptr, &err), 2) << c.args;
+    EXPECT_NE(err.find(c.option), std::string::npos) << c.args << ": the message should name " << c.option << ", got: " << err;
+    covered.insert({c.command, c.option});
+  }
+  EXPECT_FALSE(std::filesystem::exists(out)) << "a rejected command line must write nothing";
+  std::filesystem::remove_all(out);
+  // The value names the option tables give numbers (apps/main.cpp).
+  const std::set<std::string> number_values = {"N", "ID", "SECONDS", "C", "I/N", "HH:MM:SS"};
+  for (const char* cmd : {"run", "render", "calibrate", "colour-calibrate", "validate", "list", "sweep", "experiment"}) {
+    std::string help;
+    ASSERT_EQ(run(std::string(cmd) + " --help", &help), 0) << cmd;
+    std::istringstream lines(help);
+    for (std::string line; std::getline(lines, line);) {
+      std::istringstream words(line);
+      std::string name, value;
+      if (!(words >> name >> value) || name.rfind("-", 0) != 0 || !number_values.count(value)) continue;
+      EXPECT_TRUE(covered.count({cmd, name})) << "omniloc " << cmd << " " << name << " " << value << " has no case above";
+    }
+  }
 }

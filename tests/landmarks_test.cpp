@@ -15,9 +15,13 @@
 #include "core/angles.hpp"
 #include "core/rng.hpp"
 #include "localization/landmarks/landmark_solvers.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::landmarks;
+using scenes::circumcircle;
+using scenes::distance_to_circle;
+using scenes::distance_to_line;
 
 namespace {
 
@@ -41,29 +45,6 @@ std::vector<BearingObs> observe(const std::vector<Eigen::Vector2d>& L, const Pos
   return obs;
 }
 
-/// Centre and radius of the circle through three points (not collinear).
-void circumcircle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, Eigen::Vector2d& centre, double& r) {
-  const double d = 2.0 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
-  const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
-  centre = {(a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d,
-            (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d};
-  r = (a - centre).norm();
-}
-
-double distance_to_circle(const std::vector<Eigen::Vector2d>& L, const Eigen::Vector2d& p) {
-  Eigen::Vector2d c;
-  double r = 0;
-  circumcircle(L[0], L[1], L[2], c, r);
-  return std::fabs((p - c).norm() - r);
-}
-
-/// Distance from p to the whole (infinite) line through a and b.
-double distance_to_line(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d u = (b - a).normalized();
-  const Eigen::Vector2d v = p - a;
-  return std::fabs(u.x() * v.y() - u.y() * v.x());
-}
-
 // Singular sets, per solver:
 //  circle only (total_like, circle_intersection_003): robot within `margin` of the circle through
 //    the three landmarks (this includes being within `margin` of a landmark);
@@ -71,7 +52,7 @@ double distance_to_line(const Eigen::Vector2d& a, const Eigen::Vector2d& b, cons
 //    landmarks 0 and 1 or 1 and 2 (the robot sees that pair in the same or opposite direction: the
 //    landmarks nearly collinear as seen from the robot; the methods divide by the sine of that angle).
 bool near_circle(const std::vector<Eigen::Vector2d>& L, const Eigen::Vector2d& p, double margin) {
-  return distance_to_circle(L, p) < margin;
+  return distance_to_circle(L[0], L[1], L[2], p) < margin;
 }
 bool near_circle_or_lines(const std::vector<Eigen::Vector2d>& L, const Eigen::Vector2d& p, double margin) {
   return near_circle(L, p, margin) || distance_to_line(L[0], L[1], p) < margin || distance_to_line(L[1], L[2], p) < margin;

@@ -9,6 +9,7 @@
 #include "localization/grid_global.hpp"
 #include "localization/hybrid.hpp"
 #include "localization/mcl.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 
@@ -16,12 +17,7 @@ namespace {
 // Line points a robot at `pose` would see: markings within 6 m, 2 cm noise, in the robot frame.
 Observations see(const Field& f, const Pose2& pose, Rng& rng, int n = 80) {
   Observations o;
-  int guard = 0;
-  while (static_cast<int>(o.line_points.size()) < n && ++guard < 3000000) {
-    const Eigen::Vector2d w(pose.x + rng.uniform(-6, 6), pose.y + rng.uniform(-6, 6));
-    if ((w - pose.translation()).norm() > 6 || f.distance_to_marking(w) > 0.004) continue;
-    o.line_points.push_back(pose.inverse_transform(w) + Eigen::Vector2d(rng.normal(0, 0.02), rng.normal(0, 0.02)));
-  }
+  o.line_points = scenes::line_points(f, pose, n, rng, {.noise = 0.02});
   return o;
 }
 }  // namespace

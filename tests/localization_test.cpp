@@ -9,29 +9,9 @@
 #include "core/rng.hpp"
 #include "localization/field_map.hpp"
 #include "localization/matching.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
-
-namespace {
-// Line points: samples of the markings within `range` of the pose, in the robot frame, with
-// Gaussian noise of `noise` metres. `fast`: a distance map of the field that rejects most samples
-// before the exact (slower) test; it is exact to half a cell (FieldMap test above), so it changes no point.
-std::vector<Eigen::Vector2d> line_points(const Field& f, const Pose2& pose, double range, Rng& rng, int n, double noise = 0.0,
-                                         const FieldMap* fast = nullptr) {
-  std::vector<Eigen::Vector2d> pts;
-  int guard = 0;
-  while (static_cast<int>(pts.size()) < n && ++guard < 2000000) {
-    const Eigen::Vector2d w(pose.x + rng.uniform(-range, range), pose.y + rng.uniform(-range, range));
-    if ((w - pose.translation()).norm() > range) continue;
-    if (fast && fast->distance(w) > 0.004 + 0.6 * fast->cell()) continue;
-    if (f.distance_to_marking(w) > 0.004) continue;
-    Eigen::Vector2d p = pose.inverse_transform(w);
-    if (noise > 0) p += Eigen::Vector2d(rng.normal(0, noise), rng.normal(0, noise));
-    pts.push_back(p);
-  }
-  return pts;
-}
-}  // namespace
 
 TEST(FieldMap, ExactToHalfACellAgainstTheAnalyticModel) {
   const Field f = Field::preset("msl2012");
@@ -58,7 +38,7 @@ TEST(Matching, RpropConvergesFromHalfAMetreAndAThirdOfARadian) {
   Rng rng(7);
   for (int trial = 0; trial < 8; ++trial) {
     const Pose2 truth(rng.uniform(-7, 7), rng.uniform(-4.5, 4.5), rng.uniform(-kPi, kPi));
-    const auto pts = line_points(f, truth, 6.0, rng, 150);
+    const auto pts = scenes::line_points(f, truth, 150, rng);
     const double a = rng.uniform(0, kTwoPi);
     const Pose2 start(truth.x + 0.5 * std::cos(a), truth.y + 0.5 * std::sin(a), truth.theta + (trial % 2 ? 0.3 : -0.3));
     // 120 iterations for this large start offset (tracking uses 10-20 from the prediction).
@@ -129,7 +109,7 @@ ColdStarts cold_starts(const FieldMap& map, const Field& f, const MatchingParams
   int good = 0;
   for (int i = 0; i < n; ++i) {
     const Pose2 truth(rng.uniform(-9, 9), rng.uniform(-6, 6), rng.uniform(-kPi, kPi));
-    const auto pts = line_points(f, truth, 6.0, rng, 200, 0.03, &map);
+    const auto pts = scenes::line_points(f, truth, 200, rng, {.noise = 0.03, .prefilter = &map});
     const auto sign = [&] { return rng.uniform() < 0.5 ? -1.0 : 1.0; };
     const Pose2 start(truth.x + sign() * dxy, truth.y + sign() * dxy, truth.theta + sign() * dth);
     const MatchResult r = rprop_match(map, pts, start, p, p.max_iterations, start.theta);

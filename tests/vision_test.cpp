@@ -12,13 +12,13 @@
 #include "localization/vision/scan_lines.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/render/panoramic_camera.hpp"
-#include "test_scenes.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::sim;
 
 namespace {
-using testing_scenes::quiet_camera;
+using scenes::quiet_camera;
 }  // namespace
 
 class VisionTest : public ::testing::Test {
@@ -35,7 +35,7 @@ class VisionTest : public ::testing::Test {
     delete cam_;
     delete field_;
   }
-  static WorldState world(const Pose2& p) { return testing_scenes::one_robot(p); }
+  static WorldState world(const Pose2& p) { return scenes::one_robot(p); }
   static Field* field_;
   static PanoramicCamera* cam_;
   static CalibrationMap* map_;
