@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/json_parse.hpp"
+#include "core/params.hpp"
 #include "harness/camera_perception.hpp"
 #include "harness/vision_setup.hpp"
 #include "harness/localizer_registry.hpp"
@@ -85,79 +86,57 @@ std::vector<int> Scenario::localized_robots() const {
   return ids;
 }
 
-Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source) {
-  Scenario s;
-  s.source = source;
-  JsonReader r(j, "", &s.effective);
-  r.allow("comment");
-  s.name = r.string("name", name_from_stem(name));
-  if (!safe_name(s.name))
-    throw ConfigError("/name", json_brief(Json(s.name)), "a name of 1 to 100 characters from A-Z a-z 0-9 . _ - (not \".\" or \"..\"); it names the results folder");
-  s.description = r.string("description", std::string());
-  s.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, (1LL << 53)));
-  s.duration = r.positive("duration", 30.0, 3600.0);
-  s.physics_rate = r.number("physics_rate", 200.0, 20.0, 2000.0);
-  s.camera_rate = r.number("camera_rate", 30.0, 1.0, 200.0);
-  if (s.camera_rate > s.physics_rate)
-    throw ConfigError("/camera_rate", std::to_string(s.camera_rate), "a camera rate <= physics_rate (" + std::to_string(s.physics_rate) + " Hz)");
+namespace {
 
-  // Field: a preset name or an inline object.
-  const Json* field = r.raw("field");
-  if (!field || field->is_string()) {
-    s.field = Field::preset(field ? field->get<std::string>() : std::string("msl2012"), "/field");
-    s.effective["field"] = s.field.name;
+// One element of /robots; `eff` gets the effective values (the profile's noise where not given).
+RobotConfig read_robot(const Json& j, std::size_t i, const Scenario& s, std::set<int>& ids, Json& eff) {
+  const std::string rp = json_child("/robots", i);
+  JsonReader rr(j, rp, &eff);
+  rr.allow("comment");
+  RobotConfig rc;
+  rc.spec.id = static_cast<int>(rr.integer("id", static_cast<long long>(i), 0, 99));
+  if (!ids.insert(rc.spec.id).second) throw ConfigError(rp + "/id", std::to_string(rc.spec.id), "a robot id not used by another robot");
+  rc.spec.team = static_cast<int>(rr.integer("team", 0, 0, 1));
+  rc.spec.start = read_pose(rr, "start");
+  rc.spec.radius = rr.number("radius", 0.26, 0.1, 0.4);
+  rc.spec.height = rr.number("height", 0.8, 0.2, 1.5);
+  rc.spec.max_speed = rr.positive("max_speed", 4.0, 10.0);
+  rc.spec.max_accel = rr.positive("max_accel", 3.0, 20.0);
+  rc.localize = rr.boolean("localize", i == 0);
+  rc.has_heading_sensor = rr.boolean("heading_sensor", true);
+  check_on_floor(s.field, rc.spec.start.translation(), rc.spec.radius, rp + "/start", "a start position with the whole robot");
+  rc.motion = rr.raw("motion") ? *rr.raw("motion") : Json{{"type", "still"}};
+  rc.motion_path = rp + "/motion";
+  sim::MotionScript::from_json(rc.motion, rc.motion_path, 0, &s.field);  // validate now
+  rc.odometry = s.noise.odometry;
+  rc.heading = s.noise.heading;
+  if (auto o = rr.object("odometry")) {
+    rc.odometry = sim::OdometryNoise::from_json(*o, s.noise.odometry);
+    o->finish();
   } else {
-    s.field = Field::from_json(*field, "/field");
+    for (const auto& q : sim::OdometryNoise::params()) eff["odometry"][q.key] = param_value(q, rc.odometry);
   }
+  if (auto h = rr.object("heading")) {
+    rc.heading = sim::HeadingNoise::from_json(*h, s.noise.heading);
+    h->finish();
+  } else {
+    for (const auto& q : sim::HeadingNoise::params()) eff["heading"][q.key] = param_value(q, rc.heading);
+  }
+  rr.finish();
+  return rc;
+}
 
-  s.noise = NoiseProfile::named(r.string("noise_profile", std::string("robot")), "/noise_profile");
-
-  // Robots.
+// /robots: each robot, then the checks between robots.
+void read_robots(JsonReader& r, Scenario& s) {
   const Json* robots = r.raw("robots", true);
   if (!robots->is_array() || robots->empty())
     throw ConfigError("/robots", json_brief(*robots), "a non-empty array of robot objects");
   std::set<int> ids;
   Json eff_robots = Json::array();
   for (std::size_t i = 0; i < robots->size(); ++i) {
-    const std::string rp = json_child("/robots", i);
     Json eff;
-    JsonReader rr((*robots)[i], rp, &eff);
-    rr.allow("comment");
-    RobotConfig rc;
-    rc.spec.id = static_cast<int>(rr.integer("id", static_cast<long long>(i), 0, 99));
-    if (!ids.insert(rc.spec.id).second) throw ConfigError(rp + "/id", std::to_string(rc.spec.id), "a robot id not used by another robot");
-    rc.spec.team = static_cast<int>(rr.integer("team", 0, 0, 1));
-    rc.spec.start = read_pose(rr, "start");
-    rc.spec.radius = rr.number("radius", 0.26, 0.1, 0.4);
-    rc.spec.height = rr.number("height", 0.8, 0.2, 1.5);
-    rc.spec.max_speed = rr.positive("max_speed", 4.0, 10.0);
-    rc.spec.max_accel = rr.positive("max_accel", 3.0, 20.0);
-    rc.localize = rr.boolean("localize", i == 0);
-    rc.has_heading_sensor = rr.boolean("heading_sensor", true);
-    check_on_floor(s.field, rc.spec.start.translation(), rc.spec.radius, rp + "/start", "a start position with the whole robot");
-    rc.motion = rr.raw("motion") ? *rr.raw("motion") : Json{{"type", "still"}};
-    rc.motion_path = rp + "/motion";
-    sim::MotionScript::from_json(rc.motion, rc.motion_path, 0, &s.field);  // validate now
-    rc.odometry = s.noise.odometry;
-    rc.heading = s.noise.heading;
-    if (auto o = rr.object("odometry")) {
-      rc.odometry = sim::OdometryNoise::from_json(*o, s.noise.odometry);
-      o->finish();
-    } else {
-      eff["odometry"] = {{"trans_sigma", rc.odometry.trans_sigma}, {"rot_sigma", rc.odometry.rot_sigma},
-                         {"rot_per_trans", rc.odometry.rot_per_trans}, {"scale_sigma", rc.odometry.scale_sigma}};
-    }
-    if (auto h = rr.object("heading")) {
-      rc.heading = sim::HeadingNoise::from_json(*h, s.noise.heading);
-      h->finish();
-    } else {
-      eff["heading"] = {{"noise_sigma", rc.heading.noise_sigma}, {"bias_walk", rc.heading.bias_walk},
-                        {"drift_rate", rc.heading.drift_rate}, {"initial_bias", rc.heading.initial_bias},
-                        {"offset", rc.heading.offset}};
-    }
-    rr.finish();
+    s.robots.push_back(read_robot((*robots)[i], i, s, ids, eff));
     eff_robots.push_back(eff);
-    s.robots.push_back(rc);
   }
   s.effective["robots"] = eff_robots;
   // Robots must not start inside one another.
@@ -180,7 +159,10 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   }
   if (s.localized_robots().empty())
     throw ConfigError("/robots", "no robot with \"localize\": true", "at least one localized robot");
+}
 
+// /ball: position and velocity.
+void read_ball(JsonReader& r, Scenario& s, const Json& j) {
   if (auto b = r.object("ball")) {
     s.has_ball = true;
     const auto p = b->numbers("position", std::nullopt, 2);
@@ -193,8 +175,10 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
     check_on_floor(s.field, s.ball_position, 0.11, "/ball/position", "a ball position");
     b->finish();
   }
+}
 
-  // Events.
+// /events (harness/events.cpp), in time order.
+void read_events(JsonReader& r, Scenario& s) {
   if (const Json* ev = r.raw("events")) {
     if (!ev->is_array()) throw ConfigError("/events", json_brief(*ev), "an array of event objects");
     EventContext ctx;
@@ -205,8 +189,10 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
     for (std::size_t i = 0; i < ev->size(); ++i) s.events.push_back(parse_event((*ev)[i], json_child("/events", i), ctx));
     std::stable_sort(s.events.begin(), s.events.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
   }
+}
 
-  if (const Json* occ = r.raw("occlusion")) s.occlusion = sim::OcclusionMask::from_json(*occ, "/occlusion");
+// /lighting: level, sun patches, lamps (a list or a grid); then the lamps the events name must exist.
+void read_lighting(JsonReader& r, Scenario& s) {
   if (auto l = r.object("lighting")) {
     l->allow("comment");
     s.lighting.level = l->number("level", 1.0, 0.0, 20.0);
@@ -281,11 +267,10 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
         if (static_cast<std::size_t>(lights->lamps[k]) >= s.lighting.lamps.size())
           throw ConfigError(json_child(e.path + "/lamps", k), std::to_string(lights->lamps[k]),
                             "the index of a lamp in /lighting/lamps (" + std::to_string(s.lighting.lamps.size()) + " lamps)");
+}
 
-  const Json* loc = r.raw("localizer");
-  s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};
-  if (!s.localizer.is_object()) throw ConfigError("/localizer", json_brief(s.localizer), "an object {\"type\": ...}");
-
+// /camera (the profile's defaults under the scenario's values) and /vision, both validated now, data files included.
+void read_camera_and_vision(JsonReader& r, Scenario& s) {
   // Camera: the profile's defaults under the scenario's explicit values.
   s.camera = s.noise.camera;
   if (const Json* cam = r.raw("camera")) {
@@ -311,6 +296,47 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
       check_data_file(vc.colour_table, "/vision/colour_table", "\"auto\" or a colour table file for this field (omniloc colour-calibrate)",
                       [&] { (void)ColourTable::load(vc.colour_table, s.field.fingerprint()); });
   }
+}
+
+}  // namespace
+
+Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source) {
+  Scenario s;
+  s.source = source;
+  JsonReader r(j, "", &s.effective);
+  r.allow("comment");
+  s.name = r.string("name", name_from_stem(name));
+  if (!safe_name(s.name))
+    throw ConfigError("/name", json_brief(Json(s.name)), "a name of 1 to 100 characters from A-Z a-z 0-9 . _ - (not \".\" or \"..\"); it names the results folder");
+  s.description = r.string("description", std::string());
+  s.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, (1LL << 53)));
+  s.duration = r.positive("duration", 30.0, 3600.0);
+  s.physics_rate = r.number("physics_rate", 200.0, 20.0, 2000.0);
+  s.camera_rate = r.number("camera_rate", 30.0, 1.0, 200.0);
+  if (s.camera_rate > s.physics_rate)
+    throw ConfigError("/camera_rate", std::to_string(s.camera_rate), "a camera rate <= physics_rate (" + std::to_string(s.physics_rate) + " Hz)");
+
+  // Field: a preset name or an inline object.
+  const Json* field = r.raw("field");
+  if (!field || field->is_string()) {
+    s.field = Field::preset(field ? field->get<std::string>() : std::string("msl2012"), "/field");
+    s.effective["field"] = s.field.name;
+  } else {
+    s.field = Field::from_json(*field, "/field");
+  }
+
+  s.noise = NoiseProfile::named(r.string("noise_profile", std::string("robot")), "/noise_profile");
+
+  read_robots(r, s);
+  read_ball(r, s, j);
+  read_events(r, s);
+  if (const Json* occ = r.raw("occlusion")) s.occlusion = sim::OcclusionMask::from_json(*occ, "/occlusion");
+  read_lighting(r, s);
+  const Json* loc = r.raw("localizer");
+  s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};
+  if (!s.localizer.is_object()) throw ConfigError("/localizer", json_brief(s.localizer), "an object {\"type\": ...}");
+
+  read_camera_and_vision(r, s);
   r.finish();
   validate_deep(s);
   return s;
