@@ -38,11 +38,12 @@ Json one_of_strings(const std::vector<std::string>& names, const std::string& de
   return {{"type", "string"}, {"enum", names}, {"description", description}};
 }
 
-// Camera keys with their types and defaults from the default configuration (docs/camera.md says
-// what each means; CameraConfig::from_json checks the ranges and the cross-field rules).
+// Camera keys with their types and the defaults a scenario gets (what from_json records for an empty
+// object; docs/camera.md says what each means, from_json checks ranges and cross-field rules).
 Json camera_schema() {
   Json props = Json::object();
-  const Json defaults = sim::CameraConfig{}.to_json();
+  Json defaults;
+  sim::CameraConfig::from_json(Json::object(), "/camera", &defaults);
   for (const auto& [key, value] : defaults.items()) {
     Json s{{"default", value}};
     s["type"] = value.is_boolean() ? "boolean" : value.is_number_integer() ? "integer" : value.is_number() ? "number" : value.is_string() ? "string" : "array";
