@@ -24,14 +24,16 @@ sim::WorldState world_at(const Scenario& s, double t, std::uint64_t seed) {
 
 namespace {
 
-// Replays the run's camera frames 0..k_last; returns robot's image of frame k_last.
-Image replayed_frame(const Scenario& s, long long k_last, int robot, std::uint64_t seed, CameraPerception& perception) {
+// Replays the run's camera frames 0..k_last; returns robot's image of frame k_last (with `labels`, the
+// class image of the same world: the pauses earlier frames asked for are replayed all the same).
+Image replayed_frame(const Scenario& s, long long k_last, int robot, std::uint64_t seed, bool labels, CameraPerception& perception) {
   Simulation sim(s, seed);
   const std::vector<int> localized = s.localized_robots();
   const bool is_localized = std::find(localized.begin(), localized.end(), robot) != localized.end();
   for (long long k = 0; k <= k_last; ++k) {
     sim.advance_to(static_cast<double>(k) / s.camera_rate);
     const sim::WorldState now = sim.state();
+    if (k == k_last && labels) return perception.camera().render_labels(sim.camera_view(now), robot);
     for (int id : localized) {
       const PerceptionOutput po = perception.observe(sim.camera_view(now), id, now.t, sim.conditions(id, now));
       sim.set_paused(id, po.stop_robot);
@@ -63,15 +65,9 @@ void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed
   if (t < 0 || t > s.duration) throw ConfigError("--t", std::to_string(t), "a time within the scenario's duration");
   const long long k = static_cast<long long>(std::floor(t * s.camera_rate + 1e-9));
   CameraPerception perception(s, seed);
-  Image img;
-  if (labels) {
-    Simulation sim(s, seed);
-    sim.advance_to(static_cast<double>(k) / s.camera_rate);
-    img = perception.camera().render_labels(sim.camera_view(sim.state()), robot_id);
+  Image img = replayed_frame(s, k, robot_id, seed, labels, perception);
+  if (labels)
     for (auto& v : img.rgb) v = static_cast<std::uint8_t>(std::min(255, v * 21));  // class ids spread over the grey range
-  } else {
-    img = replayed_frame(s, k, robot_id, seed, perception);
-  }
   if (points && !labels) {
     const ScanResult r = perception.detector().detect(img);
     cv::Mat m(img.height, img.width, CV_8UC3, img.rgb.data());

@@ -87,7 +87,7 @@ void robot_frame(Tracked& tr, Simulation& sim, Perception& perception, const sim
 }
 
 // Scores every robot and writes the result files; the table rows go to `result`.
-void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const std::vector<Tracked>& tracked,
+void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const std::vector<RobotRecord>& records,
                    const EventLog& log, const Json& effective, RunDirectory& dir, RunResult& result) {
   Json summary;
   summary["scenario"] = sc.name;
@@ -97,11 +97,9 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   summary["duration_s"] = sc.duration;
   summary["camera_rate_hz"] = sc.camera_rate;
   summary["omniloc"] = build_info_json();  // provenance; the regression gates compare everything else
-  std::vector<RobotRecord> records;
   std::vector<TableRow> rows;
-  for (std::size_t i = 0; i < tracked.size(); ++i) {
-    const RobotRecord& rec = tracked[i].record;
-    records.push_back(rec);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const RobotRecord& rec = records[i];
     const std::string suffix = i == 0 ? "" : "_r" + std::to_string(rec.id);
     dir.write("gt" + suffix + ".tum", truth_tum(rec));
     dir.write("est" + suffix + ".tum", estimate_tum(rec));
@@ -147,7 +145,9 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
     for (auto& tr : tracked) robot_frame(tr, sim, *perception, now, k, opt, log);
     if (opt.log && k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && k > 0) *opt.log << "  t = " << now.t << " s\n";
   }
-  write_results(sc, seed, info.type, tracked, log, effective, dir, result);
+  std::vector<RobotRecord> records;
+  for (auto& tr : tracked) records.push_back(std::move(tr.record));
+  write_results(sc, seed, info.type, records, log, effective, dir, result);
   result.out_dir = dir.final_dir();
   return result;
 }
