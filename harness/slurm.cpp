@@ -378,182 +378,248 @@ SweepStatus sweep_status(const SweepSpec& spec, const std::string& out_dir, int 
   return st;
 }
 
-SlurmSubmission submit_slurm(const SweepSpec& spec, const std::string& spec_path, const SlurmOptions& o) {
-  check_slurm_options(spec, o);
-  const fs::path dir = results_dir(spec, o.out_dir);
-  const fs::path folder = dir / "slurm";
-  const fs::path spec_abs = fs::absolute(spec_path).lexically_normal();
-  const std::string exe = fs::absolute(o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe") : fs::path(o.omniloc_exe)).string();
-  const std::string rhash = runs_hash(spec);
-  Json sub = read_submission(folder);
+namespace {
 
-  // A results folder belongs to one sweep: runs are found by id, so runs of an edited sweep would
-  // silently mix with the old ones.
-  if (sub.is_object() && sub.value("runs_sha256", "") != rhash)
-    throw ConfigError("-o", "\"" + dir.string() + "\"",
-                      "the results folder of this sweep (its slurm/submission.json was written for other runs: the sweep or a "
-                      "scenario it names changed since; submit into another -o folder)");
-  SlurmSubmission out;
-  out.folder = folder.string();
-  if (o.resubmit_missing) {
-    if (!sub.is_object())
-      throw ConfigError("--resubmit-missing", "\"" + dir.string() + "\"", "a results folder with slurm/submission.json (submit with --slurm first)");
-    out.tasks = sub.value("tasks", 0);
-    if (o.tasks != 0 && o.tasks != out.tasks)
-      throw ConfigError("--tasks", std::to_string(o.tasks), std::to_string(out.tasks) + " (the array size of the first submission: runs are sharded by it)");
-  } else {
-    out.tasks = o.tasks != 0 ? o.tasks : static_cast<int>(std::min<std::size_t>(spec.runs.size(), kDefaultTasks));
-  }
-  if (!o.dry_run && !on_path("sbatch"))
-    throw RuntimeFailure("sbatch is not on PATH: run this on the cluster's login node, or use --dry-run to only write " + folder.string());
+// Where a submission goes and what its scripts run, all absolute.
+struct SubmitPaths {
+  fs::path dir;       ///< the sweep's results folder
+  fs::path folder;    ///< <results>/slurm
+  fs::path spec_abs;  ///< the sweep file
+  std::string exe;    ///< the binary the tasks run
+};
 
-  // Which shards: all of them, or those with runs missing or failed. Refused while anything of an
-  // earlier submission is still queued or running (its runs would look missing and be done twice).
+// N: the first submission's when resubmitting, else --tasks or the default.
+int array_size(const SweepSpec& spec, const SlurmOptions& o, const Json& sub, const fs::path& dir) {
+  if (!o.resubmit_missing) return o.tasks != 0 ? o.tasks : static_cast<int>(std::min<std::size_t>(spec.runs.size(), kDefaultTasks));
+  if (!sub.is_object())
+    throw ConfigError("--resubmit-missing", "\"" + dir.string() + "\"", "a results folder with slurm/submission.json (submit with --slurm first)");
+  const int tasks = sub.value("tasks", 0);
+  if (o.tasks != 0 && o.tasks != tasks)
+    throw ConfigError("--tasks", std::to_string(o.tasks), std::to_string(tasks) + " (the array size of the first submission: runs are sharded by it)");
+  return tasks;
+}
+
+// Which shards: all of them, or those with runs missing or failed. Refused while anything of an
+// earlier submission is still queued or running (its runs would look missing and be done twice).
+std::vector<int> shards_to_submit(const SweepSpec& spec, const SlurmOptions& o, const Json& sub, const fs::path& dir, int tasks) {
+  std::vector<int> shards;
   if (!o.dry_run && sub.is_object()) {
-    const SweepStatus st = sweep_status(spec, dir.string(), out.tasks);
+    const SweepStatus st = sweep_status(spec, dir.string(), tasks);
     if (!st.active_jobs.empty()) {
       std::string ids;
       for (const auto& id : st.active_jobs) ids += (ids.empty() ? "" : " ") + id;
       throw RuntimeFailure("jobs of an earlier submission into " + dir.string() + " are still queued or running (" + ids +
                            "); wait for them (omniloc sweep SPEC --status) or scancel them first");
     }
-    if (o.resubmit_missing) out.shards = st.incomplete_shards();
+    if (o.resubmit_missing) shards = st.incomplete_shards();
   } else if (o.resubmit_missing) {
-    out.shards = sweep_status(spec, dir.string(), out.tasks).incomplete_shards();
+    shards = sweep_status(spec, dir.string(), tasks).incomplete_shards();
   }
   if (!o.resubmit_missing)
-    for (int k = 0; k < out.tasks; ++k) out.shards.push_back(k);
-  if (out.shards.empty()) {
-    out.message = "nothing to resubmit: every run of " + spec.name + " in " + dir.string() + " is done\n";
-    return out;
-  }
+    for (int k = 0; k < tasks; ++k) shards.push_back(k);
+  return shards;
+}
 
-  // The scripts. Options go in #SBATCH lines so that `sbatch array.sbatch` by hand is the same job.
-  const std::string shard_cmd_tail = " --resume -j " + std::to_string(o.cpus_per_task) + " -o " + shq(dir.string());
+// Options go in #SBATCH lines so that `sbatch array.sbatch` by hand is the same job.
+std::string common_header(const SlurmOptions& o, const SubmitPaths& p) {
   // Tasks work in the folder omniloc was called from, whoever submits the scripts and from where:
   // relative paths (results/cache of calibration maps and colour tables) then mean the same thing.
   std::string common = "#SBATCH --chdir=" + fs::current_path().string() + "\n";
   if (!o.partition.empty()) common += "#SBATCH --partition=" + o.partition + "\n";
   if (!o.time_limit.empty()) common += "#SBATCH --time=" + o.time_limit + "\n";
   for (const auto& a : o.sbatch_args) common += "#SBATCH " + a + "\n";
-  const std::string env_sh = (folder / "env.sh").string();
+  const std::string env_sh = (p.folder / "env.sh").string();
   const std::string prologue =
       "set -euo pipefail\n"
       "# Site set-up (module load ..., conda activate ...) goes in env.sh, kept across resubmissions.\n"
       "if [ -f " + shq(env_sh) + " ]; then source " + shq(env_sh) + "; fi\n"
       "echo \"omniloc task on $(hostname) at $(date -u +%FT%TZ): job ${SLURM_JOB_ID:-?}, array task ${SLURM_ARRAY_TASK_ID:-none}\"\n";
-  const std::string array_sbatch =
-      "#!/bin/bash\n"
-      "# omniloc sweep " + spec.name + ": array task I runs every " + std::to_string(out.tasks) + "-th run starting at run I\n"
-      "# (--shard I/N) and skips runs already finished (--resume), so a task killed by scancel, a node\n"
-      "# failure or the time limit loses only the run it was writing, and resubmitting it\n"
-      "# (sbatch --array=2,5 array.sbatch, or omniloc sweep --slurm --resubmit-missing) redoes only the rest.\n"
-      "#SBATCH --job-name=omniloc-" + spec.name + "\n"
-      "#SBATCH --array=0-" + std::to_string(out.tasks - 1) + "\n"
-      "#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n"
-      "#SBATCH --output=" + (folder / "logs" / "task-%A_%a.log").string() + "\n" + common + prologue +
-      "# N is fixed here, not read from SLURM_ARRAY_TASK_COUNT: a resubmitted subset has another count.\n"
-      "N=" + std::to_string(out.tasks) + "\n"
-      "# llvmpipe would start one rendering thread per core of the whole node; the task owns only its\n"
-      "# --cpus-per-task cores, shared by its -j runs (an LP_NUM_THREADS set in env.sh is kept).\n"
-      "export LP_NUM_THREADS=\"${LP_NUM_THREADS:-1}\"\n"
-      "exec " + shq(exe) + " sweep " + shq(spec_abs.string()) + " --shard \"${SLURM_ARRAY_TASK_ID}/${N}\"" + shard_cmd_tail + "\n";
-  const std::string report = (folder / "report.txt").string();
-  const std::string merge_sbatch =
-      "#!/bin/bash\n"
-      "# omniloc sweep " + spec.name + ": after every array task succeeded (afterok), aggregate all runs and\n"
-      "# write the report (the aggregate table and the status per shard) to report.txt. It fails when\n"
-      "# runs are still missing, so an incomplete sweep is never reported as done.\n"
-      "#SBATCH --job-name=omniloc-" + spec.name + "-merge\n"
-      "#SBATCH --cpus-per-task=1\n"
-      "#SBATCH --output=" + (folder / "logs" / "merge-%j.log").string() + "\n" + common + prologue +
-      "tmp=" + shq(report) + ".tmp.$$\n" +
-      shq(exe) + " sweep " + shq(spec_abs.string()) + " --aggregate-only -o " + shq(dir.string()) + " >\"$tmp\"\n"
-      "status=0\n" +
-      shq(exe) + " sweep " + shq(spec_abs.string()) + " --status -o " + shq(dir.string()) + " >>\"$tmp\" || status=$?\n"
-      "mv -f \"$tmp\" " + shq(report) + "\n"
-      "cat " + shq(report) + "\n"
-      "exit $status\n";
+  return common + prologue;
+}
 
-  const std::string submit_array = "sbatch --parsable" + (o.resubmit_missing ? " --array=" + join_ints(out.shards) : std::string()) + " " +
-                                   shq((folder / "array.sbatch").string());
-  const std::string submit_merge = "sbatch --parsable --dependency=afterok:<ARRAY_JOB_ID> --kill-on-invalid-dep=yes " +
-                                   shq((folder / "merge.sbatch").string());
-  std::string commands = "# omniloc sweep " + spec.name + ": " + std::to_string(spec.runs.size()) + " runs in " + std::to_string(out.tasks) +
+std::string shard_command_tail(const SlurmOptions& o, const SubmitPaths& p) {
+  return " --resume -j " + std::to_string(o.cpus_per_task) + " -o " + shq(p.dir.string());
+}
+
+std::string array_script(const SweepSpec& spec, const SlurmOptions& o, const SubmitPaths& p, int tasks) {
+  return "#!/bin/bash\n"
+         "# omniloc sweep " + spec.name + ": array task I runs every " + std::to_string(tasks) + "-th run starting at run I\n"
+         "# (--shard I/N) and skips runs already finished (--resume), so a task killed by scancel, a node\n"
+         "# failure or the time limit loses only the run it was writing, and resubmitting it\n"
+         "# (sbatch --array=2,5 array.sbatch, or omniloc sweep --slurm --resubmit-missing) redoes only the rest.\n"
+         "#SBATCH --job-name=omniloc-" + spec.name + "\n"
+         "#SBATCH --array=0-" + std::to_string(tasks - 1) + "\n"
+         "#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n"
+         "#SBATCH --output=" + (p.folder / "logs" / "task-%A_%a.log").string() + "\n" + common_header(o, p) +
+         "# N is fixed here, not read from SLURM_ARRAY_TASK_COUNT: a resubmitted subset has another count.\n"
+         "N=" + std::to_string(tasks) + "\n"
+         "# llvmpipe would start one rendering thread per core of the whole node; the task owns only its\n"
+         "# --cpus-per-task cores, shared by its -j runs (an LP_NUM_THREADS set in env.sh is kept).\n"
+         "export LP_NUM_THREADS=\"${LP_NUM_THREADS:-1}\"\n"
+         "exec " + shq(p.exe) + " sweep " + shq(p.spec_abs.string()) + " --shard \"${SLURM_ARRAY_TASK_ID}/${N}\"" +
+         shard_command_tail(o, p) + "\n";
+}
+
+std::string merge_script(const SweepSpec& spec, const SlurmOptions& o, const SubmitPaths& p) {
+  const std::string report = (p.folder / "report.txt").string();
+  const std::string sweep = shq(p.exe) + " sweep " + shq(p.spec_abs.string());
+  return "#!/bin/bash\n"
+         "# omniloc sweep " + spec.name + ": after every array task succeeded (afterok), aggregate all runs and\n"
+         "# write the report (the aggregate table and the status per shard) to report.txt. It fails when\n"
+         "# runs are still missing, so an incomplete sweep is never reported as done.\n"
+         "#SBATCH --job-name=omniloc-" + spec.name + "-merge\n"
+         "#SBATCH --cpus-per-task=1\n"
+         "#SBATCH --output=" + (p.folder / "logs" / "merge-%j.log").string() + "\n" + common_header(o, p) +
+         "tmp=" + shq(report) + ".tmp.$$\n" +
+         sweep + " --aggregate-only -o " + shq(p.dir.string()) + " >\"$tmp\"\n"
+         "status=0\n" +
+         sweep + " --status -o " + shq(p.dir.string()) + " >>\"$tmp\" || status=$?\n"
+         "mv -f \"$tmp\" " + shq(report) + "\n"
+         "cat " + shq(report) + "\n"
+         "exit $status\n";
+}
+
+std::string array_submit_command(const SlurmOptions& o, const SubmitPaths& p, const std::vector<int>& shards) {
+  return "sbatch --parsable" + (o.resubmit_missing ? " --array=" + join_ints(shards) : std::string()) + " " +
+         shq((p.folder / "array.sbatch").string());
+}
+
+std::string merge_submit_command(const SubmitPaths& p) {
+  return "sbatch --parsable --dependency=afterok:<ARRAY_JOB_ID> --kill-on-invalid-dep=yes " + shq((p.folder / "merge.sbatch").string());
+}
+
+std::string commands_file(const SweepSpec& spec, const SlurmOptions& o, const SubmitPaths& p, int tasks, const std::vector<int>& shards) {
+  const std::string sweep = shq(p.exe) + " sweep " + shq(p.spec_abs.string());
+  std::string commands = "# omniloc sweep " + spec.name + ": " + std::to_string(spec.runs.size()) + " runs in " + std::to_string(tasks) +
                          " shards, written by omniloc " + build_info().version + " at " + utc_now() + "\n"
                          "# Submit (what omniloc sweep --slurm runs; the merge waits for every array task to succeed and is\n"
                          "# cancelled, not left pending, when one fails):\n" +
-                         submit_array + "\n" + submit_merge + "\n"
+                         array_submit_command(o, p, shards) + "\n" + merge_submit_command(p) + "\n"
                          "# The shards, one command each, for any other engine (each needs the results folder, the binary\n"
                          "# and the data; run them in any order, anywhere, any number at once):\n";
-  for (int k = 0; k < out.tasks; ++k)
-    commands += shq(exe) + " sweep " + shq(spec_abs.string()) + " --shard " + std::to_string(k) + "/" + std::to_string(out.tasks) + shard_cmd_tail + "\n";
-  commands += "# Then, once: aggregate and check\n" + shq(exe) + " sweep " + shq(spec_abs.string()) + " --aggregate-only -o " + shq(dir.string()) +
-              "\n" + shq(exe) + " sweep " + shq(spec_abs.string()) + " --status -o " + shq(dir.string()) + "\n";
+  for (int k = 0; k < tasks; ++k)
+    commands += sweep + " --shard " + std::to_string(k) + "/" + std::to_string(tasks) + shard_command_tail(o, p) + "\n";
+  commands += "# Then, once: aggregate and check\n" + sweep + " --aggregate-only -o " + shq(p.dir.string()) + "\n" + sweep +
+              " --status -o " + shq(p.dir.string()) + "\n";
+  return commands;
+}
 
+// submission.json's description of the sweep and this submission's settings; earlier submissions are kept.
+void describe_submission(Json& sub, const SweepSpec& spec, const SlurmOptions& o, const SubmitPaths& p, const std::string& rhash,
+                         int tasks) {
   std::string spec_bytes;
   try {
-    spec_bytes = read_file(spec_abs.string());
+    spec_bytes = read_file(p.spec_abs.string());
   } catch (const std::exception&) {
   }
   if (!sub.is_object()) sub = Json::object();
   sub["sweep"] = spec.name;
-  sub["spec"] = spec_abs.string();
+  sub["spec"] = p.spec_abs.string();
   sub["spec_sha256"] = sha256_hex(spec_bytes);
   sub["runs_sha256"] = rhash;
   sub["runs"] = spec.runs.size();
-  sub["tasks"] = out.tasks;
-  sub["results"] = dir.string();
+  sub["tasks"] = tasks;
+  sub["results"] = p.dir.string();
   sub["omniloc"] = build_info_json();
-  sub["omniloc_exe"] = exe;
+  sub["omniloc_exe"] = p.exe;
   sub["cpus_per_task"] = o.cpus_per_task;
   sub["partition"] = o.partition;
   sub["time"] = o.time_limit;
   sub["sbatch_args"] = o.sbatch_args;
   if (!sub.contains("submissions")) sub["submissions"] = Json::array();
+}
 
-  fs::create_directories(folder / "logs");
-  write_file_atomic((folder / "array.sbatch").string(), array_sbatch);
-  write_file_atomic((folder / "merge.sbatch").string(), merge_sbatch);
-  write_file_atomic((folder / "commands.txt").string(), commands);
+void write_submission_folder(const SubmitPaths& p, const std::string& array_sbatch, const std::string& merge_sbatch,
+                             const std::string& commands, const Json& sub) {
+  fs::create_directories(p.folder / "logs");
+  write_file_atomic((p.folder / "array.sbatch").string(), array_sbatch);
+  write_file_atomic((p.folder / "merge.sbatch").string(), merge_sbatch);
+  write_file_atomic((p.folder / "commands.txt").string(), commands);
+  const std::string env_sh = (p.folder / "env.sh").string();
   if (!fs::exists(env_sh))
     write_file_atomic(env_sh, "# Sourced by array.sbatch and merge.sbatch before omniloc runs (bash). Site set-up goes here, e.g.\n"
                               "# module load gcc/12 mesa\n");
-  write_file_atomic((folder / "submission.json").string(), sub.dump(2) + "\n");
+  write_file_atomic((p.folder / "submission.json").string(), sub.dump(2) + "\n");
+}
 
-  if (o.dry_run) {
-    out.message = "wrote " + folder.string() + " (dry run, nothing submitted): array.sbatch, merge.sbatch, env.sh, commands.txt, submission.json\n"
-                  "submit with:\n  cd " + shq(folder.string()) + "\n  " + submit_array + "\n  " + submit_merge + "\n";
-    return out;
-  }
-
+// Submits the array and the merge job after it and records both in submission.json. A refused
+// merge job still leaves the array job recorded (it is queued), then throws.
+void submit_jobs(const SlurmOptions& o, const SubmitPaths& p, Json& sub, SlurmSubmission& out) {
   std::vector<std::string> a1 = {"sbatch", "--parsable"};
   if (o.resubmit_missing) a1.push_back("--array=" + join_ints(out.shards));
-  a1.push_back((folder / "array.sbatch").string());
+  a1.push_back((p.folder / "array.sbatch").string());
   out.array_job = parse_job_id(capture(a1), "array job");
   Json record{{"array_job", out.array_job}, {"shards", out.shards}, {"submitted_at", utc_now()},
               {"kind", o.resubmit_missing ? "resubmit-missing" : "full"}};
   std::string merge_error;
   try {
     out.merge_job = parse_job_id(capture({"sbatch", "--parsable", "--dependency=afterok:" + out.array_job, "--kill-on-invalid-dep=yes",
-                                          (folder / "merge.sbatch").string()}),
+                                          (p.folder / "merge.sbatch").string()}),
                                  "merge job");
     record["merge_job"] = out.merge_job;
   } catch (const RuntimeFailure& e) {
     merge_error = e.what();
   }
   sub["submissions"].push_back(record);
-  write_file_atomic((folder / "submission.json").string(), sub.dump(2) + "\n");
+  write_file_atomic((p.folder / "submission.json").string(), sub.dump(2) + "\n");
   if (!merge_error.empty())
-    throw RuntimeFailure(merge_error + " (array job " + out.array_job + " is queued; submit the merge by hand: " + submit_merge + ")");
+    throw RuntimeFailure(merge_error + " (array job " + out.array_job + " is queued; submit the merge by hand: " + merge_submit_command(p) +
+                         ")");
+}
 
+std::string submitted_message(const SweepSpec& spec, const std::string& spec_path, const SlurmOptions& o, const SubmitPaths& p,
+                              const SlurmSubmission& out) {
   std::ostringstream m;
   m << "submitted sweep " << spec.name << " (" << spec.runs.size() << " runs): array job " << out.array_job << " with "
     << out.shards.size() << " of " << out.tasks << " tasks (" << join_ints(out.shards) << "), merge job " << out.merge_job
     << " after it\nfollow with:\n  squeue -j " << out.array_job << "," << out.merge_job << "\n  omniloc sweep " << spec_path
-    << (o.out_dir.empty() ? "" : " -o " + o.out_dir) << " --status\n  tail -f " << (folder / "logs").string() << "/task-" << out.array_job
-    << "_*.log\nreport when done: " << report << "\n";
-  out.message = m.str();
+    << (o.out_dir.empty() ? "" : " -o " + o.out_dir) << " --status\n  tail -f " << (p.folder / "logs").string() << "/task-" << out.array_job
+    << "_*.log\nreport when done: " << (p.folder / "report.txt").string() << "\n";
+  return m.str();
+}
+
+}  // namespace
+
+SlurmSubmission submit_slurm(const SweepSpec& spec, const std::string& spec_path, const SlurmOptions& o) {
+  check_slurm_options(spec, o);
+  SubmitPaths p;
+  p.dir = results_dir(spec, o.out_dir);
+  p.folder = p.dir / "slurm";
+  p.spec_abs = fs::absolute(spec_path).lexically_normal();
+  p.exe = fs::absolute(o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe") : fs::path(o.omniloc_exe)).string();
+  const std::string rhash = runs_hash(spec);
+  Json sub = read_submission(p.folder);
+
+  // A results folder belongs to one sweep: runs are found by id, so runs of an edited sweep would
+  // silently mix with the old ones.
+  if (sub.is_object() && sub.value("runs_sha256", "") != rhash)
+    throw ConfigError("-o", "\"" + p.dir.string() + "\"",
+                      "the results folder of this sweep (its slurm/submission.json was written for other runs: the sweep or a "
+                      "scenario it names changed since; submit into another -o folder)");
+  SlurmSubmission out;
+  out.folder = p.folder.string();
+  out.tasks = array_size(spec, o, sub, p.dir);
+  if (!o.dry_run && !on_path("sbatch"))
+    throw RuntimeFailure("sbatch is not on PATH: run this on the cluster's login node, or use --dry-run to only write " + p.folder.string());
+  out.shards = shards_to_submit(spec, o, sub, p.dir, out.tasks);
+  if (out.shards.empty()) {
+    out.message = "nothing to resubmit: every run of " + spec.name + " in " + p.dir.string() + " is done\n";
+    return out;
+  }
+
+  const std::string array_sbatch = array_script(spec, o, p, out.tasks);
+  const std::string merge_sbatch = merge_script(spec, o, p);
+  const std::string commands = commands_file(spec, o, p, out.tasks, out.shards);
+  describe_submission(sub, spec, o, p, rhash, out.tasks);
+  write_submission_folder(p, array_sbatch, merge_sbatch, commands, sub);
+  if (o.dry_run) {
+    out.message = "wrote " + p.folder.string() + " (dry run, nothing submitted): array.sbatch, merge.sbatch, env.sh, commands.txt, submission.json\n"
+                  "submit with:\n  cd " + shq(p.folder.string()) + "\n  " + array_submit_command(o, p, out.shards) + "\n  " +
+                  merge_submit_command(p) + "\n";
+    return out;
+  }
+  submit_jobs(o, p, sub, out);
+  out.message = submitted_message(spec, spec_path, o, p, out);
   return out;
 }
 
