@@ -19,7 +19,7 @@
 #include "core/json_parse.hpp"
 #include "core/field.hpp"
 #include "core/version.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/render_frame.hpp"
 #include "harness/runner.hpp"

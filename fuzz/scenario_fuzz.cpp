@@ -13,7 +13,7 @@
 #include <string>
 
 #include "core/json_parse.hpp"
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 

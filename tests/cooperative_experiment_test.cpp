@@ -1,5 +1,5 @@
 // The team radio network (sim/network.hpp) and the paper-001 simulation experiment
-// (harness/experiments/cooperative_001.*, scenarios/experiments/cooperative_001.json).
+// (experiments/cooperative_001.*, scenarios/experiments/cooperative_001.json).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -15,7 +15,7 @@
 #include "core/error.hpp"
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 #include "sim/network.hpp"
 
 using namespace omniloc;

@@ -1,4 +1,4 @@
-// The rendered-image mode of the paper-001 simulation (harness/experiments/cooperative_001_rendered.*):
+// The rendered-image mode of the paper-001 simulation (experiments/cooperative_001_rendered.*):
 // the ball measured in a rendered panorama, and the determinism of the mode under a seed.
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 #include "harness/vision_setup.hpp"
 #include "localization/vision/blobs.hpp"
 #include "sim/render/panoramic_camera.hpp"

@@ -13,7 +13,7 @@
 #include "core/angles.hpp"
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 #include "localization/landmarks/landmark_groups.hpp"
 
 using namespace omniloc;

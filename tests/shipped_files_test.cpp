@@ -8,7 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/json_reader.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 

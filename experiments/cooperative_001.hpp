@@ -15,8 +15,8 @@
 
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "harness/experiment.hpp"
-#include "harness/experiments/cooperative_001_rendered.hpp"
+#include "experiments/experiment.hpp"
+#include "experiments/cooperative_001_rendered.hpp"
 #include "localization/cooperative/ball_trackers.hpp"
 #include "sim/network.hpp"
 

@@ -1,4 +1,4 @@
-#include "harness/experiments/error_budget.hpp"
+#include "experiments/error_budget.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -12,7 +12,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
-#include "harness/experiments/text_format.hpp"
+#include "experiments/text_format.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"

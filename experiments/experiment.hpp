@@ -29,7 +29,7 @@ struct ExperimentInfo {
   std::function<void(const std::string& file)> validate = {};
 };
 
-/// All experiments (harness/experiment_registry.cpp holds the list).
+/// All experiments (experiments/experiment_registry.cpp holds the list).
 const std::vector<ExperimentInfo>& experiments();
 
 }  // namespace omniloc::harness

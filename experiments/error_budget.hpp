@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/json_reader.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 
 namespace omniloc::harness {
 

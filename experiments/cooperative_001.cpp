@@ -1,5 +1,5 @@
 // Experiment "cooperative_001": paper 001's simulation. See cooperative_001.hpp and docs/cooperative.md.
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 
 #include "core/json_parse.hpp"
 
@@ -19,7 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/rng.hpp"
-#include "harness/experiments/text_format.hpp"
+#include "experiments/text_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
 #include "harness/run_directory.hpp"

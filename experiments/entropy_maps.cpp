@@ -1,4 +1,4 @@
-#include "harness/experiments/entropy_maps.hpp"
+#include "experiments/entropy_maps.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
 #pragma once
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 
 namespace omniloc::harness {
 

@@ -1,9 +1,9 @@
-#include "harness/experiment.hpp"
-#include "harness/experiments/cooperative_001.hpp"
-#include "harness/experiments/entropy_maps.hpp"
-#include "harness/experiments/error_budget.hpp"
-#include "harness/experiments/global_figures.hpp"
-#include "harness/experiments/landmark_maps.hpp"
+#include "experiments/experiment.hpp"
+#include "experiments/cooperative_001.hpp"
+#include "experiments/entropy_maps.hpp"
+#include "experiments/error_budget.hpp"
+#include "experiments/global_figures.hpp"
+#include "experiments/landmark_maps.hpp"
 
 // Add an experiment: include its header and append one line to the list below.
 

@@ -1,6 +1,6 @@
 // Rendered-image mode of the paper-001 simulation. See cooperative_001_rendered.hpp and
 // docs/cooperative.md ("Rendered mode").
-#include "harness/experiments/cooperative_001_rendered.hpp"
+#include "experiments/cooperative_001_rendered.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -13,8 +13,8 @@
 #include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
-#include "harness/experiments/cooperative_001.hpp"
-#include "harness/experiments/text_format.hpp"
+#include "experiments/cooperative_001.hpp"
+#include "experiments/text_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/plot.hpp"

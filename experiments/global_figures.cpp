@@ -1,4 +1,4 @@
-#include "harness/experiments/global_figures.hpp"
+#include "experiments/global_figures.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "harness/experiments/landmark_maps.hpp"
+#include "experiments/landmark_maps.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 #include "core/atomic_file.hpp"
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "harness/experiments/text_format.hpp"
+#include "experiments/text_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
 #include "harness/run_directory.hpp"
