@@ -26,7 +26,12 @@
 #include "localization/cooperative/ball_trackers.hpp"
 #include "localization/cooperative/hough_ball.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
+
+using harness::RunDirectory;
+using harness::Series;
+using harness::line_plot;
+using harness::png_bytes;
 
 const char* to_string(CoopNoiseModel m) {
   switch (m) {
@@ -797,4 +802,4 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   return 0;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

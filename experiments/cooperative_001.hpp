@@ -20,7 +20,7 @@
 #include "localization/cooperative/ball_trackers.hpp"
 #include "sim/network.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 /// Where each robot's observation noise enters (the paper only says "Gaussian noise, 192 mm").
 enum class CoopNoiseModel {
@@ -95,4 +95,4 @@ Rng cooperative_trial_rng(std::uint64_t seed, const std::string& name, int t);
 
 int run_cooperative_001(const ExperimentArgs& args, std::ostream& out);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

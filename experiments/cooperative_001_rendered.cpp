@@ -27,7 +27,18 @@
 #include "localization/vision/scan_lines.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
+
+using harness::CameraPerception;
+using harness::LocalizerContext;
+using harness::RunDirectory;
+using harness::Series;
+using harness::VisionConfig;
+using harness::camera_tag;
+using harness::line_plot;
+using harness::localizer_info;
+using harness::make_localizer;
+using harness::png_bytes;
 
 const char* to_string(CoopPoseSource s) { return s == CoopPoseSource::Matching ? "matching" : "noisy_truth"; }
 
@@ -697,4 +708,4 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
   return j;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

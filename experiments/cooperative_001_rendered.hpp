@@ -26,8 +26,11 @@
 #include "sim/render/camera_config.hpp"
 
 namespace omniloc::harness {
-
 class RunDirectory;
+}
+
+namespace omniloc::experiments {
+
 struct Cooperative001Config;
 
 /// Where each robot's own pose (the start of its line L_i) comes from.
@@ -91,7 +94,7 @@ RenderedBallSighting ball_sighting_from_blobs(const std::vector<Blob>& blobs, in
 /// Runs the rendered mode (c.rendered must be set) with `trials` path runs, appends its markdown
 /// section to `md`, writes robots_vs_error_rendered.{csv,png} into `dir` and returns every number
 /// as JSON (key "rendered" of cooperative_001.json). `progress`: optional one-line status stream.
-Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::uint64_t seed, std::ostream& md, RunDirectory& dir,
+Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::uint64_t seed, std::ostream& md, harness::RunDirectory& dir,
                               std::ostream* progress = nullptr);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

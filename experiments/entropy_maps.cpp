@@ -17,7 +17,18 @@
 #include "localization/vision/exposure_control.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
+
+using harness::CameraPerception;
+using harness::RunDirectory;
+using harness::Scenario;
+using harness::Series;
+using harness::VisionConfig;
+using harness::heat_map;
+using harness::line_plot;
+using harness::load_scenario;
+using harness::png_bytes;
+using harness::world_at;
 
 namespace {
 
@@ -145,4 +156,4 @@ int run_entropy_maps(const ExperimentArgs& args, std::ostream& out) {
   return 0;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

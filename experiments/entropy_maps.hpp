@@ -1,7 +1,7 @@
 #pragma once
 #include "experiments/experiment.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 /// "entropy_maps": image entropy over (exposure, gain) for normal light and strong sun (paper 002
 /// figures 6 and 11c) with the auto-adjust search path drawn on it, the entropy along the search line
@@ -9,4 +9,4 @@ namespace omniloc::harness {
 /// pose of scenarios/paper/lighting_002*.json.
 int run_entropy_maps(const ExperimentArgs& args, std::ostream& out);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

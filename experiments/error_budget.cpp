@@ -17,7 +17,15 @@
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
+
+using harness::RunDirectory;
+using harness::SweepOptions;
+using harness::SweepOutcome;
+using harness::SweepSpec;
+using harness::load_sweep;
+using harness::parse_scenario;
+using harness::run_sweep;
 
 namespace fs = std::filesystem;
 
@@ -219,4 +227,4 @@ int run_error_budget(const ExperimentArgs& args, std::ostream& out) {
   return so.failed > 0 ? 1 : 0;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

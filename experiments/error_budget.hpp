@@ -9,7 +9,7 @@
 #include "core/json_reader.hpp"
 #include "experiments/experiment.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 struct ErrorSource {
   std::string name;
@@ -33,4 +33,4 @@ ErrorBudgetConfig load_error_budget(const std::string& file);
 void validate_error_budget(const std::string& file);
 int run_error_budget(const ExperimentArgs& args, std::ostream& out);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 struct ExperimentArgs {
   std::uint64_t seed = 1;
@@ -30,6 +30,6 @@ struct ExperimentInfo {
 };
 
 /// All experiments (experiments/experiment_registry.cpp holds the list).
-const std::vector<ExperimentInfo>& experiments();
+const std::vector<ExperimentInfo>& all();
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

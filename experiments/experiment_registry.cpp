@@ -7,9 +7,9 @@
 
 // Add an experiment: include its header and append one line to the list below.
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
-const std::vector<ExperimentInfo>& experiments() {
+const std::vector<ExperimentInfo>& all() {
   static const std::vector<ExperimentInfo> list = {
       {"entropy_maps", "paper 002 figures 6, 10, 11: image entropy over (exposure, gain) under normal light and sun, the auto-adjust search path, frames before / after", run_entropy_maps},
       {"global_figures", "paper 000 figures 7 and 9 (grid-sample errors, RPROP traces) and an MCL particle-cloud sequence", run_global_figures},
@@ -26,4 +26,4 @@ const std::vector<ExperimentInfo>& experiments() {
   return list;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

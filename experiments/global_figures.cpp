@@ -16,7 +16,20 @@
 #include "localization/grid_global.hpp"
 #include "localization/mcl.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
+
+using harness::CameraPerception;
+using harness::Event;
+using harness::FieldPicture;
+using harness::FrameConditions;
+using harness::PerceptionOutput;
+using harness::RunDirectory;
+using harness::Scenario;
+using harness::Series;
+using harness::line_plot;
+using harness::load_scenario;
+using harness::png_bytes;
+using harness::world_at;
 
 namespace {
 std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
@@ -156,4 +169,4 @@ int run_global_figures(const ExperimentArgs& args, std::ostream& out) {
   return 0;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

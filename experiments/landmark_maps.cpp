@@ -20,7 +20,13 @@
 #include "localization/landmarks/landmark_groups.hpp"
 #include "localization/landmarks/landmark_solvers.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
+
+using harness::RunDirectory;
+using harness::Series;
+using harness::heat_map;
+using harness::line_plot;
+using harness::png_bytes;
 
 namespace {
 
@@ -677,4 +683,4 @@ int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
   return 0;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

@@ -1,7 +1,7 @@
 #pragma once
 #include "experiments/experiment.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 /// "landmark_maps": accuracy of the landmark solvers (docs/landmarks.md, "Experiment landmark_maps").
 ///  (a) Paper 004's field (600 cm x 400 cm, the four goal posts as landmarks, the paper's frame): for each
@@ -15,4 +15,4 @@ namespace omniloc::harness {
 /// --quick: coarse grid, few trials, short paths (well under 20 s).
 int run_landmark_maps(const ExperimentArgs& args, std::ostream& out);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

@@ -5,7 +5,7 @@
 #include <string>
 #include <thread>
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 /// `f` with `a...` as std::snprintf would print them, cut at 511 characters.
 template <class... A>
@@ -27,4 +27,4 @@ inline std::string machine_text() {
   return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments
