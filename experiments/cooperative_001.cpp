@@ -19,7 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/rng.hpp"
-#include "experiments/text_format.hpp"
+#include "experiments/report_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
 #include "harness/run_directory.hpp"
@@ -328,23 +328,10 @@ Trial run_trial(const Cooperative001Config& c, CoopNoiseModel model, double ref_
 
 bool usable(const BallFix& f) { return f.status != BallFix::Status::NoObservation; }
 
-/// Running mean / variance (Welford) of per-trial values, plus pooled sums.
-struct Stat {
-  double n = 0, mean = 0, m2 = 0;
-  void add(double x) {
-    n += 1;
-    const double d = x - mean;
-    mean += d / n;
-    m2 += d * (x - mean);
-  }
-  double sd() const { return n > 1 ? std::sqrt(m2 / (n - 1)) : 0.0; }
-  double se() const { return n > 1 ? sd() / std::sqrt(n) : 0.0; }
-};
-
 /// Pooled error statistics over all fixes of many trials.
 struct ErrorAcc {
   double sum = 0, sumsq = 0, count = 0;
-  Stat per_trial;  ///< of the per-trial mean errors
+  RunningStat per_trial;  ///< of the per-trial mean errors
   void add_trial(double s, double s2, double n) {
     sum += s;
     sumsq += s2;
@@ -360,7 +347,7 @@ struct PathStats {
   std::vector<ErrorAcc> own;   ///< per robot
   ErrorAcc equal, weighted;    ///< at the stamp
   ErrorAcc weighted_at_use;    ///< weighted fix against the ball when the fix was made
-  Stat diff;                   ///< per trial: weighted mean - equal mean
+  RunningStat diff;                   ///< per trial: weighted mean - equal mean
   std::map<std::string, double> status_equal, status_weighted;
   double sent = 0, lost = 0, late = 0, age_sum = 0, age_n = 0, received_sum = 0;
   int trials = 0;
@@ -430,23 +417,6 @@ PathStats run_path(const Cooperative001Config& c, CoopNoiseModel model, const si
   return s;
 }
 
-Json read_published() {
-  std::ifstream in(std::string(OMNILOC_SOURCE_DIR) + "/results/reference/papers.json");
-  if (!in) return Json::object();
-  try {
-    return Json::parse(in);
-  } catch (const Json::parse_error&) {
-    return Json::object();
-  }
-}
-
-double published(const Json& p, const char* group, const char* key) {
-  if (p.contains(group) && p[group].contains(key) && p[group][key].is_number()) return p[group][key].get<double>();
-  return std::nan("");
-}
-
-std::string mm(double m_value, int prec = 1) { return std::isnan(m_value) ? "n/a" : strprintf("%.*f", prec, 1000.0 * m_value); }
-
 cv::Mat field_figure(const Cooperative001Config& c, const Trial& tr) {
   const double s = 110.0;  // px per metre
   const int m = 30;
@@ -481,8 +451,8 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   const std::uint64_t seed = args.seed;
   const double ref = c.reference_distance_or_mean();
   const Json paper = read_published();
-  const double p_equal = published(paper, "001_cooperative_mean_error_mm", "equal_weights") / 1000.0;
-  const double p_weighted = published(paper, "001_cooperative_mean_error_mm", "weighted") / 1000.0;
+  const double p_equal = published_number(paper, "001_cooperative_mean_error_mm", "equal_weights") / 1000.0;
+  const double p_weighted = published_number(paper, "001_cooperative_mean_error_mm", "weighted") / 1000.0;
   RunDirectory dir(args.out_dir);
   std::ostringstream md;  // the markdown report, also printed
 
@@ -512,7 +482,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
      << "| Hough fix, K_i = 1/L_i | " << mm(head.weighted.mean()) << " | " << mm(head.weighted.per_trial.sd()) << " | " << mm(p_weighted, 0) << " |\n"
      << "| paired difference 1/L - equal (mean +- s.e.) | " << mm(head.diff.mean) << " +- " << mm(head.diff.se()) << " | "
      << mm(head.diff.sd()) << " | " << mm(p_weighted - p_equal, 0) << " |\n\n";
-  const double real_before = published(paper, "001_real_mean_error_cm", "before"), real_after = published(paper, "001_real_mean_error_cm", "after");
+  const double real_before = published_number(paper, "001_real_mean_error_cm", "before"), real_after = published_number(paper, "001_real_mean_error_cm", "after");
   if (!std::isnan(real_before))
     md << strprintf("Paper's real-robot result (not simulated here): mean error %.1f cm -> %.1f cm. ", real_before, real_after)
        << "The paper does not say where its simulated noise enters; the next table runs the same draws through three readings.\n\n";
@@ -555,7 +525,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
 
   // 3. Error against the number of robots (paper fig. 10): every subset of each size, per_subset trials each.
   const int nr = static_cast<int>(c.robots.size());
-  std::vector<Stat> eq_all(static_cast<std::size_t>(nr) + 1), w_all(static_cast<std::size_t>(nr) + 1);
+  std::vector<RunningStat> eq_all(static_cast<std::size_t>(nr) + 1), w_all(static_cast<std::size_t>(nr) + 1);
   std::vector<double> eq_first(static_cast<std::size_t>(nr) + 1), w_first(static_cast<std::size_t>(nr) + 1);
   std::vector<double> degenerate(static_cast<std::size_t>(nr) + 1), fixes_k(static_cast<std::size_t>(nr) + 1);
   std::vector<int> subsets_k(static_cast<std::size_t>(nr) + 1);
@@ -633,7 +603,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
   md << "## Growth-model benchmark (paper 5.3), " << n.growth_model << " paired Monte Carlo runs, 50 steps, 100 particles, N_th = 50\n\n"
      << "| filter | mean RMSE | std | median |\n|---|---|---|---|\n";
   for (int k = 0; k < 3; ++k) {
-    Stat st;
+    RunningStat st;
     for (double v : rm[k]) st.add(v);
     std::vector<double> sorted = rm[k];
     std::sort(sorted.begin(), sorted.end());
@@ -643,7 +613,7 @@ int run_cooperative_001(const ExperimentArgs& args, std::ostream& out) {
     growth_json[to_string(kinds[k])] = {{"mean", st.mean}, {"std", st.sd()}, {"median", med}};
   }
   auto paired = [&](int a, int b) {
-    Stat d;
+    RunningStat d;
     int lower = 0;
     for (std::size_t i = 0; i < rm[a].size(); ++i) {
       d.add(rm[a][i] - rm[b][i]);

@@ -14,7 +14,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "experiments/cooperative_001.hpp"
-#include "experiments/text_format.hpp"
+#include "experiments/report_format.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/plot.hpp"
@@ -144,36 +144,6 @@ RenderedBallSighting ball_sighting_from_blobs(const std::vector<Blob>& blobs, in
 
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  const std::size_t h = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h), v.end());
-  const double hi = v[h];
-  if (v.size() % 2) return hi;
-  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(h)));
-}
-
-double mean(const std::vector<double>& v) {
-  if (v.empty()) return std::nan("");
-  double s = 0;
-  for (double x : v) s += x;
-  return s / static_cast<double>(v.size());
-}
-
-/// Sample standard deviation; undefined (NaN, "n/a" in the report) below two values.
-double sd(const std::vector<double>& v) {
-  if (v.size() < 2) return std::nan("");
-  const double m = mean(v);
-  double s = 0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / static_cast<double>(v.size() - 1));
-}
-
-/// Json cannot hold NaN: undefined figures (e.g. an empty distance bin) become null.
-Json num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-std::string mm(double m_value, int prec = 1) { return std::isfinite(m_value) ? strprintf("%.*f", prec, 1000.0 * m_value) : std::string("n/a"); }
-std::string deg(double rad, int prec = 2) { return std::isfinite(rad) ? strprintf("%.*f", prec, rad * 180.0 / kPi) : std::string("n/a"); }
-
 /// Ground truth for the report only: is the ball (partly) behind another robot as seen by `obs`?
 /// 0 = clear, 1 = partly (the robot's footprint disc overlaps the ball's angular extent), 2 = fully.
 int occlusion_class(const std::vector<Eigen::Vector2d>& robots, std::size_t obs, const Eigen::Vector2d& ball, double robot_r, double ball_r) {
@@ -229,8 +199,8 @@ struct FixAcc {
 };
 
 Json fix_json(const FixAcc& a) {
-  return Json{{"mean_mm", num(1000 * mean(a.errors))},         {"median_mm", num(1000 * median(a.errors))},
-              {"per_trial_std_mm", num(1000 * sd(a.per_trial))}, {"steps", a.steps},
+  return Json{{"mean_mm", json_number(1000 * mean(a.errors))},         {"median_mm", json_number(1000 * median(a.errors))},
+              {"per_trial_std_mm", json_number(1000 * sd(a.per_trial))}, {"steps", a.steps},
               {"no_fix", a.no_fix},                              {"degenerate", a.degenerate},
               {"single_robot", a.single}};
 }
@@ -536,7 +506,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
           }
         }
         track_mean[in][tk] = n > 0 ? sum / n : std::nan("");
-        track_json[trackers[tk]][tin[in].name] = num(1000 * track_mean[in][tk]);
+        track_json[trackers[tk]][tin[in].name] = json_number(1000 * track_mean[in][tk]);
       }
 
   // 5. Report.
@@ -612,9 +582,9 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
     bins_json.push_back({{"bin", bin_names[b]},
                          {"sightings", bin_total[b]},
                          {"missed", bin_missed[b]},
-                         {"median_abs_distance_error_mm", num(1000 * median(bin_d_abs[bu]))},
-                         {"median_signed_distance_error_mm", num(1000 * median(bin_d_err[bu]))},
-                         {"median_abs_bearing_error_deg", num(median(bin_b_abs[bu]) * 180.0 / kPi)}});
+                         {"median_abs_distance_error_mm", json_number(1000 * median(bin_d_abs[bu]))},
+                         {"median_signed_distance_error_mm", json_number(1000 * median(bin_d_err[bu]))},
+                         {"median_abs_bearing_error_deg", json_number(median(bin_b_abs[bu]) * 180.0 / kPi)}});
   }
   md << "| all | " << n_sightings << " | " << n_sightings - n_usable << " | " << mm(median(d_abs)) << " | " << mm(median(d_err)) << " | "
      << deg(median(b_abs)) << " |\n\n"
@@ -636,7 +606,7 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
     s_w.x.push_back(static_cast<double>(k));
     s_eq.y.push_back(1000 * e);
     s_w.y.push_back(1000 * w);
-    robots_json.push_back({{"robots", k}, {"equal_mm", num(1000 * e)}, {"weighted_mm", num(1000 * w)}, {"weighted_median_mm", num(1000 * med)}, {"no_fix_fraction", nf}});
+    robots_json.push_back({{"robots", k}, {"equal_mm", json_number(1000 * e)}, {"weighted_mm", json_number(1000 * w)}, {"weighted_median_mm", json_number(1000 * med)}, {"no_fix_fraction", nf}});
   }
   md << "\n";
   dir.write("robots_vs_error_rendered.csv", csv);
@@ -661,19 +631,19 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
          {"camera", g.camera.to_json()},
          {"pose_source", to_string(g.pose_source)},
          {"min_area_px", g.min_area_px},
-         {"own_estimate", {{"mean_mm", num(1000 * mean(own_err))}, {"median_mm", num(1000 * median(own_err))}}},
+         {"own_estimate", {{"mean_mm", json_number(1000 * mean(own_err))}, {"median_mm", json_number(1000 * median(own_err))}}},
          {"equal", fix_json(f_eq)},
          {"weighted", fix_json(f_w)},
          {"equal_true_poses", fix_json(f_eq_true)},
          {"weighted_true_poses", fix_json(f_w_true)},
-         {"weighted_minus_equal_mm", num(1000 * mean(diff_per_trial))},
-         {"weighted_minus_equal_no_selfloc_failure_mm", num(1000 * mean(diff_ok))},
+         {"weighted_minus_equal_mm", json_number(1000 * mean(diff_per_trial))},
+         {"weighted_minus_equal_no_selfloc_failure_mm", json_number(1000 * mean(diff_ok))},
          {"self_localisation",
-          {{"position_error_mean_mm", num(1000 * mean(pos_err))},
-           {"position_error_median_mm", num(1000 * median(pos_err))},
-           {"heading_error_mean_deg", num(mean(head_err) * 180.0 / kPi)},
-           {"position_error_max_mm", num(pos_err.empty() ? std::nan("") : 1000 * *std::max_element(pos_err.begin(), pos_err.end()))},
-           {"start_error_mm", num(1000 * mean(start_pos_err))},
+          {{"position_error_mean_mm", json_number(1000 * mean(pos_err))},
+           {"position_error_median_mm", json_number(1000 * median(pos_err))},
+           {"heading_error_mean_deg", json_number(mean(head_err) * 180.0 / kPi)},
+           {"position_error_max_mm", json_number(pos_err.empty() ? std::nan("") : 1000 * *std::max_element(pos_err.begin(), pos_err.end()))},
+           {"start_error_mm", json_number(1000 * mean(start_pos_err))},
            {"failures_over_100_mm", failures}}},
          {"trials_without_selfloc_failure", trials_ok},
          {"equal_no_selfloc_failure", fix_json(f_eq_ok)},
@@ -689,16 +659,16 @@ Json run_cooperative_rendered(const Cooperative001Config& c, int trials, std::ui
            {"seen_without_distance", n_no_distance},
            {"partly_occluded_total", partial_total},
            {"partly_occluded_used", seen_partial},
-           {"partly_occluded_median_abs_distance_error_mm", num(1000 * median(part_d_abs))},
-           {"partly_occluded_median_abs_bearing_error_deg", num(median(part_b_abs) * 180.0 / kPi)},
+           {"partly_occluded_median_abs_distance_error_mm", json_number(1000 * median(part_d_abs))},
+           {"partly_occluded_median_abs_bearing_error_deg", json_number(median(part_b_abs) * 180.0 / kPi)},
            {"multiple_regions", n_multi},
            {"outliers_over_0_5_m", n_outlier},
            {"missed_per_robot", missed_robot}}},
          {"distance_error",
-          {{"median_abs_mm", num(1000 * median(d_abs))},
-           {"median_signed_mm", num(1000 * median(d_err))},
-           {"median_signed_uncorrected_mm", num(1000 * median(c_err))}}},
-         {"bearing_error_median_abs_deg", num(median(b_abs) * 180.0 / kPi)},
+          {{"median_abs_mm", json_number(1000 * median(d_abs))},
+           {"median_signed_mm", json_number(1000 * median(d_err))},
+           {"median_signed_uncorrected_mm", json_number(1000 * median(c_err))}}},
+         {"bearing_error_median_abs_deg", json_number(median(b_abs) * 180.0 / kPi)},
          {"by_distance", bins_json},
          {"robots_vs_error", robots_json},
          {"tracking", track_json},
