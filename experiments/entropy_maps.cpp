@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "experiments/report_format.hpp"
 #include "harness/camera_perception.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
@@ -30,6 +31,115 @@ using harness::load_scenario;
 using harness::png_bytes;
 using harness::world_at;
 
+// --- configuration --------------------------------------------------------------------------------------
+
+int EntropyMapsConfig::grid_size() const { return static_cast<int>(std::floor((hi - lo) / step + 1e-9)) + 1; }
+
+EntropyMapsConfig EntropyMapsConfig::from_args(const ExperimentArgs& args) {
+  const std::string dir = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/";
+  EntropyMapsConfig c;
+  c.cases = {{"normal", dir + "lighting_002.json"}, {"sun", dir + "lighting_002_sun.json"}};
+  c.step = args.quick ? 6.0 : 2.0;
+  c.line_step = args.quick ? 2.0 : 1.0;
+  c.cell_px = args.quick ? 36 : 20;
+  c.seed = args.seed;
+  c.quick = args.quick;
+  return c;
+}
+
+// --- computation ----------------------------------------------------------------------------------------
+
+namespace {
+
+/// Renders one case's scene at given settings, each frame with its own numbered noise stream.
+struct CaseCamera {
+  sim::PanoramicCamera& cam;
+  sim::WorldState ws;
+  int robot;
+  std::uint64_t seed;
+  const CalibrationMap& map;
+  std::uint64_t k = 0;  ///< frames rendered so far (the next frame's stream number)
+  Image render(const CameraSettings& s) {
+    Rng rng = Rng::stream(seed, "entropy/" + std::to_string(k++));
+    return cam.render(ws, robot, s, rng);
+  }
+  double entropy(const Image& img) const { return image_entropy(img, map.centre(), map.max_radius()); }
+};
+
+/// Entropy over the (exposure, gain) grid and along the search line exposure = gain (a = 1, b = 0).
+void entropy_grid_and_line(const EntropyMapsConfig& cfg, CaseCamera& cc, EntropyCase& r) {
+  const int n = cfg.grid_size();
+  r.grid.assign(static_cast<std::size_t>(n) * n, 0.0);
+  for (int gi = 0; gi < n; ++gi)
+    for (int ei = 0; ei < n; ++ei) {
+      const CameraSettings s{cfg.lo + ei * cfg.step, cfg.lo + (n - 1 - gi) * cfg.step};
+      const double h = cc.entropy(cc.render(s));
+      r.grid[static_cast<std::size_t>(gi) * n + ei] = h;
+      if (h > r.grid_best) r.grid_best = h, r.grid_best_exposure = s.exposure_ms, r.grid_best_gain = s.gain;
+    }
+  for (double g = 2.0; g <= 40.0 + 1e-9; g += cfg.line_step) {
+    const double h = cc.entropy(cc.render({g, g}));
+    r.line_gain.push_back(g);
+    r.line_entropy.push_back(h);
+    if (h > r.line_best) r.line_best = h, r.line_best_gain = g;
+  }
+}
+
+/// The controller on this scene: settled under normal light at the initial setting, then this case's light.
+void adjust_exposure(CameraPerception& rig, const CameraSettings& initial, const sim::Lighting& normal_light, CaseCamera& cc, EntropyCase& r) {
+  ExposureParams ep = rig.exposure_params();
+  ep.enabled = true;
+  ep.search_at_start = false;  // settled under normal light first; the change of light triggers the search
+  ExposureController ctl(ep, initial);
+  const sim::Lighting target = cc.ws.lighting;
+  const CalibrationMap& map = cc.map;
+  for (int f = 0; f < 200; ++f) {
+    cc.ws.lighting = f < 3 ? normal_light : target;
+    const Image img = cc.render(ctl.current());
+    const double body = centre_brightness(img, map.centre(), 0.8 * map.min_radius());
+    const double h = ctl.wants_entropy() ? cc.entropy(img) : -1.0;
+    const ExposureDecision d = ctl.update(f / 30.0, body, h);
+    if (d.event && d.event->rfind("search_end", 0) == 0) {
+      r.search_end = *d.event;
+      break;
+    }
+  }
+  cc.ws.lighting = target;
+  r.search_path = ctl.path();
+  r.adjusted = ctl.current();
+  r.after = cc.render(ctl.current());
+}
+
+}  // namespace
+
+EntropyMapsResult compute_entropy_maps(const EntropyMapsConfig& cfg) {
+  std::vector<std::pair<std::string, Scenario>> cases;
+  for (const auto& [name, file] : cfg.cases) cases.emplace_back(name, load_scenario(file));
+  const Scenario& base = cases[0].second;
+  const sim::CameraConfig camera = sim::CameraConfig::from_json(base.camera, "/camera");
+  const VisionConfig vc = VisionConfig::from_json(base.vision, "/vision");
+  CameraPerception rig(camera, base.field, vc, cfg.seed);
+  const int robot = base.localized_robots().front();
+  EntropyMapsResult result;
+  for (const auto& [name, sc] : cases) {
+    EntropyCase r;
+    r.name = name;
+    CaseCamera cc{rig.camera(), world_at(sc, 0.0, cfg.seed), robot, cfg.seed, rig.calibration()};
+    entropy_grid_and_line(cfg, cc, r);
+    r.before = [&] {
+      Rng rng = Rng::stream(cfg.seed, "before");
+      return cc.cam.render(cc.ws, robot, camera.initial, rng);
+    }();
+    adjust_exposure(rig, camera.initial, base.lighting_at(0.0), cc, r);
+    r.points_before = rig.detector().detect(r.before).points.size();
+    r.points_after = rig.detector().detect(r.after).points.size();
+    result.cases.push_back(std::move(r));
+  }
+  return result;
+}
+
+// --- report ---------------------------------------------------------------------------------------------
+
 namespace {
 
 cv::Mat bgr_of(const Image& img) {
@@ -38,121 +148,67 @@ cv::Mat bgr_of(const Image& img) {
   return bgr;
 }
 
-struct Case {
-  std::string name;
-  Scenario sc;
-};
+/// The entropy heat map with the search path (on the exposure = gain line) and the adjusted setting.
+cv::Mat search_figure(const EntropyMapsConfig& cfg, const EntropyCase& c) {
+  const int n = cfg.grid_size();
+  const double lo = cfg.lo, hi = cfg.hi, step = cfg.step;
+  cv::Mat hm = heat_map(c.grid, n, n, lo, hi, hi, lo, "entropy (nats), " + c.name + " light", "exposure ms", "gain", cfg.cell_px);
+  const int cell = cfg.cell_px, l = 70, t = 36;
+  auto px = [&](double e, double g) {
+    return cv::Point(static_cast<int>(l + ((e - lo) / step + 0.5) * cell), static_cast<int>(t + ((hi - g) / step + 0.5) * cell));
+  };
+  const auto& path = c.search_path;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const cv::Point p = px(path[i].first, path[i].first);
+    if (i > 0) cv::line(hm, px(path[i - 1].first, path[i - 1].first), p, cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+    cv::circle(hm, p, 4, cv::Scalar(0, 0, 255), -1, cv::LINE_AA);
+  }
+  cv::drawMarker(hm, px(c.adjusted.exposure_ms, c.adjusted.gain), cv::Scalar(255, 255, 255), cv::MARKER_STAR, 16, 2);
+  return hm;
+}
+
+Json case_json(const EntropyMapsConfig& cfg, const EntropyCase& c) {
+  const double lo = cfg.lo, hi = cfg.hi, step = cfg.step;
+  Json jp = Json::array();
+  for (const auto& [g, h] : c.search_path) jp.push_back({g, h});
+  return {{"grid", {{"exposure_ms", {lo, hi, step}}, {"gain", {hi, lo, -step}}, {"entropy", c.grid}}},
+          {"grid_peak", {c.grid_best_exposure, c.grid_best_gain, c.grid_best}},
+          {"line", {{"gain", c.line_gain}, {"entropy", c.line_entropy}}},
+          {"line_peak_gain", c.line_best_gain},
+          {"search_path", jp},
+          {"search_end", c.search_end},
+          {"adjusted", {c.adjusted.exposure_ms, c.adjusted.gain}},
+          {"line_points", {{"before", c.points_before}, {"after", c.points_after}}}};
+}
 
 }  // namespace
 
-int run_entropy_maps(const ExperimentArgs& args, std::ostream& out) {
-  const std::string dir_s = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/";
-  std::vector<Case> cases = {{"normal", load_scenario(dir_s + "lighting_002.json")}, {"sun", load_scenario(dir_s + "lighting_002_sun.json")}};
-  const Scenario& base = cases[0].sc;
-  const sim::CameraConfig cfg = sim::CameraConfig::from_json(base.camera, "/camera");
-  const VisionConfig vc = VisionConfig::from_json(base.vision, "/vision");
-  CameraPerception rig(cfg, base.field, vc, args.seed);
-  sim::PanoramicCamera& cam = rig.camera();
-  const CalibrationMap& map = rig.calibration();
-  const LineDetector& det = rig.detector();
-  const int robot = base.localized_robots().front();
-  RunDirectory dir(args.out_dir);
-  const double step = args.quick ? 6.0 : 2.0, lo = 2.0, hi = 40.0;
-  const int n = static_cast<int>(std::floor((hi - lo) / step + 1e-9)) + 1;
+void write_entropy_maps_report(const EntropyMapsConfig& cfg, const EntropyMapsResult& r, RunDirectory& dir, std::ostream& out) {
   Json result;
   std::vector<Series> line_series;
   out << "case   | peak on the grid (exposure ms, gain) | peak along exposure = gain | line points at 18/18 | at the auto-adjusted setting\n";
-  for (auto& c : cases) {
-    sim::WorldState ws = world_at(c.sc, 0.0, args.seed);
-    auto render = [&](const CameraSettings& s, std::uint64_t k) {
-      Rng rng = Rng::stream(args.seed, "entropy/" + std::to_string(k));
-      return cam.render(ws, robot, s, rng);
-    };
-    auto entropy = [&](const Image& img) { return image_entropy(img, map.centre(), map.max_radius()); };
-    // Entropy over the (exposure, gain) grid: rows = gain from high (top) to low.
-    std::vector<double> grid(static_cast<std::size_t>(n) * n);
-    double best = -1, best_e = 0, best_g = 0;
-    std::uint64_t k = 0;
-    for (int gi = 0; gi < n; ++gi)
-      for (int ei = 0; ei < n; ++ei) {
-        const CameraSettings s{lo + ei * step, lo + (n - 1 - gi) * step};
-        const double h = entropy(render(s, k++));
-        grid[static_cast<std::size_t>(gi) * n + ei] = h;
-        if (h > best) best = h, best_e = s.exposure_ms, best_g = s.gain;
-      }
-    // Along the search line exposure = gain (a = 1, b = 0).
-    Series line{c.name, {}, {}};
-    double lbest = -1, lbest_g = 0;
-    for (double g = 2.0; g <= 40.0 + 1e-9; g += args.quick ? 2.0 : 1.0) {
-      const double h = entropy(render({g, g}, k++));
-      line.x.push_back(g);
-      line.y.push_back(h);
-      if (h > lbest) lbest = h, lbest_g = g;
-    }
-    line_series.push_back(line);
-    // The controller on this scene: settled under normal light at 18 / 18, then this case's light.
-    ExposureParams ep = rig.exposure_params();
-    ep.enabled = true;
-    ep.search_at_start = false;  // settled under normal light first; the change of light triggers the search
-    ExposureController ctl(ep, cfg.initial);
-    const sim::Lighting target = ws.lighting;
-    const Image before = [&] {
-      Rng rng = Rng::stream(args.seed, "before");
-      return cam.render(ws, robot, cfg.initial, rng);
-    }();
-    std::vector<std::pair<double, double>> path;
-    std::string end_event;
-    sim::WorldState normal = ws;
-    normal.lighting = cases[0].sc.lighting_at(0.0);
-    for (int f = 0; f < 200; ++f) {
-      ws.lighting = f < 3 ? normal.lighting : target;
-      const Image img = render(ctl.current(), k++);
-      const double body = centre_brightness(img, map.centre(), 0.8 * map.min_radius());
-      const double h = ctl.wants_entropy() ? entropy(img) : -1.0;
-      const ExposureDecision d = ctl.update(f / 30.0, body, h);
-      if (d.event && d.event->rfind("search_end", 0) == 0) {
-        end_event = *d.event;
-        break;
-      }
-    }
-    ws.lighting = target;
-    path = ctl.path();
-    const Image after = render(ctl.current(), k++);
-    const std::size_t pts_before = det.detect(before).points.size(), pts_after = det.detect(after).points.size();
-    // Heat map with the search path (exposure = gain line) drawn on it.
-    cv::Mat hm = heat_map(grid, n, n, lo, hi, hi, lo, "entropy (nats), " + c.name + " light", "exposure ms", "gain", args.quick ? 36 : 20);
-    const int cell = args.quick ? 36 : 20, l = 70, t = 36;
-    auto px = [&](double e, double g) {
-      return cv::Point(static_cast<int>(l + ((e - lo) / step + 0.5) * cell), static_cast<int>(t + ((hi - g) / step + 0.5) * cell));
-    };
-    for (std::size_t i = 0; i < path.size(); ++i) {
-      const cv::Point p = px(path[i].first, path[i].first);
-      if (i > 0) cv::line(hm, px(path[i - 1].first, path[i - 1].first), p, cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
-      cv::circle(hm, p, 4, cv::Scalar(0, 0, 255), -1, cv::LINE_AA);
-    }
-    cv::drawMarker(hm, px(ctl.current().exposure_ms, ctl.current().gain), cv::Scalar(255, 255, 255), cv::MARKER_STAR, 16, 2);
-    dir.write("entropy_" + c.name + ".png", png_bytes(hm));
-    dir.write("frame_" + c.name + "_before.png", png_bytes(bgr_of(before)));
-    dir.write("frame_" + c.name + "_after.png", png_bytes(bgr_of(after)));
-    char buf[300];
-    std::snprintf(buf, sizeof buf, "%-6s | %13.0f %7.0f %13s | %14.0f (H = %.2f)     | %20zu | %zu at %.1f / %.1f\n", c.name.c_str(), best_e, best_g, "", lbest_g, lbest,
-                  pts_before, pts_after, ctl.current().exposure_ms, ctl.current().gain);
-    out << buf;
-    Json jp = Json::array();
-    for (const auto& [g, h] : path) jp.push_back({g, h});
-    result[c.name] = {{"grid", {{"exposure_ms", {lo, hi, step}}, {"gain", {hi, lo, -step}}, {"entropy", grid}}},
-                      {"grid_peak", {best_e, best_g, best}},
-                      {"line", {{"gain", line.x}, {"entropy", line.y}}},
-                      {"line_peak_gain", lbest_g},
-                      {"search_path", jp},
-                      {"search_end", end_event},
-                      {"adjusted", {ctl.current().exposure_ms, ctl.current().gain}},
-                      {"line_points", {{"before", pts_before}, {"after", pts_after}}}};
+  for (const auto& c : r.cases) {
+    line_series.push_back(Series{c.name, c.line_gain, c.line_entropy});
+    dir.write("entropy_" + c.name + ".png", png_bytes(search_figure(cfg, c)));
+    dir.write("frame_" + c.name + "_before.png", png_bytes(bgr_of(c.before)));
+    dir.write("frame_" + c.name + "_after.png", png_bytes(bgr_of(c.after)));
+    out << strprintf("%-6s | %13.0f %7.0f %13s | %14.0f (H = %.2f)     | %20zu | %zu at %.1f / %.1f\n", c.name.c_str(), c.grid_best_exposure,
+                     c.grid_best_gain, "", c.line_best_gain, c.line_best, c.points_before, c.points_after, c.adjusted.exposure_ms, c.adjusted.gain);
+    result[c.name] = case_json(cfg, c);
   }
   dir.write("entropy_line.png", png_bytes(line_plot(line_series, "entropy along exposure = gain", "gain (= exposure ms)", "entropy, nats")));
   dir.write("entropy_maps.json", result.dump(1) + "\n");
   dir.commit();
   out << "figures: " << dir.final_dir() << "/{entropy_normal,entropy_sun,entropy_line,frame_*}.png\n";
+}
+
+// --- the experiment -------------------------------------------------------------------------------------
+
+int run_entropy_maps(const ExperimentArgs& args, std::ostream& out) {
+  const EntropyMapsConfig cfg = EntropyMapsConfig::from_args(args);
+  RunDirectory dir(args.out_dir);  // refuses an unusable output folder before any work
+  const EntropyMapsResult r = compute_entropy_maps(cfg);
+  write_entropy_maps_report(cfg, r, dir, out);
   return 0;
 }
 
