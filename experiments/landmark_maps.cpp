@@ -5,38 +5,38 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <ostream>
 #include <string>
 #include <vector>
 
 #include "core/angles.hpp"
-#include "core/atomic_file.hpp"
-#include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "experiments/text_format.hpp"
-#include "harness/field_picture.hpp"
-#include "harness/plot.hpp"
+#include "experiments/report_format.hpp"
 #include "harness/run_directory.hpp"
 #include "localization/landmarks/landmark_groups.hpp"
 #include "localization/landmarks/landmark_solvers.hpp"
 
 namespace omniloc::experiments {
 
-using harness::RunDirectory;
-using harness::Series;
-using harness::heat_map;
-using harness::line_plot;
-using harness::png_bytes;
-
-namespace {
-
 using landmarks::BearingObs;
 using landmarks::Fix;
 
+// --- configuration --------------------------------------------------------------------------------------
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+LandmarkMapsConfig LandmarkMapsConfig::from_args(const ExperimentArgs& args) {
+  LandmarkMapsConfig c;
+  c.seed = args.seed;
+  c.quick = args.quick;
+  c.map_sigma = deg2rad(0.5);
+  c.cell_m = args.quick ? 0.2 : 0.1;
+  c.map_trials = args.quick ? 10 : 400;
+  c.table_trials = args.quick ? 200 : 5000;
+  c.sim_waypoints = args.quick ? 4 : 20;
+  c.sim_paths = args.quick ? 2 : 20;
+  return c;
+}
 
-// ------------------------------------------------------------------------------------------------
+// --- computation ----------------------------------------------------------------------------------------
+
 // Paper 004's field. The paper's frame: origin at the top-left corner of the outer white lines, x along
 // the field, y across (downwards in its pictures), 1 cm : 1 px. The paper does not print the field's
 // size; its five positions and their descriptions fix it: (300, 315) "on the centre line, towards the
@@ -47,15 +47,14 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // posts (the goal edges the paper's robot detects), on the goal lines.
 // We compute in metres, in the paper's coordinates taken as an ordinary x-y frame: with y pointing down
 // that is the mirror image of the field as drawn, which changes no distance and no error.
-struct Field004 {
-  double length = 6.0;      // metres
-  double width = 4.0;       // metres
-  double goal_width = 1.0;  // metres, between the posts
-  std::array<Eigen::Vector2d, 4> posts() const {
-    const double a = 0.5 * (width - goal_width), b = 0.5 * (width + goal_width);
-    return {Eigen::Vector2d(0.0, a), Eigen::Vector2d(0.0, b), Eigen::Vector2d(length, a), Eigen::Vector2d(length, b)};
-  }
-};
+std::array<Eigen::Vector2d, 4> Field004::posts() const {
+  const double a = 0.5 * (width - goal_width), b = 0.5 * (width + goal_width);
+  return {Eigen::Vector2d(0.0, a), Eigen::Vector2d(0.0, b), Eigen::Vector2d(length, a), Eigen::Vector2d(length, b)};
+}
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double bearing_to(const Eigen::Vector2d& from, const Eigen::Vector2d& to) { return std::atan2(to.y() - from.y(), to.x() - from.x()); }
 
@@ -108,15 +107,10 @@ Fix two_circle_as_printed(std::span<const BearingObs> obs, double sign) {
 Fix two_circle_eq8(std::span<const BearingObs> obs) { return two_circle_as_printed(obs, +1.0); }
 Fix two_circle_eq9(std::span<const BearingObs> obs) { return two_circle_as_printed(obs, -1.0); }
 
-struct Solver {
-  const char* name;
-  const char* label;
-  Fix (*fn)(std::span<const BearingObs>);
-  bool exact;  // a library solver (exact to rounding off its singular set)
-};
+}  // namespace
 
-const std::vector<Solver>& solvers() {
-  static const std::vector<Solver> list = {
+const std::vector<LandmarkSolver>& landmark_solvers() {
+  static const std::vector<LandmarkSolver> list = {
       {"two_circle_004", "two-circle, paper 004 eqs. (1)-(9) (landmarks::two_circle_004)", landmarks::two_circle_004, true},
       {"three_point_004", "three-point, paper 004 eqs. (11)-(22) (landmarks::three_point_004)", landmarks::three_point_004, true},
       {"circle_intersection_003", "circle intersection, paper 003 (landmarks::circle_intersection_003)", landmarks::circle_intersection_003,
@@ -127,6 +121,9 @@ const std::vector<Solver>& solvers() {
   };
   return list;
 }
+
+namespace {
+
 constexpr std::size_t kTotal = 3;  // index of total_like, the reference for the agreement check
 
 std::array<BearingObs, 3> observe(const std::array<Eigen::Vector2d, 4>& posts, const std::array<int, 3>& sel, const Eigen::Vector2d& p,
@@ -139,31 +136,11 @@ std::array<BearingObs, 3> observe(const std::array<Eigen::Vector2d, 4>& posts, c
   return obs;
 }
 
-double quantile(std::vector<double> v, double q) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
-  return v[i];
-}
-
 // ------------------------------------------------------------------------------------------------
 // (a) maps
-struct MapResult {
-  int cols = 0, rows = 0;
-  double cell_m = 0.0;
-  int trials = 0;
-  double sigma_deg = 0.0;
-  std::vector<std::vector<double>> mean_cm;      // [solver][cell], NaN when every trial was refused
-  std::vector<std::vector<double>> refused;      // [solver][cell], fraction of trials
-  std::vector<double> max_diff_vs_total_cm;      // [solver], exact solvers: max |fix - total_like fix|
-  std::vector<long> diff_over_1mm;               // [solver], trials where that difference exceeds 1 mm
-  long compared = 0;
-};
-
-MapResult run_maps(const Field004& f, double cell_m, int trials, double sigma, std::uint64_t seed) {
-  const auto& S = solvers();
-  MapResult m;
+SolverMaps run_maps(const Field004& f, double cell_m, int trials, double sigma, std::uint64_t seed) {
+  const auto& S = landmark_solvers();
+  SolverMaps m;
   m.cols = static_cast<int>(std::lround(f.length / cell_m));
   m.rows = static_cast<int>(std::lround(f.width / cell_m));
   m.cell_m = cell_m;
@@ -213,21 +190,22 @@ MapResult run_maps(const Field004& f, double cell_m, int trials, double sigma, s
 
 // ------------------------------------------------------------------------------------------------
 // (b) table 1
+}  // namespace
+
 const std::array<Eigen::Vector2d, 5> kTable1True = {Eigen::Vector2d(300, 315), Eigen::Vector2d(140, 200), Eigen::Vector2d(75, 100),
                                                     Eigen::Vector2d(460, 200), Eigen::Vector2d(410, 83)};  // cm
 
-struct TableCell {
-  double mean_x = kNaN, mean_y = kNaN;  // cm, mean of the accepted estimates
-  double mean_err = kNaN;               // cm, mean of |estimate - truth|
-  double max_err = kNaN;                // cm
-  int ok = 0, refused = 0;
-};
+namespace {
 
-std::vector<std::vector<TableCell>> run_table(const Field004& f, int trials, double sigma, std::uint64_t seed) {
-  const auto& S = solvers();
+Table1 run_table(const Field004& f, int trials, double sigma_deg, std::uint64_t seed) {
+  const double sigma = deg2rad(sigma_deg);
+  const auto& S = landmark_solvers();
   const auto posts = f.posts();
   Rng rng = Rng::stream(seed, "landmark_maps/table1_004/" + strprintf("%.4f", rad2deg(sigma)));
-  std::vector<std::vector<TableCell>> rows(kTable1True.size(), std::vector<TableCell>(S.size()));
+  Table1 table;
+  table.sigma_deg = sigma_deg;
+  auto& rows = table.rows;
+  rows.assign(kTable1True.size(), std::vector<Table1Cell>(S.size()));
   for (std::size_t k = 0; k < kTable1True.size(); ++k) {
     const Eigen::Vector2d p = kTable1True[k] / 100.0;
     const auto sel = select_004(f, p);
@@ -236,7 +214,7 @@ std::vector<std::vector<TableCell>> run_table(const Field004& f, int trials, dou
       const auto obs = observe(posts, sel, p, rng.uniform(-kPi, kPi), sigma, rng);
       for (std::size_t s = 0; s < S.size(); ++s) {
         const Fix fx = S[s].fn(obs);
-        TableCell& cell = rows[k][s];
+        Table1Cell& cell = rows[k][s];
         if (!fx.ok) {
           ++cell.refused;
           continue;
@@ -250,7 +228,7 @@ std::vector<std::vector<TableCell>> run_table(const Field004& f, int trials, dou
       }
     }
     for (std::size_t s = 0; s < S.size(); ++s) {
-      TableCell& cell = rows[k][s];
+      Table1Cell& cell = rows[k][s];
       if (cell.ok == 0) continue;
       cell.mean_x = sx[s] / cell.ok;
       cell.mean_y = sy[s] / cell.ok;
@@ -258,37 +236,9 @@ std::vector<std::vector<TableCell>> run_table(const Field004& f, int trials, dou
       cell.max_err = mx[s];
     }
   }
-  return rows;
+  return table;
 }
 
-// Published table: results/reference/papers.json, "004_table1_cm" (the one place published numbers live).
-struct Published {
-  bool found = false;
-  std::string note;
-  std::vector<std::array<double, 8>> rows;  // true x, y, two-circle x, y, err, three-point x, y, err
-};
-
-Published read_published() {
-  Published p;
-  const std::string path = std::string(OMNILOC_SOURCE_DIR) + "/results/reference/papers.json";
-  try {
-    const Json j = Json::parse(read_file(path));
-    if (!j.contains("004_table1_cm")) {
-      p.note = path + " has no \"004_table1_cm\"";
-      return p;
-    }
-    for (const auto& r : j.at("004_table1_cm").at("rows")) {
-      std::array<double, 8> a{};
-      for (std::size_t i = 0; i < 8; ++i) a[i] = r.at(i).get<double>();
-      p.rows.push_back(a);
-    }
-    p.found = p.rows.size() == kTable1True.size();
-    if (!p.found) p.note = "004_table1_cm does not have 5 rows";
-  } catch (const std::exception& e) {
-    p.note = std::string("cannot read published numbers: ") + e.what();
-  }
-  return p;
-}
 
 // ------------------------------------------------------------------------------------------------
 // (c) paper 003's simulation (sec. 3.1). The paper: "4 landmarks at (-40, -40), (-40, 40), (40, -40),
@@ -309,12 +259,6 @@ struct SimFrame {
   Pose2 truth;
   Eigen::Vector2d goal;
   std::vector<landmarks::LandmarkSighting> sightings;
-};
-
-struct SimStats {
-  std::vector<double> err_vote, err_novote, worst_fix;  // per frame, metres (worst_fix NaN without fixes)
-  std::vector<double> fix_errors;                       // every group fix of the voting run, metres
-  int frames = 0, kept = 0, forced = 0, new_groups_vote = 0, new_groups_novote = 0;
 };
 
 constexpr int kRed = 0, kBlue = 1, kYellow = 2;
@@ -383,13 +327,12 @@ landmarks::GroupLocalizerParams sim_params(bool voting, bool remember) {
   p.use_voting = voting;
   return p;
 }
-constexpr double kSimRegionMargin = 1.0;  // metres
 
-SimStats run_sim(const std::vector<SimFrame>& frames, bool remember) {
-  SimStats st;
+Sim003Stats run_sim(const std::vector<SimFrame>& frames, bool remember) {
+  Sim003Stats st;
   landmarks::GroupLocalizer vote(Pose2(0, 0, 0), sim_params(true, remember)), plain(Pose2(0, 0, 0), sim_params(false, remember));
   for (const SimFrame& fr : frames) {
-    const auto region = landmarks::PlausibleRegion::from_path(vote.estimate().translation(), fr.goal, kSimRegionMargin);
+    const auto region = landmarks::PlausibleRegion::from_path(vote.estimate().translation(), fr.goal, LandmarkMapsResult::kSimRegionMargin);
     const auto rv = vote.update(fr.sightings, region);
     const auto rp = plain.update(fr.sightings, landmarks::PlausibleRegion::everywhere());
     const Eigen::Vector2d t = fr.truth.translation();
@@ -411,275 +354,52 @@ SimStats run_sim(const std::vector<SimFrame>& frames, bool remember) {
   return st;
 }
 
-double mean_of(const std::vector<double>& v) {
-  double s = 0;
-  int n = 0;
-  for (double x : v)
-    if (std::isfinite(x)) s += x, ++n;
-  return n ? s / n : kNaN;
+/// One condition of the paper 003 simulation over every path; the same frames (truth, noise,
+/// distractor) for both ways of recognising groups.
+std::array<Sim003Condition, 2> run_sim_conditions(const LandmarkMapsConfig& cfg, bool distractor) {
+  std::array<Sim003Condition, 2> cond;  // [remember_groups]
+  for (const bool remember : {false, true})
+    cond[remember ? 1 : 0].name = strprintf("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
+  for (int k = 0; k < cfg.sim_paths; ++k) {
+    const auto frames = make_sim_frames(derive_seed(cfg.seed, strprintf("sim003/path%d", k)), cfg.sim_waypoints, distractor);
+    for (const bool remember : {false, true}) {
+      Sim003Condition& c = cond[remember ? 1 : 0];
+      const Sim003Stats st = run_sim(frames, remember);
+      Sim003Stats& a = c.all;
+      a.err_vote.insert(a.err_vote.end(), st.err_vote.begin(), st.err_vote.end());
+      a.err_novote.insert(a.err_novote.end(), st.err_novote.begin(), st.err_novote.end());
+      a.fix_errors.insert(a.fix_errors.end(), st.fix_errors.begin(), st.fix_errors.end());
+      a.frames += st.frames;
+      a.kept += st.kept;
+      a.forced += st.forced;
+      a.new_groups_vote += st.new_groups_vote;
+      a.new_groups_novote += st.new_groups_novote;
+      c.paths.push_back(st);
+      if (k == 0)
+        for (const auto& fr : frames) c.path0_truth.push_back(fr.truth);
+    }
+  }
+  return cond;
 }
-double max_of(const std::vector<double>& v) {
-  double m = kNaN;
-  for (double x : v)
-    if (std::isfinite(x)) m = std::isfinite(m) ? std::max(m, x) : x;
-  return m;
-}
-
-Json sim_summary(const SimStats& s) {
-  return Json{{"frames", s.frames},
-              {"group_fixes", s.fix_errors.size()},
-              {"fixes_mean_m", mean_of(s.fix_errors)},
-              {"fixes_max_m", max_of(s.fix_errors)},
-              {"fixes_over_1m", std::count_if(s.fix_errors.begin(), s.fix_errors.end(), [](double e) { return e > 1.0; })},
-              {"no_voting_mean_m", mean_of(s.err_novote)},
-              {"no_voting_max_m", max_of(s.err_novote)},
-              {"voting_mean_m", mean_of(s.err_vote)},
-              {"voting_max_m", max_of(s.err_vote)},
-              {"voting_frames_kept_last", s.kept},
-              {"voting_forced_accepts", s.forced},
-              {"new_groups_voting_run", s.new_groups_vote},
-              {"new_groups_no_voting_run", s.new_groups_novote}};
-}
-
-Json posts_cm_json(const Field004& f) {
-  Json a = Json::array();
-  for (const auto& p : f.posts()) a.push_back({100 * p.x(), 100 * p.y()});
-  return a;
-}
-
-Json num_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 }  // namespace
 
-// ==================================================================================================
+LandmarkMapsResult compute_landmark_maps(const LandmarkMapsConfig& cfg) {
+  LandmarkMapsResult r;
+  r.maps = run_maps(r.field, cfg.cell_m, cfg.map_trials, cfg.map_sigma, cfg.seed);
+  for (double sd : cfg.table_sigmas_deg) r.tables.push_back(run_table(r.field, cfg.table_trials, sd, cfg.seed));
+  for (const bool distractor : {false, true})
+    for (Sim003Condition& c : run_sim_conditions(cfg, distractor)) r.sim.push_back(std::move(c));
+  return r;
+}
+
+// --- the experiment -------------------------------------------------------------------------------------
+
 int run_landmark_maps(const ExperimentArgs& args, std::ostream& out) {
-  const Field004 field;
-  const auto& S = solvers();
-  const double sigma_map = deg2rad(0.5);
-  const double cell_m = args.quick ? 0.2 : 0.1;
-  const int map_trials = args.quick ? 10 : 400;
-  const int table_trials = args.quick ? 200 : 5000;
-  const std::vector<double> table_sigmas_deg = {0.5, 2.0};
-  const int sim_waypoints = args.quick ? 4 : 20;
-  const int sim_paths = args.quick ? 2 : 20;
-  const double cap_cm = 30.0;
-  RunDirectory dir(args.out_dir);
-
-  const auto posts = field.posts();
-  out << "landmark_maps (seed " << args.seed << (args.quick ? ", quick" : "") << ")\n";
-  out << strprintf("Paper 004 field, paper's frame (origin at a line corner, cm): %.0f x %.0f cm; yellow goal posts (%.0f,%.0f) (%.0f,%.0f), "
-             "blue goal posts (%.0f,%.0f) (%.0f,%.0f)\n",
-             100 * field.length, 100 * field.width, 100 * posts[0].x(), 100 * posts[0].y(), 100 * posts[1].x(), 100 * posts[1].y(),
-             100 * posts[2].x(), 100 * posts[2].y(), 100 * posts[3].x(), 100 * posts[3].y());
-
-  // ---- (a) maps
-  const MapResult m = run_maps(field, cell_m, map_trials, sigma_map, args.seed);
-  out << strprintf("\n(a) Mean position error maps: %d x %d cells of %.0f cm, %d trials per cell, bearing noise N(0, %.1f deg), random heading\n",
-             m.cols, m.rows, 100 * cell_m, map_trials, m.sigma_deg);
-  out << "solver                     | field mean cm | median cm | p95 cm | worst cell cm | cells > " << cap_cm
-      << " cm | trials refused | max |fix - total_like| cm\n";
-  Json maps_json = Json::array();
-  std::string csv = "x_cm,y_cm";
-  for (const auto& s : S) csv += std::string(",") + s.name + "_mean_err_cm," + s.name + "_refused_frac";
-  csv += "\n";
-  for (int r = 0; r < m.rows; ++r)
-    for (int c = 0; c < m.cols; ++c) {
-      const std::size_t i = static_cast<std::size_t>(r) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(c);
-      csv += strprintf("%.1f,%.1f", 100 * (c + 0.5) * cell_m, 100 * (r + 0.5) * cell_m);
-      for (std::size_t s = 0; s < S.size(); ++s)
-        csv += std::isfinite(m.mean_cm[s][i]) ? strprintf(",%.4f,%.4f", m.mean_cm[s][i], m.refused[s][i]) : strprintf(",nan,%.4f", m.refused[s][i]);
-      csv += "\n";
-    }
-  for (std::size_t s = 0; s < S.size(); ++s) {
-    const auto& v = m.mean_cm[s];
-    const double over = static_cast<double>(std::count_if(v.begin(), v.end(), [&](double x) { return !std::isfinite(x) || x > cap_cm; })) /
-                        static_cast<double>(v.size());
-    double refused = 0;
-    for (double x : m.refused[s]) refused += x;
-    refused /= static_cast<double>(m.refused[s].size());
-    const double fm = mean_of(v), med = quantile(v, 0.5), p95 = quantile(v, 0.95), worst = max_of(v);
-    out << strprintf("%-26s | %13.2f | %9.2f | %6.2f | %13.1f | %10.2f %% | %12.4f %% | ", S[s].name, fm, med, p95, worst, 100 * over, 100 * refused)
-        << (S[s].exact ? strprintf("%.2e", m.max_diff_vs_total_cm[s]) : std::string("(diagnostic)")) << "\n";
-    maps_json.push_back({{"solver", S[s].name},
-                         {"label", S[s].label},
-                         {"field_mean_cm", fm},
-                         {"median_cell_cm", med},
-                         {"p95_cell_cm", p95},
-                         {"worst_cell_cm", worst},
-                         {"cells_over_cap_frac", over},
-                         {"trials_refused_frac", refused},
-                         {"max_diff_vs_total_like_cm", S[s].exact ? Json(m.max_diff_vs_total_cm[s]) : Json(nullptr)},
-                         {"trials_diff_over_1mm", S[s].exact ? Json(m.diff_over_1mm[s]) : Json(nullptr)},
-                         {"png", std::string("map_") + S[s].name + ".png"}});
-    std::vector<double> capped(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) capped[i] = std::isfinite(v[i]) ? std::min(v[i], cap_cm) : kNaN;
-    const int cell_px = std::max(1, static_cast<int>(std::lround(600.0 / m.cols)));
-    dir.write(std::string("map_") + S[s].name + ".png",
-              png_bytes(heat_map(capped, m.cols, m.rows, 0.0, 100 * field.length, 0.0, 100 * field.width,
-                                 strprintf("%s: mean error cm (0.5 deg, capped %.0f)", S[s].name, cap_cm), "x cm (paper 004 frame)", "y cm",
-                                 cell_px)));
-  }
-  out << strprintf("(the four exact solvers compared with total_like on %ld trials; diagnostics: eqs. (8)/(9) of paper 004 with a fixed "
-             "rotation sign)\n",
-             m.compared);
-  dir.write("maps_004.csv", csv);
-
-  // ---- (b) table 1
-  const Published pub = read_published();
-  if (!pub.found) out << "(published numbers unavailable: " << pub.note << ")\n";
-  Json table_json = Json::array();
-  std::string md = "# Paper 004, table 1, reproduced (omniloc experiment landmark_maps)\n\n";
-  md += strprintf("Field %.0f x %.0f cm (paper 004 frame, origin at a line corner), landmarks = the four goal posts; %d trials per position, "
-            "random heading, seed %llu.\n",
-            100 * field.length, 100 * field.width, table_trials, static_cast<unsigned long long>(args.seed));
-  md += "Ours: mean of the estimates (cm) and mean error (cm) under Gaussian bearing noise. Published: paper 004's single real-robot "
-        "estimate and its error (from results/reference/papers.json).\n";
-  const std::size_t TC = 0, TP = 1, E8 = 4, E9 = 5;
-  for (double sd : table_sigmas_deg) {
-    const auto rows = run_table(field, table_trials, deg2rad(sd), args.seed);
-    const std::string head =
-        "| true (cm) | two-circle mean (cm) | err | three-point mean (cm) | err | published two-circle | err | published three-point | err "
-        "| eq. (8) literal err | eq. (9) literal err |\n";
-    const std::string rule = "|---|---|---|---|---|---|---|---|---|---|---|\n";
-    out << strprintf("\n(b) Paper 004 table 1, bearing noise N(0, %.1f deg), %d trials per position (ours: mean estimate, mean error, cm)\n", sd,
-               table_trials)
-        << head << rule;
-    md += strprintf("\n## Bearing noise N(0, %.1f deg)\n\n", sd) + head + rule;
-    Json jrows = Json::array();
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      const auto& tc = rows[k][TC];
-      const auto& tp = rows[k][TP];
-      std::string line = strprintf("| (%.0f, %.0f) | (%.1f, %.1f) | %.2f | (%.1f, %.1f) | %.2f | ", kTable1True[k].x(), kTable1True[k].y(), tc.mean_x,
-                             tc.mean_y, tc.mean_err, tp.mean_x, tp.mean_y, tp.mean_err);
-      if (pub.found) {
-        const auto& p = pub.rows[k];
-        line += strprintf("(%.0f, %.0f) | %.3f | (%.0f, %.0f) | %.3f | ", p[2], p[3], p[4], p[5], p[6], p[7]);
-      } else {
-        line += "- | - | - | - | ";
-      }
-      line += strprintf("%.1f | %.1f |\n", rows[k][E8].mean_err, rows[k][E9].mean_err);
-      out << line;
-      md += line;
-      Json per = Json::object();
-      for (std::size_t s = 0; s < S.size(); ++s) {
-        const auto& c = rows[k][s];
-        per[S[s].name] = {{"mean_x_cm", num_or_null(c.mean_x)}, {"mean_y_cm", num_or_null(c.mean_y)}, {"mean_err_cm", num_or_null(c.mean_err)},
-                          {"max_err_cm", num_or_null(c.max_err)}, {"ok", c.ok},
-                          {"refused", c.refused}};
-      }
-      Json row{{"true_cm", {kTable1True[k].x(), kTable1True[k].y()}}, {"ours", per}};
-      if (pub.found)
-        row["published"] = {{"two_circle", {pub.rows[k][2], pub.rows[k][3], pub.rows[k][4]}},
-                            {"three_point", {pub.rows[k][5], pub.rows[k][6], pub.rows[k][7]}}};
-      jrows.push_back(row);
-    }
-    // Trend check: near the edge ((75, 100) and (410, 83)) against the three central positions.
-    const auto ratio = [&](std::size_t s) {
-      const double edge = 0.5 * (rows[2][s].mean_err + rows[4][s].mean_err);
-      const double centre = (rows[0][s].mean_err + rows[1][s].mean_err + rows[3][s].mean_err) / 3.0;
-      return edge / centre;
-    };
-    const std::string trend = strprintf("edge/centre mean-error ratio: two-circle %.2f, three-point %.2f (published: two-circle %.2f, three-point %.2f); "
-                                  "max |two-circle - three-point| mean error over the rows %.2e cm",
-                                  ratio(TC), ratio(TP),
-                                  pub.found ? 0.5 * (pub.rows[2][4] + pub.rows[4][4]) / ((pub.rows[0][4] + pub.rows[1][4] + pub.rows[3][4]) / 3) : kNaN,
-                                  pub.found ? 0.5 * (pub.rows[2][7] + pub.rows[4][7]) / ((pub.rows[0][7] + pub.rows[1][7] + pub.rows[3][7]) / 3) : kNaN,
-                                  [&] {
-                                    double d = 0;
-                                    for (const auto& r : rows) d = std::max(d, std::fabs(r[TC].mean_err - r[TP].mean_err));
-                                    return d;
-                                  }());
-    out << trend << "\n";
-    md += "\n" + trend + ".\n";
-    // The trend as numbers too, for the report's scorecard (scripts/paper_claims.py).
-    table_json.push_back({{"bearing_sigma_deg", sd}, {"trials", table_trials}, {"rows", jrows}, {"trend", trend},
-                          {"edge_centre_ratio", {{"two_circle", num_or_null(ratio(TC))}, {"three_point", num_or_null(ratio(TP))}}}});
-  }
-  dir.write("table1_004.json", Json{{"seed", args.seed},
-                                    {"field_cm", {100 * field.length, 100 * field.width}},
-                                    {"goal_width_cm", 100 * field.goal_width},
-                                    {"posts_cm", posts_cm_json(field)},
-                                    {"published_source", pub.found ? "results/reference/papers.json#004_table1_cm" : pub.note},
-                                    {"tables", table_json}}
-                                   .dump(1) +
-                                   "\n");
-  dir.write("table1_004.md", md);
-
-  // ---- (c) paper 003's simulation
-  out << "\n(c) Paper 003 simulation: landmarks (+-4, +-4) m (the paper's (+-40, +-40) read as decimetres), range 8 m, distance error "
-         "U(-1, 1) m, bearing noise N(0, 1 deg); "
-      << sim_paths << " random paths of " << sim_waypoints << " waypoints (path 0 plotted)\n";
-  out << "condition              | frames | group fixes: mean m   max m  (>1 m) | no voting: mean m  max m | voting: mean m  max m | kept last | "
-         "forced | new groups\n";
-  Json sim_json{{"landmarks_m", {{-4, -4, "red"}, {-4, 4, "blue"}, {4, -4, "yellow"}, {4, 4, "red"}}},
-                {"range_m", 8.0},
-                {"distance_error", "uniform [-1, 1] m"},
-                {"bearing_noise_deg", 1.0},
-                {"match", {{"max_distance_diff_m", 2.0}, {"max_angle_diff_deg", 45.0}}},
-                {"voting", {{"position_tol_m", 0.5}, {"heading_tol_deg", 10.0}, {"deadlock_limit", 3}}},
-                {"plausible_margin_m", kSimRegionMargin},
-                {"paths", sim_paths},
-                {"waypoints_per_path", sim_waypoints}};
-  for (const bool distractor : {false, true}) {
-    std::array<SimStats, 2> all;  // [remember_groups]
-    std::array<Json, 2> per_path = {Json::array(), Json::array()};
-    for (int k = 0; k < sim_paths; ++k) {
-      // The same frames (truth, noise, distractor) for both ways of recognising groups.
-      const auto frames = make_sim_frames(derive_seed(args.seed, strprintf("sim003/path%d", k)), sim_waypoints, distractor);
-      for (const bool remember : {false, true}) {
-        const std::string cname = strprintf("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
-        const SimStats st = run_sim(frames, remember);
-        SimStats& a = all[remember ? 1 : 0];
-        per_path[remember ? 1 : 0].push_back(sim_summary(st));
-        a.err_vote.insert(a.err_vote.end(), st.err_vote.begin(), st.err_vote.end());
-        a.err_novote.insert(a.err_novote.end(), st.err_novote.begin(), st.err_novote.end());
-        a.fix_errors.insert(a.fix_errors.end(), st.fix_errors.begin(), st.fix_errors.end());
-        a.frames += st.frames;
-        a.kept += st.kept;
-        a.forced += st.forced;
-        a.new_groups_vote += st.new_groups_vote;
-        a.new_groups_novote += st.new_groups_novote;
-        if (k != 0) continue;
-        Series sv{"voting", {}, st.err_vote}, sn{"no voting", {}, st.err_novote}, sw{"worst group fix", {}, {}};
-        for (std::size_t i = 0; i < st.err_vote.size(); ++i) {
-          sv.x.push_back(static_cast<double>(i));
-          sn.x.push_back(static_cast<double>(i));
-          if (std::isfinite(st.worst_fix[i])) {
-            sw.x.push_back(static_cast<double>(i));
-            sw.y.push_back(st.worst_fix[i]);
-          }
-        }
-        dir.write("sim_003_" + cname + ".png",
-                  png_bytes(line_plot({sw, sn, sv}, "Paper 003 simulation, " + cname + ", path 0: position error", "frame", "error m")));
-        Json series{{"truth", Json::array()}, {"err_vote_m", st.err_vote}, {"err_novote_m", st.err_novote}, {"worst_fix_m", Json::array()}};
-        for (const auto& fr : frames) series["truth"].push_back({fr.truth.x, fr.truth.y, fr.truth.theta});
-        for (double w : st.worst_fix) series["worst_fix_m"].push_back(num_or_null(w));
-        sim_json[cname + "_path0"] = series;
-      }
-    }
-    for (const bool remember : {false, true}) {
-      const std::string cname = strprintf("%s_%s", distractor ? "distractor" : "paper", remember ? "memory" : "consecutive");
-      const SimStats& a = all[remember ? 1 : 0];
-      const Json sum = sim_summary(a);
-      sim_json[cname] = {{"all_paths", sum}, {"per_path", per_path[remember ? 1 : 0]}};
-      out << strprintf("%-22s | %6d | %10.3f %7.3f (%5ld) | %9.3f %6.3f | %7.3f %6.3f | %9d | %6d | %d\n", cname.c_str(), a.frames,
-                 mean_of(a.fix_errors), max_of(a.fix_errors), static_cast<long>(sum["fixes_over_1m"].get<long>()), mean_of(a.err_novote),
-                 max_of(a.err_novote), mean_of(a.err_vote), max_of(a.err_vote), a.kept, a.forced, a.new_groups_vote);
-    }
-  }
-  dir.write("sim_003.json", sim_json.dump() + "\n");  // per-frame series: compact
-
-  Json top{{"seed", args.seed},
-           {"quick", args.quick},
-           {"field_004", {{"size_cm", {100 * field.length, 100 * field.width}}, {"goal_width_cm", 100 * field.goal_width},
-                          {"posts_cm", posts_cm_json(field)}, {"yellow_goal_x_cm", 0.0}, {"blue_goal_x_cm", 100 * field.length}}},
-           {"maps", {{"cell_cm", 100 * cell_m}, {"cols", m.cols}, {"rows", m.rows}, {"trials_per_cell", map_trials},
-                     {"bearing_sigma_deg", m.sigma_deg}, {"cap_cm", cap_cm}, {"solvers", maps_json}}},
-           {"files", {"maps_004.csv", "table1_004.json", "table1_004.md", "sim_003.json", "sim_003_paper_consecutive.png", "sim_003_paper_memory.png",
-                      "sim_003_distractor_consecutive.png", "sim_003_distractor_memory.png"}}};
-  dir.write("landmark_maps.json", top.dump(1) + "\n");
-  dir.commit();
-  out << "\nwritten: " << dir.final_dir() << "/{landmark_maps.json, maps_004.csv, map_*.png, table1_004.{json,md}, sim_003.json, sim_003_*.png}\n";
+  const LandmarkMapsConfig cfg = LandmarkMapsConfig::from_args(args);
+  harness::RunDirectory dir(args.out_dir);  // refuses an unusable output folder before any work
+  const LandmarkMapsResult r = compute_landmark_maps(cfg);
+  write_landmark_maps_report(cfg, r, dir, out);
   return 0;
 }
 
