@@ -1,7 +1,9 @@
 #pragma once
 // Experiments that are not a simulated match (solver accuracy maps, the paper-001 cooperative
 // simulation, benchmarks of filters): `omniloc experiment NAME [--seed N] [-o DIR] [--quick]`.
-// Each writes its tables (JSON/CSV) and a printed summary into DIR, atomically.
+// Each writes its tables (JSON/CSV) and a printed summary into DIR, atomically. The layer sits above
+// the harness (apps -> experiments -> harness); each experiment is split into configuration,
+// computation (plain result structs) and report (docs/extending.md, "Add an experiment").
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
