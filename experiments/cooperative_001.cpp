@@ -6,9 +6,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <map>
-#include <memory>
+#include <optional>
 #include <ostream>
+#include <stdexcept>
 
 #include "core/rng.hpp"
 #include "experiments/cooperative_001_report.hpp"
@@ -32,8 +32,8 @@ double CoopErrorAcc::mean() const { return count > 0 ? sum / count : 0.0; }
 double CoopErrorAcc::rms_per_axis() const { return count > 0 ? std::sqrt(sumsq / count / 2.0) : 0.0; }
 
 const CoopPathStats& CoopDirectResult::model(CoopNoiseModel m) const {
-  for (const auto& [mm, s] : by_model)
-    if (mm == m) return s;
+  for (const auto& [key, s] : by_model)
+    if (key == m) return s;
   throw std::logic_error("cooperative_001: no results for noise model " + std::string(to_string(m)));
 }
 
