@@ -19,7 +19,7 @@
 #include "core/json_parse.hpp"
 #include "core/field.hpp"
 #include "core/version.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 #include "harness/localizer_registry.hpp"
 #include "core/atomic_file.hpp"
 #include "harness/render_frame.hpp"
@@ -157,7 +157,7 @@ int validate_one(const std::string& file) {
   // An experiment description (scenarios/experiments/*.json) names its experiment; the experiment checks it.
   {
     if (j.is_object() && j.contains("experiment") && j["experiment"].is_string()) {
-      for (const auto& e : harness::experiments())
+      for (const auto& e : experiments::all())
         if (e.name == j["experiment"].get<std::string>() && e.validate) {
           e.validate(file);
           std::cout << file << ": ok (description of experiment \"" << e.name << "\")\n";
@@ -370,7 +370,7 @@ int cmd_list() {
   std::cout << "\nlocalizers:\n";
   for (const auto& l : harness::localizers()) std::cout << "  " << l.type << " - " << l.description << "\n";
   std::cout << "experiments:\n";
-  for (const auto& e : harness::experiments()) std::cout << "  " << e.name << " - " << e.description << "\n";
+  for (const auto& e : experiments::all()) std::cout << "  " << e.name << " - " << e.description << "\n";
   return 0;
 }
 
@@ -388,9 +388,9 @@ int cmd_compare(int argc, char** argv) {
 }
 
 int cmd_experiment(const cli::Args& a) {
-  for (const auto& e : harness::experiments()) {
+  for (const auto& e : experiments::all()) {
     if (e.name != a.positional[0]) continue;
-    harness::ExperimentArgs ea;
+    experiments::ExperimentArgs ea;
     if (a.has("--seed")) ea.seed = a.unsigned_integer("--seed", 0, kMaxSeed);
     ea.out_dir = a.value("-o", "results/experiments/" + e.name);
     ea.quick = a.has("--quick");

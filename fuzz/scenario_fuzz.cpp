@@ -13,7 +13,7 @@
 #include <string>
 
 #include "core/json_parse.hpp"
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 
@@ -39,7 +39,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const omniloc::Json j = omniloc::parse_json_strict(text, "fuzz input");
     if (j.is_object() && j.contains("experiment")) {
-      (void)omniloc::harness::parse_cooperative_001(j);
+      (void)omniloc::experiments::parse_cooperative_001(j);
     } else if (j.is_object() && j.contains("scenarios") && !j.contains("robots")) {
       const std::string file = sweep_dir() + "/sweep.json";
       std::ofstream(file, std::ios::binary | std::ios::trunc) << text;

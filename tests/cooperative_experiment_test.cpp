@@ -1,5 +1,5 @@
 // The team radio network (sim/network.hpp) and the paper-001 simulation experiment
-// (harness/experiments/cooperative_001.*, scenarios/experiments/cooperative_001.json).
+// (experiments/cooperative_001.*, scenarios/experiments/cooperative_001.json).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -15,7 +15,7 @@
 #include "core/error.hpp"
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 #include "sim/network.hpp"
 
 using namespace omniloc;
@@ -61,7 +61,7 @@ sim::NetworkConfig net(double latency, double jitter, sim::JitterKind kind, doub
 }
 
 Json shipped() {
-  std::ifstream in(harness::cooperative_001_default_file());
+  std::ifstream in(experiments::cooperative_001_default_file());
   return Json::parse(in);
 }
 
@@ -76,7 +76,7 @@ Json direct_only() {
 /// The ConfigError a parse of `j` raises (fails the test if none).
 ConfigError parse_error(const Json& j) {
   try {
-    harness::parse_cooperative_001(j);
+    experiments::parse_cooperative_001(j);
   } catch (const ConfigError& e) {
     return e;
   }
@@ -106,14 +106,14 @@ Json run_quick(const Json& cfg, const std::string& name, double* seconds = nullp
   fs::create_directories(d);
   const fs::path file = d / "description.json";
   std::ofstream(file) << cfg.dump(1);
-  harness::ExperimentArgs a;
+  experiments::ExperimentArgs a;
   a.seed = seed;
   a.quick = true;
   a.out_dir = (d / "out").string();
   a.config = file.string();
   std::ostringstream out;
   const auto t0 = std::chrono::steady_clock::now();
-  EXPECT_EQ(harness::run_cooperative_001(a, out), 0);
+  EXPECT_EQ(experiments::run_cooperative_001(a, out), 0);
   if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ifstream in(d / "out" / "cooperative_001.json");
   Json j = Json::parse(in);
@@ -234,18 +234,18 @@ TEST(Network, LatencyJitterAndLossStatistics) {
 // --- description file --------------------------------------------------------------------------------------
 
 TEST(Cooperative001Config, ShippedFileIsThePapersSetUp) {
-  const auto c = harness::load_cooperative_001(harness::cooperative_001_default_file());
+  const auto c = experiments::load_cooperative_001(experiments::cooperative_001_default_file());
   ASSERT_EQ(c.robots.size(), 5u);
   EXPECT_DOUBLE_EQ(c.robots[0].x(), 1.0);
   EXPECT_DOUBLE_EQ(c.robots[4].y(), 3.9);
   EXPECT_EQ(c.path_positions(), 51);  // 2500 mm in 50 mm steps
   EXPECT_NEAR((c.ball_at(50 * c.step_time) - c.ball_end).norm(), 0.0, 1e-12);
   EXPECT_DOUBLE_EQ(c.sigma, 0.192);
-  EXPECT_EQ(c.noise_model, harness::CoopNoiseModel::Polar);
+  EXPECT_EQ(c.noise_model, experiments::CoopNoiseModel::Polar);
   EXPECT_DOUBLE_EQ(c.network.loss, 0.0);
   EXPECT_DOUBLE_EQ(c.lossy_network.loss, 0.2);
   EXPECT_DOUBLE_EQ(c.lossy_network.latency, 0.1);
-  EXPECT_NO_THROW(harness::validate_cooperative_001(harness::cooperative_001_default_file()));
+  EXPECT_NO_THROW(experiments::validate_cooperative_001(experiments::cooperative_001_default_file()));
 }
 
 TEST(Cooperative001Config, BadValuesNameTheirPath) {
@@ -314,14 +314,14 @@ TEST(Cooperative001Experiment, QuickModeWritesFilesWithFiniteNumbers) {
   const fs::path d = temp_dir("quick");
   const fs::path cfg = fs::temp_directory_path() / ("omniloc_coop_direct_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + ".json");
   std::ofstream(cfg) << direct_only().dump(1);
-  harness::ExperimentArgs a;
+  experiments::ExperimentArgs a;
   a.seed = 1;
   a.quick = true;
   a.out_dir = d.string();
   a.config = cfg.string();
   std::ostringstream out;
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(harness::run_cooperative_001(a, out), 0);
+  ASSERT_EQ(experiments::run_cooperative_001(a, out), 0);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_LT(seconds, 15.0);
   for (const char* f : {"cooperative_001.json", "cooperative_001.md", "robots_vs_error.png", "robots_vs_error.csv", "field.png"}) {
@@ -349,7 +349,7 @@ TEST(Cooperative001Experiment, QuickModeWritesFilesWithFiniteNumbers) {
   const fs::path d2 = temp_dir("quick2");
   a.out_dir = d2.string();
   std::ostringstream out2;
-  ASSERT_EQ(harness::run_cooperative_001(a, out2), 0);
+  ASSERT_EQ(experiments::run_cooperative_001(a, out2), 0);
   std::ifstream in2(d2 / "cooperative_001.json");
   const Json j2 = Json::parse(in2);
   EXPECT_EQ(j["headline"], j2["headline"]);

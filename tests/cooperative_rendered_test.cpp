@@ -1,4 +1,4 @@
-// The rendered-image mode of the paper-001 simulation (harness/experiments/cooperative_001_rendered.*):
+// The rendered-image mode of the paper-001 simulation (experiments/cooperative_001_rendered.*):
 // the ball measured in a rendered panorama, and the determinism of the mode under a seed.
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
-#include "harness/experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001.hpp"
 #include "harness/vision_setup.hpp"
 #include "localization/vision/blobs.hpp"
 #include "sim/render/panoramic_camera.hpp"
@@ -23,13 +23,13 @@ namespace fs = std::filesystem;
 namespace {
 
 Json shipped() {
-  std::ifstream in(harness::cooperative_001_default_file());
+  std::ifstream in(experiments::cooperative_001_default_file());
   return Json::parse(in);
 }
 
 std::string parse_error_path(const Json& j) {
   try {
-    harness::parse_cooperative_001(j);
+    experiments::parse_cooperative_001(j);
   } catch (const ConfigError& e) {
     return e.path();
   }
@@ -49,9 +49,9 @@ TEST(CoopRendered, BallCentreDistanceGeometry) {
     const double ang = std::atan2(h - r, D) + std::asin(r / dist);
     const double d = h / std::tan(ang);  // where it meets the floor
     EXPECT_LT(d, D);
-    EXPECT_NEAR(harness::ball_centre_distance(d, h, r), D, 1e-12) << D;
+    EXPECT_NEAR(experiments::ball_centre_distance(d, h, r), D, 1e-12) << D;
   }
-  EXPECT_NEAR(harness::ball_centre_distance(2.0, 0.75, 0.0), 2.0, 1e-15);
+  EXPECT_NEAR(experiments::ball_centre_distance(2.0, 0.75, 0.0), 2.0, 1e-15);
 }
 
 TEST(CoopRendered, ConfigErrorsNameTheirPath) {
@@ -85,17 +85,17 @@ TEST(CoopRendered, ConfigErrorsNameTheirPath) {
     j["rendered"]["bogus"] = 1;
     EXPECT_EQ(parse_error_path(j), "/rendered/bogus");
   }
-  const auto c = harness::parse_cooperative_001(shipped());
+  const auto c = experiments::parse_cooperative_001(shipped());
   ASSERT_TRUE(c.rendered.has_value());
   EXPECT_DOUBLE_EQ(c.rendered->field.length, 6.0);
   EXPECT_DOUBLE_EQ(c.rendered->field.width, 4.0);
-  EXPECT_EQ(c.rendered->pose_source, harness::CoopPoseSource::Matching);
+  EXPECT_EQ(c.rendered->pose_source, experiments::CoopPoseSource::Matching);
 }
 
 // One robot alone on the paper's 6 m x 4 m field, the ball at known robot-frame positions; default
 // camera (vibration and pixel noise on), calibration map and colour table from vision_setup.
 TEST(CoopRendered, SingleFrameBearingAndDistance) {
-  const auto c = harness::parse_cooperative_001(shipped());
+  const auto c = experiments::parse_cooperative_001(shipped());
   const auto& g = *c.rendered;
   sim::PanoramicCamera cam(g.camera, g.field);
   const CalibrationMap map = harness::calibration_for(g.camera, "auto", 1);
@@ -121,7 +121,7 @@ TEST(CoopRendered, SingleFrameBearingAndDistance) {
       w.ball.position = ball;
       w.ball.radius = g.ball_radius;
       const Image img = cam.render(w, 0, g.camera.initial, rng);
-      const auto s = harness::ball_sighting_from_blobs(det.detect(img), g.min_area_px, g.camera.mount_height, g.ball_radius);
+      const auto s = experiments::ball_sighting_from_blobs(det.detect(img), g.min_area_px, g.camera.mount_height, g.ball_radius);
       ASSERT_TRUE(s.seen) << D << " " << beta;
       ASSERT_TRUE(s.has_distance) << D << " " << beta;
       const double be = std::abs(wrap_angle(s.bearing - beta)), de = s.distance - D;
@@ -150,13 +150,13 @@ TEST(CoopRendered, QuickRunIsDeterministicUnderASeed) {
   fs::create_directories(d);
   std::ofstream(d / "description.json") << cfg.dump(1);
   auto run = [&](const std::string& name, std::uint64_t seed) {
-    harness::ExperimentArgs a;
+    experiments::ExperimentArgs a;
     a.seed = seed;
     a.quick = true;
     a.config = (d / "description.json").string();
     a.out_dir = (d / name).string();
     std::ostringstream out;
-    EXPECT_EQ(harness::run_cooperative_001(a, out), 0);
+    EXPECT_EQ(experiments::run_cooperative_001(a, out), 0);
     std::ifstream in(d / name / "cooperative_001.json");
     Json j = Json::parse(in)["rendered"];
     // Timings differ between runs; everything else must not.

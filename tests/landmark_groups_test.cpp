@@ -13,7 +13,7 @@
 #include "core/angles.hpp"
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 #include "localization/landmarks/landmark_groups.hpp"
 
 using namespace omniloc;
@@ -263,13 +263,13 @@ TEST(LandmarkGroups, MemoryRecognisesAGroupAfterAGap) {
 
 TEST(LandmarkMapsExperiment, QuickRunWritesItsFiles) {
   namespace fs = std::filesystem;
-  const harness::ExperimentInfo* info = nullptr;
-  for (const auto& e : harness::experiments())
+  const experiments::ExperimentInfo* info = nullptr;
+  for (const auto& e : experiments::all())
     if (e.name == "landmark_maps") info = &e;
   ASSERT_NE(info, nullptr);
   const fs::path dir = fs::temp_directory_path() / ("omniloc_landmark_maps_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  harness::ExperimentArgs args;
+  experiments::ExperimentArgs args;
   args.seed = 3;
   args.quick = true;
   args.out_dir = dir.string();

@@ -8,7 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/json_reader.hpp"
-#include "harness/experiment.hpp"
+#include "experiments/experiment.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 
@@ -29,7 +29,7 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
         const omniloc::Json j = omniloc::Json::parse(in, nullptr, false);
         const std::string name = j.is_object() && j.contains("experiment") && j["experiment"].is_string() ? j["experiment"].get<std::string>() : "";
         bool found = false;
-        for (const auto& x : omniloc::harness::experiments())
+        for (const auto& x : omniloc::experiments::all())
           if (x.name == name && x.validate) {
             x.validate(e.path().string());
             found = true;

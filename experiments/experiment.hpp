@@ -1,14 +1,16 @@
 #pragma once
 // Experiments that are not a simulated match (solver accuracy maps, the paper-001 cooperative
 // simulation, benchmarks of filters): `omniloc experiment NAME [--seed N] [-o DIR] [--quick]`.
-// Each writes its tables (JSON/CSV) and a printed summary into DIR, atomically.
+// Each writes its tables (JSON/CSV) and a printed summary into DIR, atomically. The layer sits above
+// the harness (apps -> experiments -> harness); each experiment is split into configuration,
+// computation (plain result structs) and report (docs/extending.md, "Add an experiment").
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 struct ExperimentArgs {
   std::uint64_t seed = 1;
@@ -29,7 +31,7 @@ struct ExperimentInfo {
   std::function<void(const std::string& file)> validate = {};
 };
 
-/// All experiments (harness/experiment_registry.cpp holds the list).
-const std::vector<ExperimentInfo>& experiments();
+/// All experiments (experiments/experiment_registry.cpp holds the list).
+const std::vector<ExperimentInfo>& all();
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

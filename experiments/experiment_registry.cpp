@@ -1,15 +1,15 @@
-#include "harness/experiment.hpp"
-#include "harness/experiments/cooperative_001.hpp"
-#include "harness/experiments/entropy_maps.hpp"
-#include "harness/experiments/error_budget.hpp"
-#include "harness/experiments/global_figures.hpp"
-#include "harness/experiments/landmark_maps.hpp"
+#include "experiments/experiment.hpp"
+#include "experiments/cooperative_001.hpp"
+#include "experiments/entropy_maps.hpp"
+#include "experiments/error_budget.hpp"
+#include "experiments/global_figures.hpp"
+#include "experiments/landmark_maps.hpp"
 
 // Add an experiment: include its header and append one line to the list below.
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
-const std::vector<ExperimentInfo>& experiments() {
+const std::vector<ExperimentInfo>& all() {
   static const std::vector<ExperimentInfo> list = {
       {"entropy_maps", "paper 002 figures 6, 10, 11: image entropy over (exposure, gain) under normal light and sun, the auto-adjust search path, frames before / after", run_entropy_maps},
       {"global_figures", "paper 000 figures 7 and 9 (grid-sample errors, RPROP traces) and an MCL particle-cloud sequence", run_global_figures},
@@ -26,4 +26,4 @@ const std::vector<ExperimentInfo>& experiments() {
   return list;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments
