@@ -53,7 +53,7 @@ commands:
                          learn the colour look-up table from labelled renders of the scenario's field
   validate FILE...       check a scenario, a sweep file or an experiment description (scenarios/experiments/);
                          exit 2 with the JSON path of the first problem
-  list                   field presets, motion scripts, localizers, noise profiles, experiments
+  list                   field presets, motion scripts, event kinds, localizers, noise profiles, experiments
   schema [--markdown] [-o FILE]
                          the JSON Schema of scenario files (for editors), or the parameter
                          reference docs/localizers.md generated from the same lists
@@ -110,7 +110,7 @@ const cli::Command kValidate{"validate", "FILE...", 1, 1000000,
                              "its own process and a line \"[exit N] FILE\" (or \"[signal S] FILE\") follows it; the exit\n"
                              "code is then 0 when all passed, 2 when some had input errors, 1 when any failed otherwise.",
                              {}};
-const cli::Command kList{"list", "", 0, 0, "Field presets, motion scripts, localizers, noise profiles, experiments.", {}};
+const cli::Command kList{"list", "", 0, 0, "Field presets, motion scripts, event kinds, localizers, noise profiles, experiments.", {}};
 const cli::Command kSchema{"schema", "", 0, 0, "The JSON Schema of scenario files, or (--markdown) the parameter reference docs/localizers.md.",
                            {{"--markdown", "", "the parameter reference instead of the schema"},
                             {"-o", "FILE", "write to FILE (atomically) instead of standard output"}}};
@@ -367,6 +367,8 @@ int cmd_list() {
   for (const auto& n : sim::MotionScript::types()) std::cout << " " << n;
   std::cout << "\nnoise profiles:";
   for (const auto& n : harness::NoiseProfile::names()) std::cout << " " << n;
+  std::cout << "\nevents:";
+  for (const auto& n : harness::event_type_names()) std::cout << " " << n;
   std::cout << "\nlocalizers:\n";
   for (const auto& l : harness::localizers()) std::cout << "  " << l.type << " - " << l.description << "\n";
   std::cout << "experiments:\n";
