@@ -91,23 +91,25 @@ Slip parse(std::in_place_type_t<Slip>, JsonReader& r, const Json&, const std::st
 
 // --- apply: what the kind does to the running simulation, and what events.jsonl records ------------
 
-void apply(const Teleport& k, const Event& e, Simulation& sim, Json& log) {
+// Teleport and kidnap move the robot alike: to the given pose or one drawn from the stream "events".
+template <class K>
+void move_robot(const K& k, const Event& e, Simulation& sim, Json& log) {
   const Pose2 target = k.random_pose ? sim.random_pose_on_field() : k.pose;
   sim.teleport(e.robot, target);
   log["pose"] = {target.x, target.y, target.theta};
 }
 
-void apply(const Kidnap& k, const Event& e, Simulation& sim, Json& log) {
-  const Pose2 target = k.random_pose ? sim.random_pose_on_field() : k.pose;
-  sim.teleport(e.robot, target);
-  sim.cover_camera(e.robot, sim.time() + k.duration);
-  log["pose"] = {target.x, target.y, target.theta};
-  log["duration"] = k.duration;
-}
+void apply(const Teleport& k, const Event& e, Simulation& sim, Json& log) { move_robot(k, e, sim, log); }
 
 void apply(const Cover& k, const Event& e, Simulation& sim, Json& log) {
   sim.cover_camera(e.robot, sim.time() + k.duration);
   log["duration"] = k.duration;
+}
+
+// A kidnap is a teleport under a covered camera.
+void apply(const Kidnap& k, const Event& e, Simulation& sim, Json& log) {
+  move_robot(k, e, sim, log);
+  apply(Cover{k.duration}, e, sim, log);
 }
 
 void apply(const Occlude& k, const Event& e, Simulation& sim, Json& log) {

@@ -10,7 +10,6 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "harness/camera_perception.hpp"
-#include "harness/vision_setup.hpp"
 #include "harness/simulation.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
