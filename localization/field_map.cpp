@@ -11,13 +11,14 @@
 
 namespace omniloc {
 
-FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir) : cell_(cell), fingerprint_(field.fingerprint()) {
+FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir) : fingerprint_(field.fingerprint()) {
   // Cover the floor inside the walls plus a cell.
   const double hx = field.half_floor_x() + cell, hy = field.half_floor_y() + cell;
   nx_ = static_cast<int>(std::ceil(2 * hx / cell)) + 1;
   ny_ = static_cast<int>(std::ceil(2 * hy / cell)) + 1;
-  x0_ = -hx;
-  y0_ = -hy;
+  const double x0 = -hx, y0 = -hy;
+  grid_.resize(static_cast<std::size_t>(nx_) * ny_);
+  table_ = Table{grid_.data(), nx_, x0, y0, 1.0 / cell, cell, nx_ - 1.0, ny_ - 1.0};
   std::ostringstream name;
   name << "fieldmap_" << fingerprint_ << "_" << std::lround(cell * 1e4) << ".bin";
   const std::string file = cache_dir.empty() ? "" : (std::filesystem::path(cache_dir) / name.str()).string();
@@ -29,20 +30,22 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
     std::string line;
     std::getline(in, line);
     if (line + "\n" == header.str()) {
-      grid_.resize(static_cast<std::size_t>(nx_) * ny_);
-      in.read(reinterpret_cast<char*>(grid_.data()), static_cast<std::streamsize>(grid_.size() * sizeof(float)));
-      if (in.gcount() == static_cast<std::streamsize>(grid_.size() * sizeof(float))) {
+      std::vector<float> stored(grid_.size());
+      in.read(reinterpret_cast<char*>(stored.data()), static_cast<std::streamsize>(stored.size() * sizeof(float)));
+      if (in.gcount() == static_cast<std::streamsize>(stored.size() * sizeof(float))) {
+        std::copy(stored.begin(), stored.end(), grid_.begin());
         from_cache_ = true;
         return;
       }
     }
   }
-  grid_.resize(static_cast<std::size_t>(nx_) * ny_);
   for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) grid_[static_cast<std::size_t>(j) * nx_ + i] = static_cast<float>(field.distance_to_marking({x0_ + i * cell, y0_ + j * cell}));
+    for (int i = 0; i < nx_; ++i) grid_[static_cast<std::size_t>(j) * nx_ + i] = static_cast<float>(field.distance_to_marking({x0 + i * cell, y0 + j * cell}));
+  // Cached or not, the table holds the same float values.
   if (!file.empty()) {
     std::string out = header.str();
-    out.append(reinterpret_cast<const char*>(grid_.data()), grid_.size() * sizeof(float));
+    const std::vector<float> stored(grid_.begin(), grid_.end());
+    out.append(reinterpret_cast<const char*>(stored.data()), stored.size() * sizeof(float));
     try {
       write_file_atomic(file, out);
     } catch (const std::exception&) {
@@ -51,15 +54,20 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   }
 }
 
-double FieldMap::distance(const Eigen::Vector2d& p) const { return distance(p, nullptr); }
-
-void FieldMap::off_table(double dx, double dy, double* d, Eigen::Vector2d* g) const {
-  // Same arithmetic as before the fast path was split off, so results stay byte-identical.
-  const double out = std::hypot(dx * cell_, dy * cell_);
+FieldMap::Sample FieldMap::Table::off_table(Table t, double fx, double fy, bool gradient) {
+  // Just inside the last row / column, so the cell (i, i + 1) exists (1e-6 cells = 50 nm).
+  const double cx = std::clamp(fx, 0.0, t.last_x - 0.000001), cy = std::clamp(fy, 0.0, t.last_y - 0.000001);
+  Sample s = gradient ? t.interpolate<true>(cx, cy) : t.interpolate<false>(cx, cy);
+  const double dx = fx - cx, dy = fy - cy;  // cells
+  const double out = std::hypot(dx, dy);
   if (out > 0) {
-    *d += out;  // off the table: farther from everything
-    if (g) *g = Eigen::Vector2d(dx * cell_, dy * cell_) / out;
+    s.d += out * t.cell;  // off the table: farther from everything
+    if (gradient) {
+      s.gx = dx / out * t.cell;
+      s.gy = dy / out * t.cell;
+    }
   }
+  return s;
 }
 
 }  // namespace omniloc

@@ -3,6 +3,7 @@
 // world point to the nearest field line), with its gradient. Built once per field and cell size from
 // the analytic field model and cached on disk.
 #include <algorithm>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -14,40 +15,93 @@ namespace omniloc {
 
 class FieldMap {
  public:
+  /// The table as plain values: what a hot loop copies into a local (`const auto t = map.table()`)
+  /// so the compiler keeps the geometry in registers instead of reloading it around every lookup
+  /// (issue 20: the matcher's loop reloaded seven members per point).
+  /// A lookup's result: distance (metres) and, when asked for, its gradient (d/dx, d/dy).
+  struct Sample {
+    double d, gx, gy;
+  };
+  /// The table as plain values: what a hot loop copies into a local (`const auto t = map.table()`)
+  /// so the compiler keeps the geometry in registers instead of reloading it around every lookup
+  /// (issue 20: the matcher's loop reloaded seven members per point). Results are returned by
+  /// value for the same reason: an out-pointer into the loop would pin its variables to memory.
+  struct Table {
+    const double* cells;     // row-major, nx per row (metres)
+    std::ptrdiff_t nx;
+    double x0, y0;           // world position (metres) of cell (0, 0)'s centre
+    double inv_cell, cell;   // 1 / metres, metres
+    double last_x, last_y;   // nx - 1, ny - 1: the fast path's bounds (cells)
+    /// At world point (x, y) (metres); the gradient (per metre) only with kGradient, else 0.
+    template <bool kGradient>
+    Sample at(double x, double y) const {
+      Sample s = at_cells<kGradient>((x - x0) * inv_cell, (y - y0) * inv_cell);
+      if constexpr (kGradient) {
+        s.gx *= inv_cell;
+        s.gy *= inv_cell;
+      }
+      return s;
+    }
+    /// At table position (fx, fy) = ((x - x0) / cell, (y - y0) / cell); the gradient per cell
+    /// (metres of distance per cell of motion). Hot loops work in these units: the rotation and
+    /// the scaling fold into one multiplication per coordinate. One range test instead of two
+    /// clamps; off the table (or on its last row / column) the out-of-line path.
+    template <bool kGradient>
+    Sample at_cells(double fx, double fy) const {
+      if (!(fx >= 0.0 && fy >= 0.0 && fx < last_x && fy < last_y)) [[unlikely]]
+        return off_table(*this, fx, fy, kGradient);
+      return interpolate<kGradient>(fx, fy);
+    }
+    /// The bilinear interpolant at a table position inside [0, nx - 1) x [0, ny - 1).
+    template <bool kGradient>
+    Sample interpolate(double cx, double cy) const {
+      const int i = static_cast<int>(cx), j = static_cast<int>(cy);
+      const double ax = cx - i, ay = cy - j;
+      const double* row = cells + j * nx + i;
+      const double d00 = row[0], d10 = row[1], d01 = row[nx], d11 = row[nx + 1];
+      // Horner form: along x on both rows, then between the rows.
+      const double dx0 = d10 - d00, dx1 = d11 - d01;
+      const double lo = d00 + ax * dx0, hi = d01 + ax * dx1;
+      if constexpr (kGradient) return {lo + ay * (hi - lo), dx0 + ay * (dx1 - dx0), hi - lo};
+      return {lo + ay * (hi - lo), 0.0, 0.0};
+    }
+    /// Off the table by table position (fx, fy): the interpolant at the nearest table point plus
+    /// the distance to the table, the gradient (per cell) pointing away from it. The table by
+    /// value, so a caller's local copy never escapes.
+    static Sample off_table(Table t, double fx, double fy, bool gradient);
+  };
+
   /// cell: metres (Tribots: 50 mm). `cache_dir`: where to keep the table ("" = no cache).
   FieldMap(const Field& field, double cell = 0.05, const std::string& cache_dir = "");
+  // table_ points into grid_: a copy re-points it, a move keeps the buffer and so the pointer.
+  FieldMap(const FieldMap& o) : nx_(o.nx_), ny_(o.ny_), grid_(o.grid_), table_(o.table_), fingerprint_(o.fingerprint_), from_cache_(o.from_cache_) {
+    table_.cells = grid_.data();
+  }
+  FieldMap& operator=(const FieldMap& o) {
+    if (this != &o) *this = FieldMap(o);
+    return *this;
+  }
+  FieldMap(FieldMap&&) noexcept = default;
+  FieldMap& operator=(FieldMap&&) noexcept = default;
   /// Distance (metres) to the nearest marking centre line, bilinear between cell centres. Off the
   /// table: the border value plus the distance to the table.
-  double distance(const Eigen::Vector2d& p) const;
+  double distance(const Eigen::Vector2d& p) const { return table_.at<false>(p.x(), p.y()).d; }
   /// Distance and its gradient (d/dx, d/dy) of the same bilinear interpolant.
-  /// Inline because the matcher and MCL call it ~10^5 times per frame: the call and a std::hypot on
-  /// every lookup cost more than the interpolation (issue 20: 17.6 ns per lookup before).
   double distance(const Eigen::Vector2d& p, Eigen::Vector2d* gradient) const {
-    const double fx = (p.x() - x0_) / cell_, fy = (p.y() - y0_) / cell_;
-    const double cx = std::clamp(fx, 0.0, nx_ - 1.000001), cy = std::clamp(fy, 0.0, ny_ - 1.000001);
-    const int i = static_cast<int>(cx), j = static_cast<int>(cy);
-    const double ax = cx - i, ay = cy - j;
-    const float* row = grid_.data() + static_cast<std::size_t>(j) * nx_ + i;
-    const double d00 = row[0], d10 = row[1], d01 = row[nx_], d11 = row[nx_ + 1];
-    double d = (1 - ay) * ((1 - ax) * d00 + ax * d10) + ay * ((1 - ax) * d01 + ax * d11);
-    if (gradient) {
-      gradient->x() = ((1 - ay) * (d10 - d00) + ay * (d11 - d01)) / cell_;
-      gradient->y() = ((1 - ax) * (d01 - d00) + ax * (d11 - d10)) / cell_;
-    }
-    if (fx != cx || fy != cy) off_table(fx - cx, fy - cy, &d, gradient);
-    return d;
+    if (!gradient) return distance(p);
+    const Sample s = table_.at<true>(p.x(), p.y());
+    *gradient = Eigen::Vector2d(s.gx, s.gy);
+    return s.d;
   }
-  double cell() const { return cell_; }
+  const Table& table() const { return table_; }
+  double cell() const { return table_.cell; }
   const std::string& field_fingerprint() const { return fingerprint_; }
   bool loaded_from_cache() const { return from_cache_; }
 
  private:
-  /// Off the table by (dx, dy) cells: adds the distance to the table and points the gradient away.
-  void off_table(double dx, double dy, double* d, Eigen::Vector2d* gradient) const;
-  double cell_;
-  double x0_, y0_;  // world position of cell (0, 0)'s centre
   int nx_, ny_;
-  std::vector<float> grid_;
+  std::vector<double> grid_;  // the cached floats, widened: no conversion in the lookups
+  Table table_{};
   std::string fingerprint_;
   bool from_cache_ = false;
 };
