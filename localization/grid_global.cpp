@@ -56,11 +56,13 @@ GridSearchRecord grid_search(const Field& field, const FieldMap& map, const std:
   const double x_lo = -0.5 * field.length - p.outside, y_lo = -0.5 * field.width - p.outside;
   const int nx = static_cast<int>(std::floor((field.length + 2 * p.outside) / p.spacing + 1e-9)) + 1;
   const int ny = static_cast<int>(std::floor((field.width + 2 * p.outside) / p.spacing + 1e-9)) + 1;
-  // The points rotated once into the world orientation: E_k then needs only a translation per sample.
+  // The points rotated once into the world orientation and scaled to distance-map cells: E_k then
+  // needs only a translation per sample (the table a local, so its fields stay in registers).
+  const FieldMap::Table t = map.table();
   const double c = std::cos(heading), s = std::sin(heading), c2 = p.c_grid * p.c_grid;
   std::vector<Eigen::Vector2d> rotated;
   rotated.reserve(grid_pts.size());
-  for (const auto& o : grid_pts) rotated.emplace_back(c * o.x() - s * o.y(), s * o.x() + c * o.y());
+  for (const auto& o : grid_pts) rotated.emplace_back((c * o.x() - s * o.y()) * t.inv_cell, (s * o.x() + c * o.y()) * t.inv_cell);
   MatchingParams refine = p.matching;
   refine.c_start = std::max(refine.c, p.refine_c_start);
 
@@ -71,8 +73,9 @@ GridSearchRecord grid_search(const Field& field, const FieldMap& map, const std:
       for (int i = 0; i < nx; ++i) {
         GridSearchRecord::Sample smp{x_lo + i * p.spacing + off, y_lo + j * p.spacing + off, 0.0, pass};
         double e = 0;
+        const double px = (smp.x - t.x0) * t.inv_cell, py = (smp.y - t.y0) * t.inv_cell;
         for (const auto& w : rotated) {
-          const double d = map.distance({smp.x + w.x(), smp.y + w.y()});
+          const double d = t.at_cells<false>(px + w.x(), py + w.y()).d;
           e += 1.0 - c2 / (c2 + d * d);
         }
         smp.error = rotated.empty() ? 1.0 : e / static_cast<double>(rotated.size());
