@@ -66,41 +66,52 @@ namespace {
 // and the constant factors are applied once after the loop. A template so the error-only passes
 // carry no per-point test for the gradient (issue 20: the loop is the matcher's whole cost).
 // Positions are in table cells: the rotation and the scaling by 1 / cell are one multiplication.
-struct DataTerm {
-  double sum_inv = 0, gx = 0, gy = 0, gt = 0;  // sums of 1 / den and de / dd x gradient (per cell)
+struct Terms {
+  double inv = 0, gx = 0, gy = 0, gt = 0;  // 1 / den and de / dd x gradient (per cell), or their sums
+  void operator+=(const Terms& o) {
+    inv += o.inv;
+    gx += o.gx;
+    gy += o.gy;
+    gt += o.gt;
+  }
 };
 
+// One point's terms. Always inlined: an out-of-line call here would let the caller's locals (the
+// table, the sums) escape and be reloaded from memory on every point.
 template <bool kGradient>
-void add_point(const FieldMap::Table& t, double c2, double rx, double ry, double px, double py, DataTerm* s) {
+[[gnu::always_inline]] inline Terms point_terms(const FieldMap::Table& t, double c2, double rx, double ry, double px, double py) {
   // r: the point rotated into the world frame (cells); d(point) / dtheta = (-r.y, r.x).
   const FieldMap::Sample m = t.at_cells<kGradient>(px + rx, py + ry);
-  const double inv = 1.0 / (c2 + m.d * m.d);
-  s->sum_inv += inv;
+  Terms u;
+  u.inv = 1.0 / (c2 + m.d * m.d);
   if constexpr (kGradient) {
-    const double de = m.d * inv * inv;
-    s->gx += de * m.gx;
-    s->gy += de * m.gy;
-    s->gt += de * (m.gy * rx - m.gx * ry);  // cells cancel: gradient per cell x cells
+    const double de = m.d * u.inv * u.inv;
+    u.gx = de * m.gx;
+    u.gy = de * m.gy;
+    u.gt = de * (m.gy * rx - m.gx * ry);  // cells cancel: gradient per cell x cells
   }
+  return u;
 }
 
 template <bool kGradient>
-double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
+[[gnu::always_inline]] inline double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
   const FieldMap::Table t = map.table();
   const double c2 = c * c, a = std::cos(q.z()) * t.inv_cell, b = std::sin(q.z()) * t.inv_cell;
   const double px = (q.x() - t.x0) * t.inv_cell, py = (q.y() - t.y0) * t.inv_cell;
-  DataTerm s;
+  const Eigen::Vector2d* P = pts.data();
+  const std::size_t n = pts.size();
+  Terms s;
   std::size_t k = 0;
 #if defined(__SSE2__)
-  // Two points per step in SSE2 lanes (every x86-64 has them): the same operations as add_point,
+  // Two points per step in SSE2 lanes (every x86-64 has them): the same operations as point_terms,
   // lane by lane, so each point's terms are bit-identical; only the order of the sums differs
   // (even and odd points summed apart, then added). A pair with a point off the table goes
-  // through add_point.
+  // through point_terms.
   __m128d v_inv = _mm_setzero_pd(), v_gx = _mm_setzero_pd(), v_gy = _mm_setzero_pd(), v_gt = _mm_setzero_pd();
   const __m128d va = _mm_set1_pd(a), vb = _mm_set1_pd(b), vpx = _mm_set1_pd(px), vpy = _mm_set1_pd(py);
   const __m128d vlx = _mm_set1_pd(t.last_x), vly = _mm_set1_pd(t.last_y), vc2 = _mm_set1_pd(c2), one = _mm_set1_pd(1.0), zero = _mm_setzero_pd();
-  for (; k + 1 < pts.size(); k += 2) {
-    const __m128d p0 = _mm_loadu_pd(pts[k].data()), p1 = _mm_loadu_pd(pts[k + 1].data());
+  for (; k + 1 < n; k += 2) {
+    const __m128d p0 = _mm_loadu_pd(P[k].data()), p1 = _mm_loadu_pd(P[k + 1].data());
     const __m128d ox = _mm_unpacklo_pd(p0, p1), oy = _mm_unpackhi_pd(p0, p1);
     const __m128d rx = _mm_sub_pd(_mm_mul_pd(va, ox), _mm_mul_pd(vb, oy));
     const __m128d ry = _mm_add_pd(_mm_mul_pd(vb, ox), _mm_mul_pd(va, oy));
@@ -110,8 +121,8 @@ double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, c
       alignas(16) double rxs[2], rys[2];
       _mm_store_pd(rxs, rx);
       _mm_store_pd(rys, ry);
-      add_point<kGradient>(t, c2, rxs[0], rys[0], px, py, &s);
-      add_point<kGradient>(t, c2, rxs[1], rys[1], px, py, &s);
+      s += point_terms<kGradient>(t, c2, rxs[0], rys[0], px, py);
+      s += point_terms<kGradient>(t, c2, rxs[1], rys[1], px, py);
       continue;
     }
     const __m128i ij_x = _mm_cvttpd_epi32(fx), ij_y = _mm_cvttpd_epi32(fy);  // truncation = floor: fx, fy >= 0
@@ -136,19 +147,22 @@ double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, c
     }
   }
   const auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
-  s.sum_inv += lanes(v_inv);
+  s.inv += lanes(v_inv);
   s.gx += lanes(v_gx);
   s.gy += lanes(v_gy);
   s.gt += lanes(v_gt);
 #endif
-  for (; k < pts.size(); ++k) {
-    const auto& o = pts[k];
-    add_point<kGradient>(t, c2, a * o.x() - b * o.y(), b * o.x() + a * o.y(), px, py, &s);
-  }
+  for (; k < n; ++k) s += point_terms<kGradient>(t, c2, a * P[k].x() - b * P[k].y(), b * P[k].x() + a * P[k].y(), px, py);
   if constexpr (kGradient) *grad = 2.0 * c2 * Eigen::Vector3d(s.gx * t.inv_cell, s.gy * t.inv_cell, s.gt);
-  return static_cast<double>(pts.size()) - c2 * s.sum_inv;
+  return static_cast<double>(n) - c2 * s.inv;
 }
 
+// Compiled twice where the compiler can (GCC on x86-64): for AVX2 machines, whose three-operand
+// instructions drop most of SSE2's register copies, and for any x86-64; picked once at load time.
+// Neither version contracts to FMA (AVX2 alone does not enable it), so both give the same bits.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
   return grad ? data_term<true>(map, pts, q, c, grad) : data_term<false>(map, pts, q, c, nullptr);
 }
