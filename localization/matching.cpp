@@ -3,11 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <Eigen/Dense>
+
+#include "localization/match_data_term.hpp"
 
 namespace omniloc {
 
@@ -59,119 +57,9 @@ std::vector<Eigen::Vector2d> subsample(const std::vector<Eigen::Vector2d>& pts, 
   return out;
 }
 
-namespace {
-
-// Data term sum e(d) = sum 1 - c^2 / (c^2 + d^2) over the points and, with a gradient, its
-// derivatives over (x, y, theta). One division per point: e sums c^2 / den, de / dd = 2 c^2 d / den^2
-// and the constant factors are applied once after the loop. A template so the error-only passes
-// carry no per-point test for the gradient (issue 20: the loop is the matcher's whole cost).
-// Positions are in table cells: the rotation and the scaling by 1 / cell are one multiplication.
-struct Terms {
-  double inv = 0, gx = 0, gy = 0, gt = 0;  // 1 / den and de / dd x gradient (per cell), or their sums
-  void operator+=(const Terms& o) {
-    inv += o.inv;
-    gx += o.gx;
-    gy += o.gy;
-    gt += o.gt;
-  }
-};
-
-// One point's terms. Always inlined: an out-of-line call here would let the caller's locals (the
-// table, the sums) escape and be reloaded from memory on every point.
-template <bool kGradient>
-[[gnu::always_inline]] inline Terms point_terms(const FieldMap::Table& t, double c2, double rx, double ry, double px, double py) {
-  // r: the point rotated into the world frame (cells); d(point) / dtheta = (-r.y, r.x).
-  const FieldMap::Sample m = t.at_cells<kGradient>(px + rx, py + ry);
-  Terms u;
-  u.inv = 1.0 / (c2 + m.d * m.d);
-  if constexpr (kGradient) {
-    const double de = m.d * u.inv * u.inv;
-    u.gx = de * m.gx;
-    u.gy = de * m.gy;
-    u.gt = de * (m.gy * rx - m.gx * ry);  // cells cancel: gradient per cell x cells
-  }
-  return u;
-}
-
-template <bool kGradient>
-[[gnu::always_inline]] inline double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
-  const FieldMap::Table t = map.table();
-  const double c2 = c * c, a = std::cos(q.z()) * t.inv_cell, b = std::sin(q.z()) * t.inv_cell;
-  const double px = (q.x() - t.x0) * t.inv_cell, py = (q.y() - t.y0) * t.inv_cell;
-  const Eigen::Vector2d* P = pts.data();
-  const std::size_t n = pts.size();
-  Terms s;
-  std::size_t k = 0;
-#if defined(__SSE2__)
-  // Two points per step in SSE2 lanes (every x86-64 has them): the same operations as point_terms,
-  // lane by lane, so each point's terms are bit-identical; only the order of the sums differs
-  // (even and odd points summed apart, then added). A pair with a point off the table goes
-  // through point_terms.
-  __m128d v_inv = _mm_setzero_pd(), v_gx = _mm_setzero_pd(), v_gy = _mm_setzero_pd(), v_gt = _mm_setzero_pd();
-  const __m128d va = _mm_set1_pd(a), vb = _mm_set1_pd(b), vpx = _mm_set1_pd(px), vpy = _mm_set1_pd(py);
-  const __m128d vlx = _mm_set1_pd(t.last_x), vly = _mm_set1_pd(t.last_y), vc2 = _mm_set1_pd(c2), one = _mm_set1_pd(1.0), zero = _mm_setzero_pd();
-  for (; k + 1 < n; k += 2) {
-    const __m128d p0 = _mm_loadu_pd(P[k].data()), p1 = _mm_loadu_pd(P[k + 1].data());
-    const __m128d ox = _mm_unpacklo_pd(p0, p1), oy = _mm_unpackhi_pd(p0, p1);
-    const __m128d rx = _mm_sub_pd(_mm_mul_pd(va, ox), _mm_mul_pd(vb, oy));
-    const __m128d ry = _mm_add_pd(_mm_mul_pd(vb, ox), _mm_mul_pd(va, oy));
-    const __m128d fx = _mm_add_pd(vpx, rx), fy = _mm_add_pd(vpy, ry);
-    const __m128d on = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(fx, zero), _mm_cmpge_pd(fy, zero)), _mm_and_pd(_mm_cmplt_pd(fx, vlx), _mm_cmplt_pd(fy, vly)));
-    if (_mm_movemask_pd(on) != 3) [[unlikely]] {
-      alignas(16) double rxs[2], rys[2];
-      _mm_store_pd(rxs, rx);
-      _mm_store_pd(rys, ry);
-      s += point_terms<kGradient>(t, c2, rxs[0], rys[0], px, py);
-      s += point_terms<kGradient>(t, c2, rxs[1], rys[1], px, py);
-      continue;
-    }
-    const __m128i ij_x = _mm_cvttpd_epi32(fx), ij_y = _mm_cvttpd_epi32(fy);  // truncation = floor: fx, fy >= 0
-    const __m128d ax = _mm_sub_pd(fx, _mm_cvtepi32_pd(ij_x)), ay = _mm_sub_pd(fy, _mm_cvtepi32_pd(ij_y));
-    const double* r0 = t.cells + _mm_cvtsi128_si32(ij_y) * t.nx + _mm_cvtsi128_si32(ij_x);
-    const double* r1 = t.cells + _mm_cvtsi128_si32(_mm_shuffle_epi32(ij_y, 1)) * t.nx + _mm_cvtsi128_si32(_mm_shuffle_epi32(ij_x, 1));
-    const __m128d top0 = _mm_loadu_pd(r0), bot0 = _mm_loadu_pd(r0 + t.nx), top1 = _mm_loadu_pd(r1), bot1 = _mm_loadu_pd(r1 + t.nx);
-    const __m128d d00 = _mm_unpacklo_pd(top0, top1), d10 = _mm_unpackhi_pd(top0, top1);
-    const __m128d d01 = _mm_unpacklo_pd(bot0, bot1), d11 = _mm_unpackhi_pd(bot0, bot1);
-    const __m128d dx0 = _mm_sub_pd(d10, d00), dx1 = _mm_sub_pd(d11, d01);
-    const __m128d lo = _mm_add_pd(d00, _mm_mul_pd(ax, dx0)), hi = _mm_add_pd(d01, _mm_mul_pd(ax, dx1));
-    const __m128d hl = _mm_sub_pd(hi, lo);
-    const __m128d d = _mm_add_pd(lo, _mm_mul_pd(ay, hl));
-    const __m128d inv = _mm_div_pd(one, _mm_add_pd(vc2, _mm_mul_pd(d, d)));
-    v_inv = _mm_add_pd(v_inv, inv);
-    if constexpr (kGradient) {
-      const __m128d gx = _mm_add_pd(dx0, _mm_mul_pd(ay, _mm_sub_pd(dx1, dx0))), gy = hl;
-      const __m128d de = _mm_mul_pd(_mm_mul_pd(d, inv), inv);
-      v_gx = _mm_add_pd(v_gx, _mm_mul_pd(de, gx));
-      v_gy = _mm_add_pd(v_gy, _mm_mul_pd(de, gy));
-      v_gt = _mm_add_pd(v_gt, _mm_mul_pd(de, _mm_sub_pd(_mm_mul_pd(gy, rx), _mm_mul_pd(gx, ry))));
-    }
-  }
-  const auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
-  s.inv += lanes(v_inv);
-  s.gx += lanes(v_gx);
-  s.gy += lanes(v_gy);
-  s.gt += lanes(v_gt);
-#endif
-  for (; k < n; ++k) s += point_terms<kGradient>(t, c2, a * P[k].x() - b * P[k].y(), b * P[k].x() + a * P[k].y(), px, py);
-  if constexpr (kGradient) *grad = 2.0 * c2 * Eigen::Vector3d(s.gx * t.inv_cell, s.gy * t.inv_cell, s.gt);
-  return static_cast<double>(n) - c2 * s.inv;
-}
-
-// Compiled twice where the compiler can (GCC on x86-64): for AVX2 machines, whose three-operand
-// instructions drop most of SSE2's register copies, and for any x86-64; picked once at load time.
-// Neither version contracts to FMA (AVX2 alone does not enable it), so both give the same bits.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-double data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
-  return grad ? data_term<true>(map, pts, q, c, grad) : data_term<false>(map, pts, q, c, nullptr);
-}
-
-}  // namespace
-
 double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& pose, double c) {
   if (pts.empty()) return 1.0;
-  return data_term(map, pts, {pose.x, pose.y, pose.theta}, c, nullptr) / pts.size();
+  return match_data_term(map, pts, {pose.x, pose.y, pose.theta}, c, nullptr) / pts.size();
 }
 
 MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& start, const MatchingParams& p,
@@ -201,8 +89,8 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     prev.setZero();
     while (r.iterations < end) {
       Eigen::Vector3d g;
-      data_term(map, pts, q, c, &g);
-      if (trace) trace->push_back(pts.empty() ? 1.0 : data_term(map, pts, q, p.c, nullptr) / pts.size());
+      match_data_term(map, pts, q, c, &g);
+      if (trace) trace->push_back(pts.empty() ? 1.0 : match_data_term(map, pts, q, p.c, nullptr) / pts.size());
       if (prior_theta && p.heading_prior > 0) g.z() += 2.0 * p.heading_prior * angle_diff(q.z(), *prior_theta);
       for (int k = 0; k < 3; ++k) {
         // iRPROP-: on a sign change shrink the step and skip this update.
@@ -223,7 +111,7 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     }
   }
   r.pose = Pose2(q.x(), q.y(), q.z());
-  r.error = pts.empty() ? 1.0 : data_term(map, pts, q, p.c, nullptr) / pts.size();
+  r.error = pts.empty() ? 1.0 : match_data_term(map, pts, q, p.c, nullptr) / pts.size();
   if (trace) trace->push_back(r.error);
   // Curvature of the data term by central differences of its gradient. Near the optimum
   // e(d) ~ d^2 / c^2, so the Gauss-Newton information of points with noise sigma is H c^2 / (2 sigma^2).
@@ -233,8 +121,8 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     Eigen::Vector3d qp = q, qm = q, gp, gm;
     qp[k] += h[k];
     qm[k] -= h[k];
-    data_term(map, pts, qp, p.c, &gp);
-    data_term(map, pts, qm, p.c, &gm);
+    match_data_term(map, pts, qp, p.c, &gp);
+    match_data_term(map, pts, qm, p.c, &gm);
     H.col(k) = (gp - gm) / (2 * h[k]);
   }
   H = 0.5 * (H + H.transpose()).eval();
