@@ -18,7 +18,7 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   ny_ = static_cast<int>(std::ceil(2 * hy / cell)) + 1;
   const double x0 = -hx, y0 = -hy;
   grid_.resize(static_cast<std::size_t>(nx_) * ny_);
-  table_ = Table{grid_.data(), nx_, x0, y0, 1.0 / cell, cell, nx_ - 1.0, ny_ - 1.0};
+  table_ = Table{grid_.data(), nx_, x0, y0, 1.0 / cell, cell, nx_ - 1.0, ny_ - 1.0, static_cast<unsigned>(nx_ - 1), static_cast<unsigned>(ny_ - 1)};
   std::ostringstream name;
   name << "fieldmap_" << fingerprint_ << "_" << std::lround(cell * 1e4) << ".bin";
   const std::string file = cache_dir.empty() ? "" : (std::filesystem::path(cache_dir) / name.str()).string();

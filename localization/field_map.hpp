@@ -32,6 +32,7 @@ class FieldMap {
     double x0, y0;           // world position (metres) of cell (0, 0)'s centre
     double inv_cell, cell;   // 1 / metres, metres
     double last_x, last_y;   // nx - 1, ny - 1: the fast path's bounds (cells)
+    unsigned last_i, last_j; // the same as cell indices
     /// At world point (x, y) (metres); the gradient (per metre) only with kGradient, else 0.
     template <bool kGradient>
     Sample at(double x, double y) const {
@@ -48,14 +49,22 @@ class FieldMap {
     /// clamps; off the table (or on its last row / column) the out-of-line path.
     template <bool kGradient>
     Sample at_cells(double fx, double fy) const {
-      if (!(fx >= 0.0 && fy >= 0.0 && fx < last_x && fy < last_y)) [[unlikely]]
+      // On the table iff 0 <= fx < nx - 1 and 0 <= fy < ny - 1: the cell indices (truncated) as
+      // unsigned below nx - 1, ny - 1 (a negative index or NaN's INT_MIN wraps above), and the
+      // smaller coordinate not negative (fx in (-1, 0) truncates to 0).
+      const int i = static_cast<int>(fx), j = static_cast<int>(fy);
+      if (!(static_cast<unsigned>(i) < last_i && static_cast<unsigned>(j) < last_j && std::min(fx, fy) >= 0.0)) [[unlikely]]
         return off_table(*this, fx, fy, kGradient);
-      return interpolate<kGradient>(fx, fy);
+      return interpolate<kGradient>(fx, fy, i, j);
     }
     /// The bilinear interpolant at a table position inside [0, nx - 1) x [0, ny - 1).
     template <bool kGradient>
     Sample interpolate(double cx, double cy) const {
-      const int i = static_cast<int>(cx), j = static_cast<int>(cy);
+      return interpolate<kGradient>(cx, cy, static_cast<int>(cx), static_cast<int>(cy));
+    }
+    /// The same with the cell (i, j) = (floor(cx), floor(cy)) known.
+    template <bool kGradient>
+    Sample interpolate(double cx, double cy, int i, int j) const {
       const double ax = cx - i, ay = cy - j;
       const double* row = cells + j * nx + i;
       const double d00 = row[0], d10 = row[1], d01 = row[nx], d11 = row[nx + 1];
