@@ -8,6 +8,7 @@
 #include <span>
 
 #include "core/angles.hpp"
+#include "core/fast_trig.hpp"
 #include "localization/landmarks/landmark_fix.hpp"
 
 namespace omniloc::landmarks::detail {
@@ -53,9 +54,10 @@ inline bool triple_ok(std::span<const BearingObs> obs, double& far2) {
 /// So reliability = |det(M)| / sqrt(sum of the three squared gradient differences): one division
 /// and one square root instead of a general 3 x 3 inverse. 0 when singular.
 inline double triple_reliability(const Eigen::Vector2d d[3], const double r2[3]) {
-  const double gx0 = d[0].y() / r2[0], gy0 = -d[0].x() / r2[0];
-  const double gx1 = d[1].y() / r2[1], gy1 = -d[1].x() / r2[1];
-  const double gx2 = d[2].y() / r2[2], gy2 = -d[2].x() / r2[2];
+  const double i0 = 1.0 / r2[0], i1 = 1.0 / r2[1], i2 = 1.0 / r2[2];
+  const double gx0 = d[0].y() * i0, gy0 = -d[0].x() * i0;
+  const double gx1 = d[1].y() * i1, gy1 = -d[1].x() * i1;
+  const double gx2 = d[2].y() * i2, gy2 = -d[2].x() * i2;
   const double ux = gx1 - gx0, uy = gy1 - gy0;
   const double vx = gx2 - gx0, vy = gy2 - gy0;
   const double wx = gx2 - gx1, wy = gy2 - gy1;
@@ -93,8 +95,8 @@ inline Fix finish_triple(std::span<const BearingObs> obs, const double c[3], con
   f.pose.x = P.x();
   f.pose.y = P.y();
   // atan2 is in [-pi, pi]; Pose2's (-pi, pi] needs only -pi mapped to pi (no fmod, and no rounding
-  // of the round trip through wrap_angle).
-  const double theta = std::atan2(sy, sx);
+  // of the round trip through wrap_angle). atan2_fast: branch-free, within ~2 ulp of libm's.
+  const double theta = atan2_fast(sy, sx);
   f.pose.theta = theta == -kPi ? kPi : theta;
   f.reliability = rel;
   return f;
