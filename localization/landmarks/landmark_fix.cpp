@@ -129,7 +129,7 @@ Fix finish_fix(std::span<const BearingObs> obs, std::span<const Eigen::Vector2d>
       c[i] = dirs.empty() ? std::cos(obs[i].bearing) : dirs[i].x();
       s[i] = dirs.empty() ? std::sin(obs[i].bearing) : dirs[i].y();
     }
-    return detail::finish_triple(obs, c, s, position, scale);
+    return detail::finish_triple(obs, c, s, 0.0, position, scale * scale);
   }
   if (!std::isfinite(position.x()) || !std::isfinite(position.y()))
     return no_fix("numerical failure: non-finite position (singular geometry)");

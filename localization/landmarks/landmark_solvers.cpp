@@ -18,10 +18,16 @@ using detail::triple_ok;
 
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-/// (cos, sin) of the three bearings: one sincos each, shared by the solver and its heading.
-/// sincos_fast: inline, within ~2 ulp of libm (the libm calls were a quarter of a solve).
-inline void bearing_cs(std::span<const BearingObs> obs, double c[3], double s[3]) {
-  for (std::size_t i = 0; i < 3; ++i) sincos_fast(obs[i].bearing, s[i], c[i]);
+/// (cos, sin) of the bearings relative to the first, bearing_i - bearing_0 (so c[0] = 1, s[0] = 0):
+/// the position depends on bearing differences only, and the heading is that of the rotated
+/// bearings minus bearing_0 (finish_triple), so two sincos are enough. sincos_fast: inline, within
+/// ~2 ulp of libm (the libm calls were a quarter of a solve). The differences are rounded to the
+/// ulp of the bearings, i.e. 4e-16 rad for bearings in (-pi, pi] (7e-12 rad at 1e5).
+inline void relative_cs(std::span<const BearingObs> obs, double c[3], double s[3]) {
+  c[0] = 1.0;
+  s[0] = 0.0;
+  sincos_fast(obs[1].bearing - obs[0].bearing, s[1], c[1]);
+  sincos_fast(obs[2].bearing - obs[0].bearing, s[2], c[2]);
 }
 
 std::string line_reason(int i, int j) {
@@ -51,7 +57,7 @@ Fix three_point_004(std::span<const BearingObs> obs) {
   double far2 = 0.0;
   if (!triple_ok(obs, far2)) return bad_input(obs);
   double c[3], s[3];
-  bearing_cs(obs, c, s);
+  relative_cs(obs, c, s);
   const Eigen::Vector2d& P1 = obs[0].landmark;
   const Eigen::Vector2d& P2 = obs[1].landmark;
   const Eigen::Vector2d& P3 = obs[2].landmark;
@@ -96,7 +102,7 @@ Fix three_point_004(std::span<const BearingObs> obs) {
   const Eigen::Vector2d P0(P1.x() + f * (c210 * v21.x() - s210 * v21.y()), P1.y() + f * (s210 * v21.x() + c210 * v21.y()));
   // Eq. (22) gives the heading from P1 alone: phi0 = phi21 + alpha210 - phi01 (the direction P0 -> P1
   // minus its bearing). finish_triple computes the same quantity averaged over the three landmarks.
-  return finish_triple(obs, c, s, P0, std::sqrt(far2));
+  return finish_triple(obs, c, s, obs[0].bearing, P0, far2);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -104,7 +110,7 @@ Fix two_circle_004(std::span<const BearingObs> obs) {
   double far2 = 0.0;
   if (!triple_ok(obs, far2)) return bad_input(obs);
   double c[3], s[3];
-  bearing_cs(obs, c, s);
+  relative_cs(obs, c, s);
   const Eigen::Vector2d& D1L = obs[0].landmark;
   const Eigen::Vector2d& D1R = obs[1].landmark;
   const Eigen::Vector2d& D2L = obs[2].landmark;
@@ -144,7 +150,7 @@ Fix two_circle_004(std::span<const BearingObs> obs) {
   const double inv_n = 1.0 / (dt * dt + cr * cr);
   const double cr2 = (dt * dt - cr * cr) * inv_n, sr2 = -2.0 * cr * dt * inv_n;
   const Eigen::Vector2d R(cr2 * V_OD2.x() - sr2 * V_OD2.y() + O2.x(), sr2 * V_OD2.x() + cr2 * V_OD2.y() + O2.y());
-  return finish_triple(obs, c, s, R, std::sqrt(far2));
+  return finish_triple(obs, c, s, obs[0].bearing, R, far2);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -152,7 +158,7 @@ Fix circle_intersection_003(std::span<const BearingObs> obs) {
   double far2 = 0.0;
   if (!triple_ok(obs, far2)) return bad_input(obs);
   double c[3], s[3];
-  bearing_cs(obs, c, s);
+  relative_cs(obs, c, s);
   // sin of the angle subtended at the robot by each pair (bearing_j - bearing_i for (i, j) = (0, 1),
   // (1, 2), (2, 0)).
   const double s01 = c[0] * s[1] - s[0] * c[1];
@@ -190,7 +196,7 @@ Fix circle_intersection_003(std::span<const BearingObs> obs) {
   if (!(u2 >= kSingularTol * kSingularTol * radius2)) return no_fix(kOnCircle);
   const double t = a.dot(u) / u2;
   const Eigen::Vector2d R(2.0 * (Oa.x() + t * u.x()) - Lk.x(), 2.0 * (Oa.y() + t * u.y()) - Lk.y());
-  return finish_triple(obs, c, s, R, std::sqrt(far2));
+  return finish_triple(obs, c, s, obs[0].bearing, R, far2);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -214,7 +220,7 @@ Fix total_like(std::span<const BearingObs> obs) {
   double far2 = 0.0;
   if (!triple_ok(obs, far2)) return bad_input(obs);
   double c[3], s[3];
-  bearing_cs(obs, c, s);
+  relative_cs(obs, c, s);
   // ToTal (Pierlot, Van Droogenbroeck, "A New Three Object Triangulation Algorithm for Mobile Robot
   // Positioning", IEEE T-RO 30(3), 2014), formulated here from its equations; our own code.
   // x12..y31 are twice the centres of the circles (B1, B2, R), (B2, B3, R), (B3, B1, R) relative
@@ -273,7 +279,7 @@ Fix total_like(std::span<const BearingObs> obs) {
   if (!(std::fabs(D) > 1e-14 * dnorm)) return no_fix(kOnCircle);
   const double invD = 1.0 / D;  // the single division
   const Eigen::Vector2d R(B2.x() + k31 * (c12.y() - c23.y()) * invD, B2.y() + k31 * (c23.x() - c12.x()) * invD);
-  return finish_triple(obs, c, s, R, std::sqrt(far2));
+  return finish_triple(obs, c, s, obs[0].bearing, R, far2);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -67,10 +67,12 @@ inline double triple_reliability(const Eigen::Vector2d d[3], const double r2[3])
   return rel > 0.0 && std::isfinite(rel) ? rel : 0.0;
 }
 
-/// finish_fix for three observations whose bearings' (cos, sin) are c[i], s[i]; scale as there.
-/// Same checks, same reasons, same heading arithmetic; reliability by triple_reliability.
-inline Fix finish_triple(std::span<const BearingObs> obs, const double c[3], const double s[3],
-                         const Eigen::Vector2d& P, double scale) {
+/// finish_fix for three observations; c[i], s[i] = (cos, sin)(bearing_i - b0), i.e. the bearings
+/// rotated by -b0 (the solvers pass b0 = bearing_0 and so need no sincos of bearing_0 itself;
+/// finish_fix passes b0 = 0). scale2 = scale^2 (far2 of triple_ok). Same checks and reasons as
+/// finish_fix; reliability by triple_reliability.
+inline Fix finish_triple(std::span<const BearingObs> obs, const double c[3], const double s[3], double b0,
+                         const Eigen::Vector2d& P, double scale2) {
   Eigen::Vector2d d[3];
   double r2[3];
   double sx = 0.0, sy = 0.0;
@@ -79,7 +81,8 @@ inline Fix finish_triple(std::span<const BearingObs> obs, const double c[3], con
     d[i] = obs[static_cast<std::size_t>(i)].landmark - P;
     r2[i] = d[i].squaredNorm();
     at_landmark |= r2[i] < kSameLandmark * kSameLandmark;
-    // heading_from_bearings: the offset rotated by -bearing, summed (distance-weighted circular mean).
+    // heading_from_bearings: the offset rotated by -bearing, summed (distance-weighted circular
+    // mean); here rotated by -(bearing - b0), so the sum's angle is the heading + b0.
     sx += c[i] * d[i].x() + s[i] * d[i].y();
     sy += c[i] * d[i].y() - s[i] * d[i].x();
   }
@@ -89,15 +92,24 @@ inline Fix finish_triple(std::span<const BearingObs> obs, const double c[3], con
   if (!(sx * sx + sy * sy > 0.0) || !std::isfinite(sx) || !std::isfinite(sy))
     return no_fix("heading undefined at the computed position");
   const double rel = triple_reliability(d, r2);
-  if (!(rel * scale >= kSingularTol)) return no_fix("robot on the circle through the three landmarks (singular geometry)");
+  if (!(rel * rel * scale2 >= kSingularTol * kSingularTol)) return no_fix("robot on the circle through the three landmarks (singular geometry)");
   Fix f;
   f.ok = true;
   f.pose.x = P.x();
   f.pose.y = P.y();
-  // atan2 is in [-pi, pi]; Pose2's (-pi, pi] needs only -pi mapped to pi (no fmod, and no rounding
-  // of the round trip through wrap_angle). atan2_fast: branch-free, within ~2 ulp of libm's.
-  const double theta = atan2_fast(sy, sx);
-  f.pose.theta = theta == -kPi ? kPi : theta;
+  // Heading = atan2(sum) - b0, wrapped to Pose2's (-pi, pi] without fmod: subtract the nearest
+  // multiple of 2 pi (2 pi in two parts, so that k 2 pi is exact to ~1e-25 rad for |k| < 2^20), then
+  // fix the half-open boundary (the rounding may leave t a few ulp outside [-pi, pi]).
+  // atan2_fast: branch-free, within ~2 ulp of libm's.
+  constexpr double kTwoPiHi = 0x1.921fb544p+2;           // 2 pi, first 33 bits (k kTwoPiHi exact)
+  constexpr double kTwoPiLo = 0x1.0b4611a626331p-32;     // 2 pi - kTwoPiHi, rounded
+  constexpr double kRound = 0x1.8p52;
+  double t = atan2_fast(sy, sx) - b0;
+  const double k = (t * (1.0 / kTwoPi) + kRound) - kRound;
+  t = (t - k * kTwoPiHi) - k * kTwoPiLo;
+  if (t <= -kPi) t += kTwoPi;
+  if (t > kPi) t -= kTwoPi;
+  f.pose.theta = t;
   f.reliability = rel;
   return f;
 }
