@@ -274,9 +274,15 @@ Fix total_like(std::span<const BearingObs> obs) {
   // quadratically with the distance to the circle (each centre moves linearly towards the common
   // one). Threshold 1e-14: refused within ~1e-7 scale of the circle (~1e-6 m for landmarks 10 m
   // apart), two decades above the ~1e-16 rounding floor exactly on it.
-  const double n12 = c12.norm(), n23 = c23.norm(), n31 = c31.norm();
-  const double dnorm = n12 * n23 + n23 * n31 + n31 * n12;
-  if (!(std::fabs(D) > 1e-14 * dnorm)) return no_fix(kOnCircle);
+  // dnorm = n12 n23 + n23 n31 + n31 n12 (n the centres' norms) is at most n12^2 + n23^2 + n31^2
+  // (ab <= (a^2 + b^2) / 2), so the square roots are needed only when |D| is below that bound times
+  // 1e-14, i.e. near the circle: the same decision, without three square roots on the common path.
+  const double q12 = c12.squaredNorm(), q23 = c23.squaredNorm(), q31 = c31.squaredNorm();
+  if (!(std::fabs(D) > 1e-14 * (q12 + q23 + q31))) {
+    const double n12 = std::sqrt(q12), n23 = std::sqrt(q23), n31 = std::sqrt(q31);
+    const double dnorm = n12 * n23 + n23 * n31 + n31 * n12;
+    if (!(std::fabs(D) > 1e-14 * dnorm)) return no_fix(kOnCircle);
+  }
   const double invD = 1.0 / D;  // the single division
   const Eigen::Vector2d R(B2.x() + k31 * (c12.y() - c23.y()) * invD, B2.y() + k31 * (c23.x() - c12.x()) * invD);
   return finish_triple(obs, c, s, obs[0].bearing, R, far2);
