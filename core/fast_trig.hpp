@@ -11,8 +11,7 @@
 // Method (textbook, Cody & Waite): x = n pi/2 + r with n the nearest integer to x 2/pi and
 // |r| <= pi/4; pi/2 split into three parts (33 + 33 + 53 bits) so that n * part is exact for
 // |n| < 2^20 and r keeps ~100 bits of pi/2; then polynomials of degree 13 (sin) and 14 (cos) in r;
-// finally the quadrant n mod 4 swaps and negates the two, branch-free.
-#include <bit>
+// finally the quadrant n mod 4 swaps and negates the two, branch-free (products with a 0/+-1 table).
 #include <cmath>
 #include <cstdint>
 
@@ -44,12 +43,13 @@ inline void sincos_fast(double x, double& s, double& c) {
                     z4 * (0x1.1eeb68cd22f56p-29 + z * -0x1.907d8f29fe831p-37);
   const double sr = r + r * z * ps;
   const double cr = (1.0 - 0.5 * z) + z * z * pc;
-  // Quadrant q = n mod 4: (sin, cos) = (sr, cr), (cr, -sr), (-sr, -cr), (-cr, sr).
-  const auto q = static_cast<std::uint64_t>(static_cast<std::int64_t>(n));
-  const std::uint64_t swap = std::uint64_t{0} - (q & 1u);
-  const auto sb = std::bit_cast<std::uint64_t>(sr), cb = std::bit_cast<std::uint64_t>(cr);
-  s = std::bit_cast<double>(((sb & ~swap) | (cb & swap)) ^ ((q & 2u) << 62));
-  c = std::bit_cast<double>(((cb & ~swap) | (sb & swap)) ^ (((q + 1u) & 2u) << 62));
+  // Quadrant q = n mod 4: (sin, cos) = (sr, cr), (cr, -sr), (-sr, -cr), (-cr, sr), as products with
+  // 0 and +-1 from a table (exact; the index is known long before the polynomials, so the loads
+  // cost no latency, and there is no branch or integer round trip).
+  static constexpr double kQ[4][4] = {{1, 0, 1, 0}, {0, 1, 0, -1}, {-1, 0, -1, 0}, {0, -1, 0, 1}};
+  const double* m = kQ[static_cast<std::uint64_t>(static_cast<std::int64_t>(n)) & 3u];
+  s = sr * m[0] + cr * m[1];
+  c = cr * m[2] + sr * m[3];
 }
 
 /// atan2(y, x) in [-pi, pi], within a few ulp of libm's (measured against long-double atan2l on 4e6
