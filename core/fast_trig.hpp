@@ -53,8 +53,10 @@ inline void sincos_fast(double x, double& s, double& c) {
 }
 
 /// atan2(y, x) in [-pi, pi], within a few ulp of libm's (measured against long-double atan2l on 4e6
-/// random points: see tests/core_test.cpp, which checks 4 ulp), branch-free on the common path:
-/// glibc's atan2 branches on the octant, which is data for a heading, and costs ~135 instructions.
+/// random points: see tests/core_test.cpp, which checks 4 ulp), the octant selections written as
+/// arithmetic (GCC 12 still compiles the max/min choice below to one branch; forcing maxsd/minsd
+/// together with other bit-selects measured slower in the solvers): glibc's atan2 branches on the
+/// octant, which is data for a heading, and costs ~135 instructions.
 /// Zeros, infinities and NaN go to std::atan2 (the same results as libm there).
 ///
 /// Method (textbook): with mx = max(|x|, |y|), mn = min(|x|, |y|), atan(mn / mx) in [0, pi/4] is
