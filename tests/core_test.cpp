@@ -1,8 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <initializer_list>
+#include <limits>
+#include <utility>
 
 #include "core/angles.hpp"
+#include "core/fast_trig.hpp"
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
 #include "core/pose2.hpp"
@@ -15,6 +21,63 @@ TEST(Angles, WrapIntoHalfOpenInterval) {
   EXPECT_NEAR(wrap_angle(-kPi), kPi, 1e-12);
   EXPECT_NEAR(wrap_angle(0.5), 0.5, 1e-15);
   EXPECT_NEAR(angle_diff(0.1, 2 * kPi - 0.1), 0.2, 1e-12);
+}
+
+TEST(FastSincos, WithinFourUlpOfLongDoubleAndExactFallbackOutsideItsRange) {
+  // Reference: long double sinl/cosl (64-bit mantissa), rounded error in units of the double's ulp.
+  const auto ulps = [](double got, long double ref) {
+    const double r = std::fabs(static_cast<double>(ref));
+    return static_cast<double>(std::fabs(static_cast<long double>(got) - ref)) / (std::nextafter(r, 2.0 * r + 1.0) - r);
+  };
+  std::uint64_t state = 12345;
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double u = static_cast<double>(state >> 11) * 0x1.0p-53;  // [0, 1)
+    const double x = (i % 2 ? 40.0 : 1e5) * (2.0 * u - 1.0);
+    double s = 0.0, c = 0.0;
+    sincos_fast(x, s, c);
+    worst = std::max({worst, ulps(s, std::sin(static_cast<long double>(x))), ulps(c, std::cos(static_cast<long double>(x)))});
+  }
+  EXPECT_LT(worst, 4.0);
+  for (const double x : {0.0, kPi / 2, kPi, -kPi, 1e5, -1e5}) {
+    double s = 0.0, c = 0.0;
+    sincos_fast(x, s, c);
+    EXPECT_NEAR(s, std::sin(x), 1e-15) << x;
+    EXPECT_NEAR(c, std::cos(x), 1e-15) << x;
+  }
+  for (const double x : {1e6, -3e7, 1e300}) {  // std::sin/cos beyond 1e5
+    double s = 0.0, c = 0.0;
+    sincos_fast(x, s, c);
+    EXPECT_EQ(s, std::sin(x));
+    EXPECT_EQ(c, std::cos(x));
+  }
+  double s = 0.0, c = 0.0;
+  sincos_fast(std::numeric_limits<double>::quiet_NaN(), s, c);
+  EXPECT_TRUE(std::isnan(s) && std::isnan(c));
+}
+
+TEST(FastAtan2, WithinFourUlpOfLongDoubleAndLibmAtTheSpecialCases) {
+  std::uint64_t state = 6789;
+  const auto uniform = [&state] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1.0p-53 * 2.0 - 1.0;  // [-1, 1)
+  };
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double x = 50.0 * uniform();
+    const double y = i % 4 == 0 ? x * (1.0 + 1e-9 * uniform()) : 50.0 * uniform();  // also near the diagonals
+    const long double ref = std::atan2(static_cast<long double>(y), static_cast<long double>(x));
+    const double r = std::fabs(static_cast<double>(ref));
+    worst = std::max(worst, static_cast<double>(std::fabs(static_cast<long double>(atan2_fast(y, x)) - ref)) /
+                                (std::nextafter(r, 2.0 * r + 1.0) - r));
+  }
+  EXPECT_LT(worst, 4.0);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& [y, x] : std::initializer_list<std::pair<double, double>>{
+           {0.0, 1.0}, {-0.0, -1.0}, {0.0, -1.0}, {1.0, 0.0}, {-1.0, 0.0}, {1.0, 1.0}, {-1.0, -1.0}, {inf, 1.0}, {1.0, -inf}})
+    EXPECT_EQ(atan2_fast(y, x), std::atan2(y, x)) << y << " " << x;
+  EXPECT_TRUE(std::isnan(atan2_fast(std::numeric_limits<double>::quiet_NaN(), 1.0)));
 }
 
 TEST(Pose2, ComposeInverseBetween) {

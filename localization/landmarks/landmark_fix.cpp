@@ -1,4 +1,5 @@
 #include "localization/landmarks/landmark_fix.hpp"
+#include "localization/landmarks/triple_fix.hpp"
 
 #include <cmath>
 #include <utility>
@@ -94,19 +95,16 @@ double bearing_reliability(std::span<const BearingObs> obs, const Eigen::Vector2
   };
   double trace = 0.0;
   if (obs.size() == 3) {
-    // Square Jacobian: invert it directly (not J^T J, which would square its condition number and
-    // blur the singular set). Position covariance per unit bearing variance = rows 0-1 of J^-1
-    // times their transpose; its trace is their squared norm.
-    Eigen::Matrix3d J;
+    // Square Jacobian: its inverse directly (not J^T J, which would square its condition number and
+    // blur the singular set), in closed form (detail::triple_reliability).
+    Eigen::Vector2d d[3];
+    double r2[3];
     for (std::size_t i = 0; i < 3; ++i) {
-      double jx = 0, jy = 0;
-      if (!row(i, jx, jy)) return 0.0;
-      J.row(static_cast<Eigen::Index>(i)) << jx, jy, -1.0;
+      d[i] = obs[i].landmark - position;
+      r2[i] = d[i].squaredNorm();
+      if (!(r2[i] > 0.0)) return 0.0;
     }
-    const double det = J.determinant();
-    if (!(std::fabs(det) > 0.0) || !std::isfinite(det)) return 0.0;
-    const Eigen::Matrix3d inv = J.inverse();
-    trace = inv.topRows<2>().squaredNorm();
+    return detail::triple_reliability(d, r2);
   } else {
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     for (std::size_t i = 0; i < obs.size(); ++i) {
@@ -125,6 +123,14 @@ double bearing_reliability(std::span<const BearingObs> obs, const Eigen::Vector2
 
 Fix finish_fix(std::span<const BearingObs> obs, std::span<const Eigen::Vector2d> dirs, const Eigen::Vector2d& position,
                double scale) {
+  if (obs.size() == 3) {
+    double c[3], s[3];
+    for (std::size_t i = 0; i < 3; ++i) {
+      c[i] = dirs.empty() ? std::cos(obs[i].bearing) : dirs[i].x();
+      s[i] = dirs.empty() ? std::sin(obs[i].bearing) : dirs[i].y();
+    }
+    return detail::finish_triple(obs, c, s, 0.0, position, scale * scale);
+  }
   if (!std::isfinite(position.x()) || !std::isfinite(position.y()))
     return no_fix("numerical failure: non-finite position (singular geometry)");
   for (const auto& o : obs)
