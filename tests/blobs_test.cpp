@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <string>
+#include <tuple>
 
 #include "core/angles.hpp"
 #include "core/field.hpp"
@@ -364,6 +367,147 @@ TEST(LandmarkLocalizerTest, OdometryPredictionBetweenFixes) {
     } else {
       EXPECT_FALSE(e.valid) << "0.3 s after the fix, beyond max_prediction_time";
       EXPECT_EQ(e.mode, LocalizerMode::kNoFix);
+    }
+  }
+}
+
+namespace {
+
+// Bit-for-bit equality of two detections (ties in the detector's sort key broken by the other fields).
+void expect_same_blobs(std::vector<Blob> a, std::vector<Blob> b, const std::string& what) {
+  auto key = [](const Blob& x) { return std::make_tuple(x.colour, x.kind, x.bearing, x.area_px, x.distance, x.left_bearing); };
+  auto by_key = [&](const Blob& x, const Blob& y) { return key(x) < key(y); };
+  std::sort(a.begin(), a.end(), by_key);
+  std::sort(b.begin(), b.end(), by_key);
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].colour, b[k].colour) << what << ", blob " << k;
+    EXPECT_EQ(a[k].kind, b[k].kind) << what << ", blob " << k;
+    EXPECT_EQ(a[k].bearing, b[k].bearing) << what << ", blob " << k;
+    EXPECT_EQ(a[k].left_bearing, b[k].left_bearing) << what << ", blob " << k;
+    EXPECT_EQ(a[k].right_bearing, b[k].right_bearing) << what << ", blob " << k;
+    EXPECT_EQ(a[k].distance, b[k].distance) << what << ", blob " << k;
+    EXPECT_EQ(a[k].has_distance, b[k].has_distance) << what << ", blob " << k;
+    EXPECT_EQ(a[k].area_px, b[k].area_px) << what << ", blob " << k;
+    EXPECT_EQ(a[k].left_occluded, b[k].left_occluded) << what << ", blob " << k;
+    EXPECT_EQ(a[k].right_occluded, b[k].right_occluded) << what << ", blob " << k;
+  }
+}
+
+}  // namespace
+
+// detect() classifies a grid and flood-fills from it; detect_full() classifies every pixel and runs
+// OpenCV's connected components. Same blobs to the bit on rendered frames: quiet and noisy camera,
+// black sectors cutting cubes (occluded edges), edge observations, several minimum areas.
+TEST_F(BlobsTest, GridSearchGivesTheFullResolutionBlobs) {
+  PanoramicCamera noisy(CameraConfig{}, *arena_);
+  // The sectors are painted (0, 0, 0); the table learnt the robots' black, a little brighter.
+  std::uint8_t dark = 0;
+  for (int g = 0; g < 100 && !dark; ++g) {
+    const std::uint8_t rgb[3] = {static_cast<std::uint8_t>(g), static_cast<std::uint8_t>(g), static_cast<std::uint8_t>(g)};
+    if (table_->classify(rgb) == kObstacleBlack) dark = rgb[0];
+  }
+  ASSERT_GT(dark, 0);
+  Rng rng(21), poses(5);
+  int blobs = 0, occluded = 0;
+  for (int k = 0; k < 10; ++k) {
+    const Pose2 pose(poses.uniform(-4.5, 4.5), poses.uniform(-3.5, 3.5), poses.uniform(-3.1, 3.1));
+    Image img = (k % 2 ? noisy : *cam_).render(one_robot(pose), 0, {}, rng);
+    if (k % 3 == 0) {  // a black sector over one side of each cube
+      std::vector<Sector> sectors;
+      for (const auto& l : arena_->landmarks) sectors.push_back({bearing_to(pose, l.position), deg2rad(4)});
+      paint_sectors(img, cam_->centre(), sectors);
+      for (std::size_t i = 0; i < img.rgb.size(); i += 3)
+        if (img.rgb[i] == 0 && img.rgb[i + 1] == 0 && img.rgb[i + 2] == 0) img.rgb[i] = img.rgb[i + 1] = img.rgb[i + 2] = dark;
+    }
+    for (const int min_area : {1, 8, 25, 100}) {
+      BlobParams p;
+      p.min_area_px = min_area;
+      p.edge_colours = {kRed, kBlue};
+      const BlobDetector det(p, *map_, *table_);
+      ASSERT_LT((det.grid_rows() - 1) * (det.grid_cols() - 1), min_area);
+      const std::vector<Blob> fast = det.detect(img);
+      expect_same_blobs(fast, det.detect_full(img), "frame " + std::to_string(k) + ", min_area_px " + std::to_string(min_area));
+      blobs += static_cast<int>(fast.size());
+      for (const Blob& b : fast) occluded += b.left_occluded + b.right_occluded;
+    }
+  }
+  EXPECT_GT(blobs, 100);
+  EXPECT_GT(occluded, 0);  // the occlusion test ran on lazily classified pixels
+}
+
+// The grid's guarantee on regions it could only just catch: 1-pixel-wide lines between grid rows or
+// columns, a diagonal line (8-connected only), and a region that fills a whole grid cell, hence
+// below min_area_px, which neither path reports. Then random thin scribbles, touching black
+// patches, at several minimum areas.
+TEST_F(BlobsTest, GridSearchFindsThinRegions) {
+  const std::array<std::uint8_t, 3> green{60, 140, 60}, red{220, 40, 40}, blue{40, 60, 200}, black{10, 10, 10};
+  ColourTable table(6);
+  {
+    Image im, lab;
+    im.width = lab.width = 8;
+    im.height = lab.height = 1;
+    const std::pair<std::array<std::uint8_t, 3>, ColourClass> learnt[] = {{green, kFieldGreen}, {red, kRed}, {blue, kBlue}, {black, kObstacleBlack}};
+    for (const auto& [rgb, cls] : learnt)
+      for (int rep = 0; rep < 2; ++rep) {
+        im.rgb.insert(im.rgb.end(), rgb.begin(), rgb.end());
+        lab.rgb.insert(lab.rgb.end(), {static_cast<std::uint8_t>(cls), 0, 0});
+      }
+    table.learn({im}, {lab});
+  }
+  const int w = map_->image_width(), h = map_->image_height();
+  const int cu = static_cast<int>(map_->centre().x()), cv = static_cast<int>(map_->centre().y());
+  ASSERT_LT(map_->min_radius(), 120.0);
+  auto blank = [&] {
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.rgb.resize(static_cast<std::size_t>(w) * h * 3);
+    for (std::size_t i = 0; i < img.rgb.size(); i += 3) std::copy(green.begin(), green.end(), img.rgb.begin() + static_cast<std::ptrdiff_t>(i));
+    return img;
+  };
+  auto paint = [&](Image& img, int u, int v, const std::array<std::uint8_t, 3>& rgb) {
+    if (u >= 0 && v >= 0 && u < w && v < h) std::copy(rgb.begin(), rgb.end(), img.row(v) + 3 * u);
+  };
+
+  const BlobDetector det(BlobParams{}, *map_, table);
+  const int gr = det.grid_rows(), gc = det.grid_cols();
+  ASSERT_LT((gr - 1) * (gc - 1), BlobParams{}.min_area_px);
+  Image img = blank();
+  // Grid rows are v % gr == 0, grid columns u % gc == 0: lines one past them.
+  const int vh = (cv - 150) / gr * gr + 1, uv = (cu + 150) / gc * gc + 1;
+  for (int k = 0; k < 30; ++k) paint(img, cu - 15 + k, vh, red);   // horizontal, between grid rows
+  for (int k = 0; k < 30; ++k) paint(img, uv, cv - 15 + k, blue);  // vertical, between grid columns
+  for (int k = 0; k < 30; ++k) paint(img, cu - 200 + k, cv + 40 + k, red);  // diagonal
+  const int cell_u = (cu - 150) / gc * gc + 1, cell_v = (cv + 150) / gr * gr + 1;
+  for (int dv = 0; dv < gr - 1; ++dv)
+    for (int du = 0; du < gc - 1; ++du) paint(img, cell_u + du, cell_v + dv, blue);  // a whole cell
+  const std::vector<Blob> found = det.detect(img);
+  ASSERT_EQ(found.size(), 3u);
+  for (const Blob& b : found) EXPECT_EQ(b.area_px, 30);
+  expect_same_blobs(found, det.detect_full(img), "lines");
+
+  Rng rng(99);
+  const std::array<std::uint8_t, 3>* colours[] = {&red, &blue, &black};
+  for (int k = 0; k < 8; ++k) {
+    img = blank();
+    for (int s = 0; s < 60; ++s) {
+      const double r = rng.uniform(130.0, 300.0), a = rng.uniform(-kPi, kPi);
+      int u = cu + static_cast<int>(r * std::cos(a)), v = cv + static_cast<int>(r * std::sin(a));
+      const auto& rgb = *colours[rng.uniform_index(3)];
+      const int len = 1 + static_cast<int>(rng.uniform_index(60));
+      for (int step = 0; step < len; ++step) {
+        paint(img, u, v, rgb);
+        u += static_cast<int>(rng.uniform_index(3)) - 1;
+        v += static_cast<int>(rng.uniform_index(3)) - 1;
+      }
+    }
+    for (const int min_area : {1, 3, 10, 25, 50}) {
+      BlobParams p;
+      p.min_area_px = min_area;
+      p.edge_colours = {kRed};
+      const BlobDetector d(p, *map_, table);
+      expect_same_blobs(d.detect(img), d.detect_full(img), "scribbles " + std::to_string(k) + ", min_area_px " + std::to_string(min_area));
     }
   }
 }

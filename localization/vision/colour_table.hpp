@@ -38,10 +38,17 @@ class ColourTable {
   explicit ColourTable(int bits = 6);
   /// Learns from pairs of images and label images (class id per pixel in channel 0).
   void learn(const std::vector<Image>& images, const std::vector<Image>& labels, int min_count = 2, int fill_radius = 3);
-  std::uint8_t classify(const std::uint8_t* rgb) const {
-    const int s = 8 - bits_;
-    return lut_[((rgb[0] >> s) << (2 * bits_)) | ((rgb[1] >> s) << bits_) | (rgb[2] >> s)];
-  }
+  std::uint8_t classify(const std::uint8_t* rgb) const { return lookup()(rgb); }
+  /// classify() by value, for loops over many pixels: its fields stay in registers where the
+  /// table's members would be reloaded after every store through a byte pointer (which may alias them).
+  struct Lookup {
+    const std::uint8_t* lut;
+    int shift, bits;
+    std::uint8_t operator()(const std::uint8_t* rgb) const {
+      return lut[((rgb[0] >> shift) << (2 * bits)) | ((rgb[1] >> shift) << bits) | (rgb[2] >> shift)];
+    }
+  };
+  Lookup lookup() const { return {lut_.data(), 8 - bits_, bits_}; }
   int bits() const { return bits_; }
   /// The field the table was learned for (fingerprint); a table of another field is refused.
   std::string field;
