@@ -31,7 +31,7 @@ static void BM_MatchingUpdate(benchmark::State& state) {
   // data-term evaluation (each update also evaluates the error once and the gradient six times for
   // the Hessian that gives the Kalman filter its covariance).
   const double points = static_cast<double>(obs.line_points.size());
-  state.counters["iterations"] = iterations;
+  state.counters["rprop_iterations"] = iterations;
   state.counters["s_per_point_iteration"] = benchmark::Counter(points * iterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["s_per_point_evaluation"] = benchmark::Counter(points * (iterations + 7), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
