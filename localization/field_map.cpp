@@ -23,6 +23,8 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   name << "fieldmap_" << fingerprint_ << "_" << std::lround(cell * 1e4) << ".bin";
   const std::string file = cache_dir.empty() ? "" : (std::filesystem::path(cache_dir) / name.str()).string();
   // Cache: a header naming field, cell and size, then the floats. A mismatching file is rebuilt.
+  // In memory the floats are widened to doubles (no conversion per lookup): cached or computed, the
+  // table holds the same float values.
   std::ostringstream header;
   header << "omniloc-fieldmap 1 " << fingerprint_ << " " << cell << " " << nx_ << " " << ny_ << "\n";
   if (!file.empty() && std::filesystem::exists(file)) {
@@ -41,7 +43,6 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   }
   for (int j = 0; j < ny_; ++j)
     for (int i = 0; i < nx_; ++i) grid_[static_cast<std::size_t>(j) * nx_ + i] = static_cast<float>(field.distance_to_marking({x0 + i * cell, y0 + j * cell}));
-  // Cached or not, the table holds the same float values.
   if (!file.empty()) {
     std::string out = header.str();
     const std::vector<float> stored(grid_.begin(), grid_.end());

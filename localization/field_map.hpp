@@ -15,9 +15,6 @@ namespace omniloc {
 
 class FieldMap {
  public:
-  /// The table as plain values: what a hot loop copies into a local (`const auto t = map.table()`)
-  /// so the compiler keeps the geometry in registers instead of reloading it around every lookup
-  /// (issue 20: the matcher's loop reloaded seven members per point).
   /// A lookup's result: distance (metres) and, when asked for, its gradient (d/dx, d/dy).
   struct Sample {
     double d, gx, gy;
