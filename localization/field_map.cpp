@@ -14,11 +14,11 @@ namespace omniloc {
 FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir) : fingerprint_(field.fingerprint()) {
   // Cover the floor inside the walls plus a cell.
   const double hx = field.half_floor_x() + cell, hy = field.half_floor_y() + cell;
-  nx_ = static_cast<int>(std::ceil(2 * hx / cell)) + 1;
-  ny_ = static_cast<int>(std::ceil(2 * hy / cell)) + 1;
+  const int nx = static_cast<int>(std::ceil(2 * hx / cell)) + 1;
+  const int ny = static_cast<int>(std::ceil(2 * hy / cell)) + 1;
   const double x0 = -hx, y0 = -hy;
-  grid_.resize(static_cast<std::size_t>(nx_) * ny_);
-  table_ = Table{grid_.data(), nx_, x0, y0, 1.0 / cell, cell, nx_ - 1.0, ny_ - 1.0, static_cast<unsigned>(nx_ - 1), static_cast<unsigned>(ny_ - 1)};
+  grid_.resize(static_cast<std::size_t>(nx) * ny);
+  table_ = Table{grid_.data(), nx, x0, y0, 1.0 / cell, cell, nx - 1.0, ny - 1.0, static_cast<unsigned>(nx - 1), static_cast<unsigned>(ny - 1)};
   std::ostringstream name;
   name << "fieldmap_" << fingerprint_ << "_" << std::lround(cell * 1e4) << ".bin";
   const std::string file = cache_dir.empty() ? "" : (std::filesystem::path(cache_dir) / name.str()).string();
@@ -26,7 +26,7 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   // In memory the floats are widened to doubles (no conversion per lookup): cached or computed, the
   // table holds the same float values.
   std::ostringstream header;
-  header << "omniloc-fieldmap 1 " << fingerprint_ << " " << cell << " " << nx_ << " " << ny_ << "\n";
+  header << "omniloc-fieldmap 1 " << fingerprint_ << " " << cell << " " << nx << " " << ny << "\n";
   if (!file.empty() && std::filesystem::exists(file)) {
     std::ifstream in(file, std::ios::binary);
     std::string line;
@@ -41,8 +41,8 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
       }
     }
   }
-  for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) grid_[static_cast<std::size_t>(j) * nx_ + i] = static_cast<float>(field.distance_to_marking({x0 + i * cell, y0 + j * cell}));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) grid_[static_cast<std::size_t>(j) * nx + i] = static_cast<float>(field.distance_to_marking({x0 + i * cell, y0 + j * cell}));
   if (!file.empty()) {
     std::string out = header.str();
     const std::vector<float> stored(grid_.begin(), grid_.end());

@@ -30,10 +30,13 @@ class FieldMap {
     double inv_cell, cell;   // 1 / metres, metres
     double last_x, last_y;   // nx - 1, ny - 1: the fast path's bounds (cells)
     unsigned last_i, last_j; // the same as cell indices
+    /// World x, y (metres) -> table position (cells), as at() and the hot loops take it.
+    double cells_x(double x) const { return (x - x0) * inv_cell; }
+    double cells_y(double y) const { return (y - y0) * inv_cell; }
     /// At world point (x, y) (metres); the gradient (per metre) only with kGradient, else 0.
     template <bool kGradient>
     Sample at(double x, double y) const {
-      Sample s = at_cells<kGradient>((x - x0) * inv_cell, (y - y0) * inv_cell);
+      Sample s = at_cells<kGradient>(cells_x(x), cells_y(y));
       if constexpr (kGradient) {
         s.gx *= inv_cell;
         s.gy *= inv_cell;
@@ -80,7 +83,7 @@ class FieldMap {
   /// cell: metres (Tribots: 50 mm). `cache_dir`: where to keep the table ("" = no cache).
   FieldMap(const Field& field, double cell = 0.05, const std::string& cache_dir = "");
   // table_ points into grid_: a copy re-points it, a move keeps the buffer and so the pointer.
-  FieldMap(const FieldMap& o) : nx_(o.nx_), ny_(o.ny_), grid_(o.grid_), table_(o.table_), fingerprint_(o.fingerprint_), from_cache_(o.from_cache_) {
+  FieldMap(const FieldMap& o) : grid_(o.grid_), table_(o.table_), fingerprint_(o.fingerprint_), from_cache_(o.from_cache_) {
     table_.cells = grid_.data();
   }
   FieldMap& operator=(const FieldMap& o) {
@@ -105,7 +108,6 @@ class FieldMap {
   bool loaded_from_cache() const { return from_cache_; }
 
  private:
-  int nx_, ny_;
   std::vector<double> grid_;  // the cached floats, widened: no conversion in the lookups
   Table table_{};
   std::string fingerprint_;

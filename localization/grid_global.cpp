@@ -73,7 +73,7 @@ GridSearchRecord grid_search(const Field& field, const FieldMap& map, const std:
       for (int i = 0; i < nx; ++i) {
         GridSearchRecord::Sample smp{x_lo + i * p.spacing + off, y_lo + j * p.spacing + off, 0.0, pass};
         double e = 0;
-        const double px = (smp.x - t.x0) * t.inv_cell, py = (smp.y - t.y0) * t.inv_cell;
+        const double px = t.cells_x(smp.x), py = t.cells_y(smp.y);
         for (const auto& w : rotated) {
           const double d = t.at_cells<false>(px + w.x(), py + w.y()).d;
           e += 1.0 - c2 / (c2 + d * d);

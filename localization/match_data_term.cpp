@@ -180,7 +180,7 @@ double data_term(const Setup& u, const std::vector<Eigen::Vector2d>& pts, Eigen:
 
 double match_data_term(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector3d& q, double c, Eigen::Vector3d* grad) {
   const FieldMap::Table& t = map.table();
-  const Setup u{t, c * c, std::cos(q.z()) * t.inv_cell, std::sin(q.z()) * t.inv_cell, (q.x() - t.x0) * t.inv_cell, (q.y() - t.y0) * t.inv_cell};
+  const Setup u{t, c * c, std::cos(q.z()) * t.inv_cell, std::sin(q.z()) * t.inv_cell, t.cells_x(q.x()), t.cells_y(q.y())};
   return grad ? data_term<true>(u, pts, grad) : data_term<false>(u, pts, nullptr);
 }
 

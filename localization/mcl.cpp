@@ -90,7 +90,7 @@ double McLLocalizer::log_likelihood(const Pose2& q, const std::vector<Eigen::Vec
     // is a local so its fields stay in registers.
     const FieldMap::Table t = map_.table();
     const double a = std::cos(q.theta) * t.inv_cell, b = std::sin(q.theta) * t.inv_cell, clamp = p_.clamp;
-    const double px = (q.x - t.x0) * t.inv_cell, py = (q.y - t.y0) * t.inv_cell;
+    const double px = t.cells_x(q.x), py = t.cells_y(q.y);
     for (const auto& o : *pts) {
       const double d = std::min(clamp, t.at_cells<false>(px + a * o.x() - b * o.y(), py + b * o.x() + a * o.y()).d);
       lw -= d * d * inv2s2;

@@ -165,6 +165,13 @@ struct BlobDetector::Component {
   int area = 0;
   std::int64_t sum_u = 0, sum_v = 0;  // of pixel coordinates, for the centroid
   std::vector<Span> spans;
+  /// Empties the component for a new region of `c` (keeps the spans' storage).
+  void start(ColourClass c) {
+    colour = c;
+    area = 0;
+    sum_u = sum_v = 0;
+    spans.clear();
+  }
   void add(int v, int u0, int u1) {
     const int n = u1 - u0 + 1;
     spans.push_back({v, u0, u1});
@@ -361,10 +368,20 @@ void sort_blobs(std::vector<Blob>& out) {
 
 }  // namespace
 
+bool BlobDetector::usable(const Image& img) const {
+  if (img.width != w_ || img.height != h_ || img.rgb.size() < 3 * inside_.size()) return false;
+  return mean_grey(img) >= p_.dark_mean;
+}
+
+std::array<bool, 256> BlobDetector::wanted_classes() const {
+  std::array<bool, 256> wanted{};
+  for (const ColourClass c : p_.colours) wanted[c] = true;
+  return wanted;
+}
+
 std::vector<Blob> BlobDetector::detect(const Image& img) const {
   std::vector<Blob> out;
-  if (img.width != w_ || img.height != h_ || img.rgb.size() < 3 * inside_.size()) return out;
-  if (mean_grey(img) < p_.dark_mean) return out;
+  if (!usable(img)) return out;
 
   // Per thread: detect() is const and may run for several robots at once; reused so that the
   // class buffer is not allocated (and page-faulted) per frame.
@@ -374,8 +391,7 @@ std::vector<Blob> BlobDetector::detect(const Image& img) const {
   cls_buf.resize(inside_.size());
   std::uint8_t* const cls = cls_buf.data();
   const std::uint8_t* const src = img.rgb.data();
-  std::array<bool, 256> wanted{};
-  for (const ColourClass c : p_.colours) wanted[c] = true;
+  const std::array<bool, 256> wanted = wanted_classes();
 
   // The grid: grid rows whole, other rows every grid_cols_-th pixel (the same columns in every row),
   // the rest marked unclassified. A seed per run of a wanted colour along a grid row.
@@ -393,10 +409,7 @@ std::vector<Blob> BlobDetector::detect(const Image& img) const {
       if (k == kUnclassified) k = cls[i] = classify(src + 3 * i);
       return k == colour;
     };
-    comp.colour = static_cast<ColourClass>(colour);
-    comp.area = 0;
-    comp.sum_u = comp.sum_v = 0;
-    comp.spans.clear();
+    comp.start(static_cast<ColourClass>(colour));
     stack.clear();
     stack.push_back(seed);
     while (!stack.empty()) {
@@ -431,15 +444,13 @@ std::vector<Blob> BlobDetector::detect(const Image& img) const {
 
 std::vector<Blob> BlobDetector::detect_full(const Image& img) const {
   std::vector<Blob> out;
-  if (img.width != w_ || img.height != h_ || img.rgb.size() < 3 * inside_.size()) return out;
-  if (mean_grey(img) < p_.dark_mean) return out;
+  if (!usable(img)) return out;
 
   // Classify the annulus once, noting each wanted colour's bounding box so connected components run
   // on that box only.
   std::vector<std::uint8_t> cls_buf(inside_.size(), kOutside);
   std::uint8_t* const cls = cls_buf.data();
-  std::array<bool, 256> wanted{};
-  for (const ColourClass c : p_.colours) wanted[c] = true;
+  const std::array<bool, 256> wanted = wanted_classes();
   std::array<int, 256> bx0, by0, bx1, by1;
   bx0.fill(w_);
   by0.fill(h_);
@@ -470,10 +481,7 @@ std::vector<Blob> BlobDetector::detect_full(const Image& img) const {
       if (stats.at<int>(k, cv::CC_STAT_AREA) < p_.min_area_px) continue;
       const int x0 = stats.at<int>(k, cv::CC_STAT_LEFT), y0 = stats.at<int>(k, cv::CC_STAT_TOP);
       const int x1 = x0 + stats.at<int>(k, cv::CC_STAT_WIDTH), y1 = y0 + stats.at<int>(k, cv::CC_STAT_HEIGHT);
-      comp.colour = colour;
-      comp.area = 0;
-      comp.sum_u = comp.sum_v = 0;
-      comp.spans.clear();
+      comp.start(colour);
       for (int v = y0; v < y1; ++v) {
         const int* lab = labels.ptr<int>(v);
         for (int u = x0; u < x1;) {

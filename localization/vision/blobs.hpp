@@ -19,6 +19,7 @@
 // For goal colours (edge_colours) the two edges are also given as separate observations
 // (Blob::Kind::kLeftEdge / kRightEdge), their distance taken near that edge. Units and frames as in
 // localization/localizer.hpp (Blob).
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -98,6 +99,10 @@ class BlobDetector {
   // Appends the blobs of one component; `cls` holds classes, kUnclassified (classified here when
   // read) or visited marks (see blobs.cpp).
   void measure(const Image& img, std::uint8_t* cls, const Component& comp, std::vector<Blob>& out) const;
+  /// The image has the calibrated size and is not dark (see dark_mean): worth searching.
+  bool usable(const Image& img) const;
+  /// Indexed by colour class: true for the classes searched for (p_.colours).
+  std::array<bool, 256> wanted_classes() const;
 };
 
 }  // namespace omniloc
