@@ -93,7 +93,6 @@ double bearing_reliability(std::span<const BearingObs> obs, const Eigen::Vector2
     jy = -d.x() / r2;
     return true;
   };
-  double trace = 0.0;
   if (obs.size() == 3) {
     // Square Jacobian: its inverse directly (not J^T J, which would square its condition number and
     // blur the singular set), in closed form (detail::triple_reliability).
@@ -105,18 +104,17 @@ double bearing_reliability(std::span<const BearingObs> obs, const Eigen::Vector2
       if (!(r2[i] > 0.0)) return 0.0;
     }
     return detail::triple_reliability(d, r2);
-  } else {
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    for (std::size_t i = 0; i < obs.size(); ++i) {
-      double jx = 0, jy = 0;
-      if (!row(i, jx, jy)) return 0.0;
-      const Eigen::Vector3d j(jx, jy, -1.0);
-      A += j * j.transpose();
-    }
-    const double det = A.determinant();
-    if (!(det > 0.0) || !std::isfinite(det)) return 0.0;
-    trace = A.inverse().topLeftCorner<2, 2>().trace();
   }
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    double jx = 0, jy = 0;
+    if (!row(i, jx, jy)) return 0.0;
+    const Eigen::Vector3d j(jx, jy, -1.0);
+    A += j * j.transpose();
+  }
+  const double det = A.determinant();
+  if (!(det > 0.0) || !std::isfinite(det)) return 0.0;
+  const double trace = A.inverse().topLeftCorner<2, 2>().trace();
   if (!(trace > 0.0) || !std::isfinite(trace)) return 0.0;
   return 1.0 / std::sqrt(trace);
 }
