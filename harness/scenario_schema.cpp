@@ -79,8 +79,9 @@ Json localizer_schema() {
     Json props = l.schema();
     props["type"] = {{"const", l.type}};
     props["comment"] = kComment;
-    cases.push_back({{"if", {{"properties", {{"type", {{"const", l.type}}}}}}},
-                     {"then", {{"properties", props}, {"additionalProperties", false}, {"description", l.description}}}});
+    Json then{{"properties", props}, {"additionalProperties", false}, {"description", l.description}};
+    if (l.type == "external") then["required"] = {"command"};  // the client program (docs/protocol.md)
+    cases.push_back({{"if", {{"properties", {{"type", {{"const", l.type}}}}}}}, {"then", then}});
   }
   return {{"type", "object"},
           {"description", "the localizer and its parameters (docs/localizers.md)"},

@@ -34,9 +34,23 @@ def row_stats(runs, key, defaults, metrics, phase="tracking"):
     return sel, out
 
 
+def external_peers(runs, key, defaults, metrics):
+    """The external localizers (summary.json localizer_type "external", docs/protocol.md) that ran
+    a row's scenario and configuration: [{"name", "runs", "stats"}], by name. They pair by the same
+    key with the localizer replaced by the client's name, so they sit beside the built-in row."""
+    names = sorted({r.localizer for r in runs if r.summary.get("localizer_type") == "external" and r.localizer != key.get("localizer")})
+    peers = []
+    for name in names:
+        sel, st = row_stats(runs, dict(key, localizer=name), defaults, metrics)
+        if sel:
+            peers.append({"name": name, "runs": sel, "stats": st, "version": (sel[0].summary.get("external") or {}).get("version", "")})
+    return peers
+
+
 def pair_table(papers, table, runs, labels=None, include_extra=True):
     """Rows of a 9-column error table: [{"label", "published" (list or None), "runs", "stats" (per
-    column), "key", "command"}], published rows first in the paper's order, then our extra rows."""
+    column), "key", "command", "peers"}], published rows first in the paper's order, then our extra
+    rows; "peers" are the external localizers run on the row's scenario and configuration."""
     t = papers[table]
     rb = t["reproduced_by"]
     metrics = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
@@ -51,7 +65,8 @@ def pair_table(papers, table, runs, labels=None, include_extra=True):
         key, defaults, command = row_key(papers, table, label)
         sel, st = row_stats(runs, key, defaults, metrics + ["line_points/mean", "frames"])
         rows.append({"label": label, "published": t["rows"].get(label) if label in rb["rows"] else None, "runs": sel, "stats": st,
-                     "key": key, "command": command, "phased": any("tracking_phase" in (r.robot() or {}) for r in sel)})
+                     "key": key, "command": command, "phased": any("tracking_phase" in (r.robot() or {}) for r in sel),
+                     "peers": external_peers(runs, key, defaults, metrics + ["line_points/mean", "frames"])})
     return rows
 
 

@@ -10,6 +10,8 @@ localizer and configuration values ("reproduced_by"), and our runs are found by 
 their position in a sweep. --rows keeps only the named rows (published or extra). A row without
 runs says "not run" and prints the command that runs it. Ours: mean over seeds (n shown); runs with
 kidnaps or covers use their tracking phase. Only the published numbers come from papers.json.
+External localizers (docs/protocol.md) found in RESULTS on a row's scenario and configuration are
+printed beside it, named "external: <the client's name>".
 """
 import argparse
 import pathlib
@@ -53,6 +55,10 @@ def main():
         else:
             lines.append([p["label"], "not run"] + ["-"] * 9 + ["-", "0"])
             notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {p['command']}")
+        for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario and configuration
+            pst = peer["stats"]
+            lines.append([p["label"], f"external: {peer['name']}"] + [f"{pst[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] +
+                         [f"{pst['line_points/mean']['mean']:.0f}", str(pst["x_cm/mean"]["n"])])
         if p["published"]:
             lines.append([p["label"], "paper"] + [f"{v:.3f}" for v in p["published"]] + ["-", "-"])
             if p["runs"]:

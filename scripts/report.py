@@ -228,6 +228,11 @@ def error_table(rep, papers, table, runs):
         else:
             rows.append([p["label"], "not run"] + ["-"] * 9 + ["-", 0])
             classes.append("missing")
+        for peer in p.get("peers", []):  # external localizers (docs/protocol.md), same scenario and configuration
+            pst = peer["stats"]
+            rows.append([p["label"], f"external: {peer['name']}"] + [fnum(pst[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
+                        [fnum(pst["line_points/mean"]["mean"], 0), pst["x_cm/mean"]["n"]])
+            classes.append("")
         if p["published"]:
             rows.append([p["label"], "paper"] + [fnum(v, 3) for v in p["published"]] + ["-", "-"])
             classes.append("paper")
@@ -656,7 +661,9 @@ def cdf_and_timing(rep, runs):
         for loc, d in sorted(timing.items()):
             rows.append([loc] + [fnum(statistics.median(v), 3) if v else "-" for v in d.values()] + [len(d["render_ms"])])
         rep.table(["localizer", "render ms (median)", "vision ms", "localize ms", "frames"], rows,
-                  f"wall time per frame on {platform.node()} ({os.cpu_count()} cores, {platform.machine()}); runs in a sweep share the cores")
+                  f"wall time per frame on {platform.node()} ({os.cpu_count()} cores, {platform.machine()}); runs in a sweep share the cores. "
+                  "For an external localizer (docs/protocol.md) 'localize' is the protocol's round trip: frame sent to estimate read, "
+                  "the client's own computation included")
         fig, ax = plt.subplots(figsize=(7, 3.5))
         locs = sorted(timing)
         bottom = [0.0] * len(locs)
