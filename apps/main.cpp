@@ -26,8 +26,8 @@
 #include "harness/scenario_schema.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
-#include "harness/slurm.hpp"
-#include "harness/sweep.hpp"
+#include "batch/slurm.hpp"
+#include "batch/sweep.hpp"
 #include "harness/vision_setup.hpp"
 #include "sim/render/camera_config.hpp"
 #include "sim/motion.hpp"
@@ -95,14 +95,17 @@ const cli::Command kRender{"render", "FILE", 1, 1, "Render the panorama robot ID
                             {"--seed", "N", "seed (default: the scenario's)"},
                             {"--labels", "", "draw the classified colours"},
                             {"--points", "", "draw the detected line points"},
-                            {"-o", "FILE.png", "output picture (required)"}}};
+                            {"-o", "FILE.png", "output picture (required); an existing file only with --overwrite"},
+                            {"--overwrite", "", "replace an existing -o file"}}};
 const cli::Command kCalibrate{"calibrate", "FILE", 1, 1,
                               "Model-free mirror calibration with the scenario's camera; prints the map's error against the true mirror.",
-                              {{"-o", "MAP.json", "output map (default results/cache/calibration_v2_<camera>.json)"},
+                              {{"-o", "MAP.json", "output map (default results/cache/calibration_v2_<camera>.json); an existing file only with --overwrite"},
+                               {"--overwrite", "", "replace an existing -o file"},
                                {"--seed", "N", "seed (default 1)"},
                                {"--image-centre", "", "assume the mirror axis at the image centre (before issue 17; saved only with -o)"}}};
 const cli::Command kColourCalibrate{"colour-calibrate", "FILE", 1, 1, "Learn the colour look-up table from labelled renders of the scenario's field.",
-                                    {{"-o", "TABLE.lut", "output table (default results/cache/colour_<camera>_<field>.lut)"},
+                                    {{"-o", "TABLE.lut", "output table (default results/cache/colour_<camera>_<field>.lut); an existing file only with --overwrite"},
+                                     {"--overwrite", "", "replace an existing -o file"},
                                      {"--seed", "N", "seed (default 1)"}}};
 const cli::Command kValidate{"validate", "FILE...", 1, 1000000,
                              "Check scenario, sweep or experiment description files without running anything;\n"
@@ -134,7 +137,8 @@ const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                            {"--status", "", "runs done / failed / missing per shard and the Slurm jobs' states; exit 0 when complete"}}};
 const cli::Command kExperiment{"experiment", "NAME", 1, 1, "Run a named experiment (omniloc list).",
                                {{"--seed", "N", "seed"},
-                                {"-o", "DIR", "output folder (default results/experiments/NAME)"},
+                                {"-o", "DIR", "output folder (default results/experiments/NAME); must not exist or be empty unless --overwrite"},
+                                {"--overwrite", "", "replace what is at -o DIR"},
                                 {"--quick", "", "the reduced version"},
                                 {"--config", "FILE", "description file instead of scenarios/experiments/NAME.json"}}};
 
@@ -147,7 +151,7 @@ void check_output_target(const cli::Args& a) {
   const auto st = std::filesystem::symlink_status(out, ec);
   if (ec || !std::filesystem::exists(st)) return;
   if (std::filesystem::is_directory(st) && std::filesystem::is_empty(out, ec) && !ec) return;
-  throw UsageError("-o " + out + " exists and is " + (std::filesystem::is_directory(st) ? "a folder with content" : "not an empty folder") +
+  throw UsageError("-o " + out + " exists and is " + (std::filesystem::is_directory(st) ? "a folder with content" : "a file") +
                    "; give --overwrite to replace it, or another -o");
 }
 
@@ -168,7 +172,7 @@ int validate_one(const std::string& file) {
   }
   // A sweep file lists scenarios (and has no robots of its own): every combination is validated.
   if (j.is_object() && j.contains("scenarios") && !j.contains("robots")) {
-    const auto spec = harness::load_sweep(file);
+    const auto spec = batch::load_sweep(file);
     std::cout << file << ": ok (sweep \"" << spec.name << "\", " << spec.runs.size() << " run(s))\n";
     return 0;
   }
@@ -240,16 +244,16 @@ int cmd_run(const cli::Args& a) {
   return 0;
 }
 
-// Slurm submission and status (harness/slurm.hpp); every option is checked before anything is written.
-int cmd_sweep_slurm(const cli::Args& a, const harness::SweepSpec& spec) {
+// Slurm submission and status (batch/slurm.hpp); every option is checked before anything is written.
+int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
   if (a.has("--slurm") && a.has("--status")) throw UsageError("--status and --slurm are separate commands");
   const int tasks = static_cast<int>(a.integer("--tasks", 0, 1, 100000));
   if (a.has("--status")) {
-    const auto st = harness::sweep_status(spec, a.value("-o"), tasks);
+    const auto st = batch::sweep_status(spec, a.value("-o"), tasks);
     std::cout << st.text;
     return st.complete() ? 0 : 1;
   }
-  harness::SlurmOptions so;
+  batch::SlurmOptions so;
   so.tasks = tasks;
   so.partition = a.value("--partition");
   so.time_limit = a.value("--time");
@@ -259,16 +263,16 @@ int cmd_sweep_slurm(const cli::Args& a, const harness::SweepSpec& spec) {
   so.dry_run = a.has("--dry-run");
   so.resubmit_missing = a.has("--resubmit-missing");
   so.out_dir = a.value("-o");
-  const auto r = harness::submit_slurm(spec, a.positional[0], so);
+  const auto r = batch::submit_slurm(spec, a.positional[0], so);
   std::cout << r.message;
   return 0;
 }
 
 int cmd_sweep(const cli::Args& a) {
-  if (a.has("--slurm") || a.has("--status")) return cmd_sweep_slurm(a, harness::load_sweep(a.positional[0]));
+  if (a.has("--slurm") || a.has("--status")) return cmd_sweep_slurm(a, batch::load_sweep(a.positional[0]));
   for (const char* o : {"--tasks", "--partition", "--time", "--cpus-per-task", "--sbatch-arg", "--dry-run", "--resubmit-missing"})
     if (a.has(o)) throw UsageError(std::string(o) + " needs --slurm");
-  harness::SweepOptions o;
+  batch::SweepOptions o;
   o.jobs = static_cast<int>(a.integer("-j", 1, 1, 256));
   const std::string shard = a.value("--shard");
   if (a.has("--shard")) {
@@ -284,19 +288,22 @@ int cmd_sweep(const cli::Args& a) {
   o.aggregate_only = a.has("--aggregate-only");
   o.stop_after = static_cast<std::size_t>(a.integer("--stop-after", 0, 0, 1000000000));
   o.out_dir = a.value("-o");
-  const auto spec = harness::load_sweep(a.positional[0]);
+  const auto spec = batch::load_sweep(a.positional[0]);
   o.progress = &std::cerr;
   std::cerr << "sweep " << spec.name << ": " << spec.runs.size() << " runs, " << o.jobs << " worker(s)"
             << (o.shard_count > 1 ? ", shard " + shard : std::string()) << "\n";
-  const auto r = harness::run_sweep(spec, o);
+  const auto r = batch::run_sweep(spec, o);
   std::cout << r.table << "ran " << r.ran << ", skipped " << r.skipped << ", failed " << r.failed << ", missing " << r.missing
-            << "\nresults: " << r.out_dir << "\n";
-  return r.failed > 0 ? 1 : 0;
+            << "\nresults: " << r.out_dir << (r.aggregate_written ? " (final aggregate: aggregate.json, aggregate.csv, runs.csv)" : "") << "\n";
+  // A whole sweep (not a shard) that could not write its final aggregate is not done.
+  const bool whole = o.shard_count == 1 || o.aggregate_only;
+  return r.failed > 0 || (whole && !r.aggregate_written) ? 1 : 0;
 }
 
 int cmd_render(const cli::Args& a) {
   const std::string out = a.value("-o");
   if (out.empty()) throw UsageError("render needs -o frame.png");
+  check_output_target(a);
   const auto s = harness::load_scenario(a.positional[0]);
   const double t = a.number("--t", 0.0, 0.0, s.duration);
   const int robot = static_cast<int>(a.integer("--robot", s.localized_robots().front(), 0, 99));
@@ -308,6 +315,7 @@ int cmd_render(const cli::Args& a) {
 }
 
 int cmd_calibrate(const cli::Args& a) {
+  check_output_target(a);  // an explicit -o; the default is the shared cache, which calibrating refreshes
   const std::uint64_t seed = a.unsigned_integer("--seed", 1, kMaxSeed);
   const auto s = harness::load_scenario(a.positional[0]);
   const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
@@ -338,6 +346,7 @@ int cmd_calibrate(const cli::Args& a) {
 }
 
 int cmd_colour_calibrate(const cli::Args& a) {
+  check_output_target(a);  // an explicit -o; the default is the shared cache
   const std::uint64_t seed = a.unsigned_integer("--seed", 1, kMaxSeed);
   const auto s = harness::load_scenario(a.positional[0]);
   const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
@@ -390,6 +399,7 @@ int cmd_compare(int argc, char** argv) {
 }
 
 int cmd_experiment(const cli::Args& a) {
+  check_output_target(a);
   for (const auto& e : experiments::all()) {
     if (e.name != a.positional[0]) continue;
     experiments::ExperimentArgs ea;

@@ -15,17 +15,17 @@
 #include "experiments/report_format.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
-#include "harness/sweep.hpp"
+#include "batch/sweep.hpp"
 
 namespace omniloc::experiments {
 
 using harness::RunDirectory;
-using harness::SweepOptions;
-using harness::SweepOutcome;
-using harness::SweepSpec;
-using harness::load_sweep;
+using batch::SweepOptions;
+using batch::SweepOutcome;
+using batch::SweepSpec;
+using batch::load_sweep;
 using harness::parse_scenario;
-using harness::run_sweep;
+using batch::run_sweep;
 
 namespace fs = std::filesystem;
 

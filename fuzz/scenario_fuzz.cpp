@@ -19,7 +19,7 @@
 #include "external/external_localizer.hpp"
 #include "external/olp_framing.hpp"
 #include "harness/scenario.hpp"
-#include "harness/sweep.hpp"
+#include "batch/sweep.hpp"
 
 namespace {
 
@@ -80,7 +80,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else if (j.is_object() && j.contains("scenarios") && !j.contains("robots")) {
       const std::string file = sweep_dir() + "/sweep.json";
       std::ofstream(file, std::ios::binary | std::ios::trunc) << text;
-      (void)omniloc::harness::load_sweep(file);
+      (void)omniloc::batch::load_sweep(file);
     } else {
       (void)omniloc::harness::parse_scenario(j, "fuzz", "fuzz input");
     }

@@ -25,9 +25,10 @@ ALLOWED = {
     "localization": {"core"},  # never sim/: it gets what a real robot gets
     "external": {"core", "localization"},  # the olp/1 host: speaks to a process, never sees sim/
     "harness": {"core", "sim", "localization", "external"},
-    "experiments": {"core", "sim", "localization", "external", "harness"},
-    "apps": {"core", "sim", "localization", "external", "harness", "experiments"},
-    "testing": {"core", "sim", "localization", "external", "harness", "experiments"},
+    "batch": {"core", "sim", "localization", "external", "harness"},  # many runs, above the single run
+    "experiments": {"core", "sim", "localization", "external", "harness", "batch"},
+    "apps": {"core", "sim", "localization", "external", "harness", "batch", "experiments"},
+    "testing": {"core", "sim", "localization", "external", "harness", "batch", "experiments"},
 }
 UNSCANNED = {"tests", "bench", "fuzz"}
 LAYERS = set(ALLOWED) | UNSCANNED

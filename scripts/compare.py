@@ -128,12 +128,15 @@ def main():
     ap.add_argument("b")
     ap.add_argument("--markdown", action="store_true", help="a markdown table instead of aligned text")
     ap.add_argument("--alpha", type=float, default=ALPHA, help="significance level of the t-test (default 0.05)")
+    ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (said in the output)")
     a = ap.parse_args()
     if not 0 < a.alpha < 1:
         ap.error("--alpha must lie in (0, 1)")
     try:
-        ra, _, _ = R.discover([a.a])
-        rb, _, _ = R.discover([a.b])
+        ra, _, _ = R.discover([a.a], a.accept_incomplete)
+        rb, _, _ = R.discover([a.b], a.accept_incomplete)
+        for d in R.INCOMPLETE:
+            print(f"note: {d} is an incomplete sweep; only its finished runs are compared")
     except SystemExit as e:
         print(f"compare: {e}", file=sys.stderr)
         return 2

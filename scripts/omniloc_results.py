@@ -42,9 +42,33 @@ def _skip_dir(d):
     return d.name.startswith(".") or ".staging" in d.name or d.name.endswith(".tmp") or ".partial" in d.name
 
 
-def discover(paths):
+# Sweep folders used although their aggregate was not final (discover(..., accept_incomplete=True)),
+# so a tool can say so in its output.
+INCOMPLETE = []
+
+
+def incomplete_reason(d, files):
+    """Why sweep folder `d` is not final, or None: only the merge (or a local sweep that ran every
+    run) writes aggregate.json, with "complete" (batch/aggregate.hpp); a folder with runs/ and
+    specs/ but no aggregate.json is a sweep whose shards or merge have not finished."""
+    if "aggregate.json" in files:
+        try:
+            agg = json.loads((d / "aggregate.json").read_text())
+        except (OSError, ValueError):
+            return "its aggregate.json cannot be read"
+        if agg.get("complete") is False:
+            return f"its aggregate covers {agg.get('done')} of {agg.get('expected')} runs"
+        return None
+    if (d / "runs").is_dir() and (d / "specs").is_dir():
+        return "it has no final aggregate yet (shards still running, or the merge `omniloc sweep SPEC --aggregate-only` not run)"
+    return None
+
+
+def discover(paths, accept_incomplete=False):
     """(runs, sweeps, experiments) under the given folders: run folders (summary.json, including those
-    inside sweeps), sweep folders (aggregate.json) and experiment folders (PNG / JSON pictures)."""
+    inside sweeps), sweep folders (aggregate.json) and experiment folders (PNG / JSON pictures).
+    A sweep folder whose aggregate is not final stops it (SystemExit naming the folder) unless
+    `accept_incomplete`; then its finished runs are used and the folder is listed in INCOMPLETE."""
     runs, sweeps, experiments = [], [], []
     stale = set()
     for p in paths:
@@ -57,6 +81,13 @@ def discover(paths):
                 subdirs[:] = []
                 continue
             subdirs.sort()
+            why = incomplete_reason(d, files)
+            if why:
+                if not accept_incomplete:
+                    raise SystemExit(f"{d}: an incomplete sweep: {why}; see `omniloc sweep SPEC --status`, "
+                                     "or pass --accept-incomplete to use its finished runs anyway")
+                if d not in INCOMPLETE:
+                    INCOMPLETE.append(d)
             if "aggregate.json" in files:
                 sweeps.append(d)
                 # Only the runs this sweep lists: a folder reused with another spec keeps old runs.

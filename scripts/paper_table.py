@@ -30,6 +30,7 @@ def main():
     ap.add_argument("--paper", required=True, help="a table key of results/reference/papers.json")
     ap.add_argument("--rows", nargs="+", metavar="LABEL", help="only these rows (published or extra row labels)")
     ap.add_argument("--markdown", action="store_true")
+    ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (said in the output)")
     a = ap.parse_args()
     papers = R.load_papers()
     tables = [k for k, v in papers.items() if isinstance(v, dict) and "columns" in v and "reproduced_by" in v and isinstance(v.get("rows"), dict)]
@@ -37,7 +38,7 @@ def main():
         print(f"error: no error table \"{a.paper}\" in papers.json; tables: {', '.join(tables)}", file=sys.stderr)
         return 2
     try:
-        runs, _, _ = R.discover(a.results)
+        runs, _, _ = R.discover(a.results, a.accept_incomplete)
         rows = C.pair_table(papers, a.paper, runs, a.rows)
     except KeyError as e:
         print(f"error: {e.args[0]}", file=sys.stderr)
@@ -76,6 +77,8 @@ def main():
     for n in notes:
         print(n)
     print(f"\nunits: x, y in cm, th in rad; paper: {papers[a.paper]['source']}")
+    for d in R.INCOMPLETE:
+        print(f"note: {d} is an incomplete sweep (--accept-incomplete): only its finished runs are in this table")
     return 0
 
 

@@ -760,15 +760,18 @@ def main():
     ap.add_argument("--title", default="omniloc report")
     ap.add_argument("--max-runs", type=int, default=24, help="trajectory plots for at most this many conditions per sweep, first seed of each (default 24)")
     ap.add_argument("--baseline", nargs="+", help="result folders to compare with (e.g. another commit's), per metric with Welch's t")
+    ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (the report says so)")
     ap.add_argument("--history", help="folder with icount.jsonl / bench.jsonl (default results/history if it exists; 'none' to leave out)")
     a = ap.parse_args()
     papers = R.load_papers()
-    runs, sweeps, experiments = R.discover(a.results)
+    runs, sweeps, experiments = R.discover(a.results, a.accept_incomplete)
     if not (runs or sweeps or experiments):
         sys.exit("report.py: no results (summary.json, aggregate.json or experiment pictures) under " + " ".join(a.results))
     rep = Report(a.out, a.title)
     rep.para(f"{len(sweeps)} sweep(s), {len(runs)} run(s), {len(experiments)} experiment(s). Published numbers: results/reference/papers.json; "
              f"everything else is read from the result files.")
+    for d in R.INCOMPLETE:
+        rep.para(f"**Incomplete sweep** (--accept-incomplete): {pathlib.Path(d).name} has no final aggregate; only its finished runs are reported.")
     provenance(rep, runs, sweeps)
     ctx = C.Context(papers, runs, experiments)
     scorecard(rep, ctx)
@@ -777,7 +780,7 @@ def main():
     error_budget_section(rep, ctx)
     if a.baseline:
         import compare
-        base_runs, _, _ = R.discover(a.baseline)
+        base_runs, _, _ = R.discover(a.baseline, a.accept_incomplete)
         rep.heading("Comparison with the baseline", 2, "baseline")
         header, rows = compare.compare_rows(base_runs, runs)
         rep.table(header, rows, f"baseline: {' '.join(a.baseline)}; this report's results as 'new'. "

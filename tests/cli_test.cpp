@@ -100,3 +100,31 @@ TEST(Cli, EveryNumberOptionRejectsAWordAndNamesIt) {
     }
   }
 }
+
+// Issue 31: no command replaces a user's file or non-empty folder without --overwrite. Each command
+// with -o is refused (exit 2, the file untouched, the message naming --overwrite) before any work,
+// and does its work when told --overwrite.
+TEST(Cli, NoCommandOverwritesWithoutBeingTold) {
+  const auto dir = std::filesystem::temp_directory_path() / ("omniloc_cli_overwrite_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "full");
+  omniloc::write_file_atomic((dir / "full" / "keep.txt").string(), "mine");
+  const std::string file = (dir / "keep.png").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"render " + kScenario + " --t 0 -o " + file, file},
+      {"calibrate " + kScenario + " -o " + file, file},
+      {"colour-calibrate " + kScenario + " -o " + file, file},
+      {"experiment error_budget --quick -o " + (dir / "full").string(), (dir / "full" / "keep.txt").string()},
+  };
+  for (const auto& [args, target] : cases) {
+    omniloc::write_file_atomic(file, "mine");
+    std::string err;
+    EXPECT_EQ(run(args, nullptr, &err), 2) << args;
+    EXPECT_NE(err.find("--overwrite"), std::string::npos) << args << ": " << err;
+    EXPECT_EQ(omniloc::read_file(target), "mine") << args << " touched " << target;
+  }
+  // Told to: the picture is replaced.
+  EXPECT_EQ(run("render " + kScenario + " --t 0 -o " + file + " --overwrite"), 0);
+  EXPECT_NE(omniloc::read_file(file), "mine");
+  std::filesystem::remove_all(dir);
+}

@@ -192,12 +192,16 @@ TEST(Cluster, FailedTaskCancelsTheMergeAndResubmitMissingCompletes) {
   EXPECT_EQ(a.at(array + "_2"), "FAILED");
   EXPECT_EQ(a.at(array + "_0"), "COMPLETED");
   EXPECT_EQ(m.at(merge), "CANCELLED");  // --kill-on-invalid-dep=yes: not PENDING forever
+  // Three shards finished, one failed, no merge: nothing may look like the sweep's result (issue 31).
+  for (const char* f : {"aggregate.json", "aggregate.csv", "runs.csv"}) EXPECT_FALSE(fs::exists(res / f)) << f;
+  EXPECT_TRUE(fs::exists(res / "progress" / "shard-0-of-4.json"));
 
   const Out st = sh(exe() + " sweep " + sweep + " --status -o " + res.string());
   EXPECT_EQ(st.code, 1) << st.text;
   EXPECT_NE(st.text.find("failed: " + bad_id), std::string::npos) << st.text;
   EXPECT_NE(st.text.find(array + "_2 FAILED"), std::string::npos) << st.text;
   EXPECT_NE(st.text.find("incomplete shards: 2;"), std::string::npos) << st.text;
+  EXPECT_NE(st.text.find("aggregate: none yet"), std::string::npos) << st.text;
 
   fs::remove(res / "runs" / bad_id);  // the fault is repaired
   const Out again = sh(exe() + " sweep " + sweep + " --slurm --resubmit-missing -o " + res.string());
@@ -244,6 +248,7 @@ TEST(Cluster, TaskKilledMidRunIsRecovered) {
   EXPECT_EQ(a.at(array + "_1"), "CANCELLED");
   EXPECT_EQ(wait_for(merge).at(merge), "CANCELLED");
   EXPECT_EQ(read_file(first.string()), kept);  // the finished run is untouched
+  EXPECT_FALSE(fs::exists(res / "aggregate.json")) << "a shard wrote the sweep's aggregate";
 
   const Out st = sh(exe() + " sweep " + sweep + " --status -o " + res.string());
   EXPECT_EQ(st.code, 1);

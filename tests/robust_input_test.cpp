@@ -22,7 +22,7 @@
 #include "core/json_parse.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
-#include "harness/sweep.hpp"
+#include "batch/sweep.hpp"
 
 namespace fs = std::filesystem;
 using omniloc::ConfigError;
@@ -304,7 +304,7 @@ TEST(RobustInput, SweepWorkerFailuresAreRecordedAndLockedRunsSkipped) {
   const fs::path dir = scratch("sweep_out");
   fs::remove_all(dir);
   const std::string file = write("tiny_sweep.json", R"({"name": "tiny", "scenarios": [")" + kQuickstart + R"("], "seeds": [1, 2]})");
-  const auto spec = omniloc::harness::load_sweep(file);
+  const auto spec = omniloc::batch::load_sweep(file);
   ASSERT_EQ(spec.runs.size(), 2u);
   // Run 0: its spec file cannot be written (a folder stands in the way, as a full disk would refuse it).
   fs::create_directories(dir / "specs" / (spec.runs[0].id + ".json") / "blocker");
@@ -313,11 +313,11 @@ TEST(RobustInput, SweepWorkerFailuresAreRecordedAndLockedRunsSkipped) {
   const int fd = ::open((dir / "locks" / (spec.runs[1].id + ".lock")).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
-  omniloc::harness::SweepOptions o;
+  omniloc::batch::SweepOptions o;
   o.out_dir = dir.string();
   o.jobs = 2;
   o.omniloc_exe = "/bin/false";  // must never be started here
-  const auto r = omniloc::harness::run_sweep(spec, o);
+  const auto r = omniloc::batch::run_sweep(spec, o);
   ::close(fd);
   EXPECT_EQ(r.failed, 1u);
   EXPECT_EQ(r.skipped, 1u);
@@ -337,14 +337,14 @@ TEST(RobustInput, SweepChildrenDieWithTheSweep) {
                                                               "\nexec sleep 300\n");
   fs::permissions(exe, fs::perms::owner_all);
   const std::string file = write("kill_sweep.json", R"({"name": "kill", "scenarios": [")" + kQuickstart + R"("], "seeds": [1]})");
-  const auto spec = omniloc::harness::load_sweep(file);
+  const auto spec = omniloc::batch::load_sweep(file);
   const pid_t sweep = ::fork();
   ASSERT_GE(sweep, 0);
   if (sweep == 0) {
-    omniloc::harness::SweepOptions o;
+    omniloc::batch::SweepOptions o;
     o.out_dir = (dir / "out").string();
     o.omniloc_exe = exe;
-    (void)omniloc::harness::run_sweep(spec, o);
+    (void)omniloc::batch::run_sweep(spec, o);
     ::_exit(0);
   }
   const fs::path pid_file = dir / "child.pid";

@@ -10,7 +10,7 @@
 #include "core/json_reader.hpp"
 #include "experiments/experiment.hpp"
 #include "harness/scenario.hpp"
-#include "harness/sweep.hpp"
+#include "batch/sweep.hpp"
 
 namespace fs = std::filesystem;
 
@@ -22,7 +22,7 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
     const bool experiment = e.path().parent_path().filename() == "experiments";
     try {
       if (sweep) {
-        omniloc::harness::load_sweep(e.path().string());
+        omniloc::batch::load_sweep(e.path().string());
       } else if (experiment) {
         // An experiment's description file: validated by the experiment named in its "experiment" key.
         std::ifstream in(e.path());
@@ -49,7 +49,7 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
 // The default main job runs scenarios/sweeps/paper_suite.json: every paper scenario must be in it,
 // and every published row's variant (occlusion fractions, auto-adjust off, other localizers) with it.
 TEST(ShippedFiles, PaperSuiteRunsEveryPaperScenario) {
-  const auto spec = omniloc::harness::load_sweep(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/sweeps/paper_suite.json");
+  const auto spec = omniloc::batch::load_sweep(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/sweeps/paper_suite.json");
   std::set<std::string> in_suite;
   for (const auto& r : spec.runs) in_suite.insert(r.scenario_name);
   for (const auto& e : fs::directory_iterator(fs::path(OMNILOC_SOURCE_DIR) / "scenarios" / "paper")) {

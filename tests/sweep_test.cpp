@@ -7,10 +7,11 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "harness/run_directory.hpp"
-#include "harness/sweep.hpp"
+#include "batch/sweep.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;
+using namespace omniloc::batch;
 namespace fs = std::filesystem;
 
 namespace {
@@ -59,19 +60,38 @@ TEST(Sweep, AggregateIndependentOfWorkersResumeAndShards) {
   EXPECT_EQ(sweep_into(spec, "j2", 2).failed, 0u);
   EXPECT_EQ(aggregate("j1"), aggregate("j2"));
 
-  // Interrupted after 17 runs, then resumed: only the rest runs, same aggregate.
+  // Interrupted after 17 runs: no aggregate file exists that could pass for the result (issue 31);
+  // resumed: only the rest runs, and then the same aggregate.
   const auto part = sweep_into(spec, "resumed", 2, false, 17);
   EXPECT_EQ(part.missing, 48u - 17u);
-  EXPECT_NE(aggregate("resumed"), aggregate("j1"));
+  EXPECT_FALSE(part.aggregate_written);
+  for (const char* f : {"aggregate.json", "aggregate.csv", "runs.csv"}) EXPECT_FALSE(fs::exists(test_dir() / "resumed" / f)) << f;
   const auto rest = sweep_into(spec, "resumed", 2, true);
   EXPECT_EQ(rest.skipped, 17u);
   EXPECT_EQ(rest.ran, 31u);
+  EXPECT_TRUE(rest.aggregate_written);
   EXPECT_EQ(aggregate("resumed"), aggregate("j1"));
+  const Json agg = Json::parse(read_file((test_dir() / "resumed" / "aggregate.json").string()));
+  EXPECT_EQ(agg["expected"], 48);
+  EXPECT_EQ(agg["done"], 48);
+  EXPECT_EQ(agg["failed"], 0);
+  EXPECT_EQ(agg["complete"], true);
 
-  // Two shards into one folder equal the whole.
-  sweep_into(spec, "sharded", 1, false, 0, 0, 2);
+  // Two shards into one folder: neither writes the sweep's aggregate, each its own progress; the
+  // merge (--aggregate-only) then equals the whole.
+  const auto first = sweep_into(spec, "sharded", 1, false, 0, 0, 2);
+  EXPECT_FALSE(first.aggregate_written);
+  EXPECT_FALSE(fs::exists(test_dir() / "sharded" / "aggregate.json"));
   const auto second = sweep_into(spec, "sharded", 1, false, 0, 1, 2);
   EXPECT_EQ(second.ran, 24u);
+  EXPECT_FALSE(fs::exists(test_dir() / "sharded" / "aggregate.json")) << "a shard wrote the sweep's aggregate";
+  const Json progress = Json::parse(read_file((test_dir() / "sharded" / "progress" / "shard-1-of-2.json").string()));
+  EXPECT_EQ(progress["runs"], 24);
+  EXPECT_EQ(progress["done"], 24);
+  SweepOptions merge;
+  merge.aggregate_only = true;
+  merge.out_dir = (test_dir() / "sharded").string();
+  EXPECT_TRUE(run_sweep(spec, merge).aggregate_written);
   EXPECT_EQ(aggregate("sharded"), aggregate("j1"));
 }
 
@@ -153,7 +173,13 @@ std::vector<std::vector<std::string>> parse_csv(const std::string& s) {
 TEST(Sweep, CsvFilesAreValidWithJsonObjectParameters) {
   fs::remove_all(test_dir());
   const SweepSpec spec = load_sweep(make_sweep());
-  sweep_into(spec, "csv", 2, false, 6);  // a few finished runs are enough for aggregate rows
+  sweep_into(spec, "csv", 2, false, 6);  // a few finished runs are enough for aggregate rows ...
+  SweepOptions take;                       // ... once the rest are recorded as failed (a final aggregate)
+  take.aggregate_only = true;
+  take.out_dir = (test_dir() / "csv").string();
+  for (std::size_t i = 6; i < spec.runs.size(); ++i)
+    write_file_atomic((test_dir() / "csv" / "failed" / (spec.runs[i].id + ".json")).string(), "{}\n");
+  ASSERT_TRUE(run_sweep(spec, take).aggregate_written);
   for (const char* f : {"runs.csv", "aggregate.csv"}) {
     const auto rows = parse_csv(read_file((test_dir() / "csv" / f).string()));
     ASSERT_GT(rows.size(), 1u) << f;

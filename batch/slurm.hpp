@@ -1,7 +1,7 @@
 #pragma once
 // Sweeps on a Slurm cluster: a job array whose task I runs `omniloc sweep SPEC --shard I/N --resume`
 // and a merge job that aggregates once every task has succeeded. Nothing here runs a simulation:
-// the shards are ordinary sweep processes (harness/sweep.hpp), so a Slurm sweep gives the same
+// the shards are ordinary sweep processes (batch/sweep.hpp), so a Slurm sweep gives the same
 // run folders and byte-identical aggregates as a local one, and a task killed at any point loses
 // only the run it was writing (run folders are committed by rename).
 //
@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "harness/sweep.hpp"
+#include "batch/sweep.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::batch {
 
 struct SlurmOptions {
   int tasks = 0;                         ///< array size N (0: min(runs, 32)); at most the number of runs
@@ -76,4 +76,4 @@ SweepStatus sweep_status(const SweepSpec& spec, const std::string& out_dir, int 
 /// SHA-256 of a byte string as 64 lowercase hex digits (FIPS 180-4); identifies a sweep's content.
 std::string sha256_hex(const std::string& bytes);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::batch

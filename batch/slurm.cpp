@@ -1,4 +1,4 @@
-#include "harness/slurm.hpp"
+#include "batch/slurm.hpp"
 
 #include <poll.h>
 #include <sys/wait.h>
@@ -23,7 +23,7 @@
 #include "external/external_config.hpp"
 #include "external/sha256.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::batch {
 
 namespace fs = std::filesystem;
 
@@ -321,6 +321,10 @@ SweepStatus sweep_status(const SweepSpec& spec, const std::string& out_dir, int 
     if (s.missing_ids.size() > 3) t << "    ... and " << s.missing_ids.size() - 3 << " more missing\n";
   }
   t << merge_line;
+  // Only the merge (or a local sweep that ran everything) writes the aggregate (batch/aggregate.hpp).
+  std::error_code ec;
+  t << (fs::exists(dir / "aggregate.json", ec) ? "aggregate: final (aggregate.json, aggregate.csv, runs.csv)\n"
+                                               : "aggregate: none yet (written by the merge once no run is missing)\n");
   if (!st.active_jobs.empty()) t << "still queued or running: " << st.active_jobs.size() << " job(s)\n";
   if (st.complete()) {
     t << "complete: every run finished\n";
@@ -585,4 +589,4 @@ SlurmSubmission submit_slurm(const SweepSpec& spec, const std::string& spec_path
   return out;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::batch

@@ -1,0 +1,38 @@
+#pragma once
+// The aggregate of a sweep: per scenario x localizer x parameters, the mean and 95 % interval over
+// seeds of every number in the runs' summary.json. Computed from the finished run folders in run
+// order, so it does not depend on -j, sharding or interruptions; written (runs.csv, aggregate.csv,
+// aggregate.json) only when it is final: every run of the sweep done or failed, by the process that
+// covers the whole sweep (a local sweep, or the merge after Slurm shards), never by a shard.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "batch/sweep_spec.hpp"
+
+namespace omniloc::batch {
+
+/// Mean and 95 % confidence interval (Student t) of a sample.
+struct Interval {
+  double mean = 0, low = 0, high = 0;
+  std::size_t n = 0;
+};
+Interval mean_ci95(const std::vector<double>& v);
+
+/// Whether run `r` has a finished folder (its summary.json is written last, by rename).
+bool run_finished(const std::filesystem::path& dir, const SweepRun& r);
+
+struct AggregateOutcome {
+  std::size_t expected = 0, done = 0, failed = 0, missing = 0;
+  bool written = false;  ///< the final files were written (nothing missing)
+  std::string table;     ///< the printed aggregate (also when not written: what is there so far)
+};
+
+/// Takes the census of `dir` and, when no run is missing, writes the final runs.csv,
+/// aggregate.csv and aggregate.json atomically (aggregate.json records expected / done / failed).
+/// With runs missing it writes nothing final and removes final files a different, earlier state of
+/// the folder left (they would no longer describe it).
+AggregateOutcome write_final_aggregate(const SweepSpec& spec, const std::filesystem::path& dir);
+
+}  // namespace omniloc::batch

@@ -1,0 +1,303 @@
+#include "batch/sweep.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <ostream>
+#include <thread>
+
+#include "core/atomic_file.hpp"
+#include "core/version.hpp"
+#include "harness/run_directory.hpp"
+
+namespace omniloc::batch {
+
+namespace fs = std::filesystem;
+using harness::remove_stale_partials;
+
+namespace {
+
+std::string fmt(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string fmt_duration(double s) {
+  char b[32];
+  if (s >= 3600) std::snprintf(b, sizeof b, "%dh%02dm", static_cast<int>(s / 3600), static_cast<int>(std::fmod(s, 3600) / 60));
+  else if (s >= 60) std::snprintf(b, sizeof b, "%dm%02ds", static_cast<int>(s / 60), static_cast<int>(std::fmod(s, 60)));
+  else std::snprintf(b, sizeof b, "%.0fs", s);
+  return b;
+}
+
+// Runs one child `omniloc run`; returns its wait status. `lock_fd` (the run's lock, opened
+// close-on-exec) is handed to the child as a plain descriptor, so the lock stays held as long as
+// either process lives.
+int spawn_run(const std::string& exe, const std::string& spec, const std::string& out, const std::string& log, int lock_fd) {
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    // The child dies with the thread that forked it (the sweep's worker): after kill -9 of the sweep
+    // no orphan keeps running beside a later --resume. If the parent died before prctl took effect,
+    // getppid() already differs.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
+    if (lock_fd >= 0) (void)::dup(lock_fd);  // dup() clears FD_CLOEXEC on the copy
+    int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) fd = ::open("/dev/null", O_WRONLY);
+    if (fd >= 0) {
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      ::close(fd);
+    }
+    // --overwrite: the sweep owns runs/<id>/ and replaces a previous result of the same run.
+    ::execl(exe.c_str(), exe.c_str(), "run", spec.c_str(), "-o", out.c_str(), "--overwrite", "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return status;
+}
+
+std::string tail_of(const std::string& path, std::size_t max_chars) {
+  std::string s;
+  try {
+    s = read_file(path);
+  } catch (...) {
+    return "";
+  }
+  return s.size() > max_chars ? s.substr(s.size() - max_chars) : s;
+}
+
+}  // namespace
+
+namespace {
+
+struct SweepFolder {
+  fs::path dir;
+  std::string exe;  ///< the binary spawned for runs
+};
+
+SweepFolder open_sweep_folder(const std::string& out_dir, const SweepOptions& o) {
+  SweepFolder f{out_dir, ""};
+  fs::create_directories(f.dir / "runs");
+  fs::create_directories(f.dir / "specs");
+  fs::create_directories(f.dir / "logs");
+  fs::create_directories(f.dir / "failed");
+  f.exe = o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe").string() : o.omniloc_exe;
+  fs::create_directories(f.dir / "locks");
+  // Staging folders of runs killed mid-write are hidden (".<id>.partial-<host>-<pid>"); clear those
+  // whose process is gone, never those of runs still going (another shard or Slurm array task
+  // sharing the folder), nor another host's, which cannot be judged from here.
+  remove_stale_partials((f.dir / "runs").string());
+  return f;
+}
+
+// This shard's runs that still need doing; `skipped` counts those --resume finds finished.
+std::vector<const SweepRun*> runs_to_do(const SweepSpec& spec, const SweepOptions& o, const fs::path& dir, std::size_t& skipped) {
+  std::vector<const SweepRun*> todo;
+  for (const auto& r : spec.runs) {
+    if (static_cast<int>(r.index % o.shard_count) != o.shard_index) continue;
+    if (o.aggregate_only) continue;
+    if (o.resume && run_finished(dir, r)) {
+      ++skipped;
+      continue;
+    }
+    todo.push_back(&r);
+  }
+  if (o.stop_after > 0 && todo.size() > o.stop_after) todo.resize(o.stop_after);
+  return todo;
+}
+
+// llvmpipe draws with one thread per core by default, so N parallel runs on N cores would run N^2
+// rasterizer threads: on 2 cores -j 2 took 19.0-19.7 s for 8 short tracking runs with the default
+// and 16.6-17.9 s with one thread per run (docs/performance.md). Results are byte-identical with
+// any thread count. The children inherit the variable; a value the user set is kept.
+void share_rasterizer_threads(int jobs) {
+  if (jobs > 1 && std::getenv("LP_NUM_THREADS") == nullptr) {
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    ::setenv("LP_NUM_THREADS", std::to_string(std::max(1u, cores / static_cast<unsigned>(jobs))).c_str(), 0);
+  }
+}
+
+class SweepWorkers {
+ public:
+  SweepWorkers(const SweepFolder& folder, const SweepOptions& o, std::vector<const SweepRun*> todo)
+      : folder_(folder), o_(o), todo_(std::move(todo)), tty_(o.progress && ::isatty(2)), t0_(std::chrono::steady_clock::now()) {}
+
+  void run() {
+    std::vector<std::thread> pool;
+    for (int k = 0; k < std::max(1, o_.jobs); ++k) pool.emplace_back([this] { work(); });
+    for (auto& t : pool) t.join();
+    if (tty_) *o_.progress << "\n";
+  }
+  std::size_t done() const { return done_; }
+  std::size_t failed() const { return failed_; }
+  std::size_t busy() const { return busy_; }
+
+ private:
+  enum class Result { ok, failed, finished_elsewhere };
+
+  void work() {
+    for (;;) {
+      const std::size_t i = next_.fetch_add(1);
+      if (i >= todo_.size()) return;
+      const SweepRun& r = *todo_[i];
+      const fs::path fail_marker = folder_.dir / "failed" / (r.id + ".json");
+      double secs = 0;
+      // One lock per run: a second sweep (a --resume beside a sweep still running, or a
+      // resubmitted shard) skips a run somebody else is running instead of running it twice.
+      const std::string lock_path = (folder_.dir / "locks" / (r.id + ".lock")).string();
+      const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+      if (lock_fd >= 0 && ::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+        ::close(lock_fd);
+        std::lock_guard<std::mutex> lock(mu_);
+        ++busy_;
+        if (o_.progress) *o_.progress << r.id << ": skipped, another process is running it\n";
+        continue;
+      }
+      const Result result = run_locked(r, fail_marker, lock_path, lock_fd, secs);
+      if (lock_fd >= 0) ::close(lock_fd);
+      if (result == Result::finished_elsewhere) {
+        std::lock_guard<std::mutex> lock(mu_);
+        ++busy_;
+        continue;
+      }
+      report(r, result == Result::ok, secs);
+    }
+  }
+
+  // Runs `r` holding its lock `lock_fd` (-1: the lock could not be created); `secs` gets the run's time.
+  Result run_locked(const SweepRun& r, const fs::path& fail_marker, const std::string& lock_path, int lock_fd, double& secs) {
+    // Any exception here (a full disk while writing the spec or the failure record) becomes a
+    // recorded failure of this run: an exception escaping a std::thread would abort the sweep.
+    try {
+      if (lock_fd < 0) throw RuntimeFailure("cannot create lock " + lock_path + ": " + std::strerror(errno));
+      // Finished by another process since the list was made.
+      if (o_.resume && run_finished(folder_.dir, r)) return Result::finished_elsewhere;
+      const std::string spec_path = (folder_.dir / "specs" / (r.id + ".json")).string();
+      write_file_atomic(spec_path, r.scenario.dump(2) + "\n");
+      const std::string log = (folder_.dir / "logs" / (r.id + ".log")).string();
+      const auto r0 = std::chrono::steady_clock::now();
+      const int st = spawn_run(folder_.exe, spec_path, (folder_.dir / "runs" / r.id).string(), log, lock_fd);
+      secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+      const bool ok = st >= 0 && WIFEXITED(st) && WEXITSTATUS(st) == 0 && run_finished(folder_.dir, r);
+      if (ok) {
+        std::error_code ec;
+        fs::remove(fail_marker, ec);
+      } else {
+        Json f{{"id", r.id}, {"log", tail_of(log, 2000)}};
+        if (st >= 0 && WIFEXITED(st)) f["exit_code"] = WEXITSTATUS(st);
+        if (st >= 0 && WIFSIGNALED(st)) f["signal"] = WTERMSIG(st);
+        write_file_atomic(fail_marker.string(), f.dump(2) + "\n");
+      }
+      return ok ? Result::ok : Result::failed;
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (o_.progress) *o_.progress << r.id << ": FAILED: " << e.what() << "\n";
+      try {
+        write_file_atomic(fail_marker.string(), Json{{"id", r.id}, {"error", e.what()}}.dump(2) + "\n");
+      } catch (const std::exception&) {
+        // The disk that made the run fail may refuse the record too; the count below still has it.
+      }
+      return Result::failed;
+    }
+  }
+
+  void report(const SweepRun& r, bool ok, double secs) {
+    std::lock_guard<std::mutex> lock(mu_);
+    ++done_;
+    if (!ok) ++failed_;
+    if (!o_.progress) return;
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+    const double eta = el / done_ * (todo_.size() - done_);
+    if (tty_) {
+      const int width = 30, filled = static_cast<int>(width * done_ / std::max<std::size_t>(1, todo_.size()));
+      *o_.progress << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done_ << "/" << todo_.size()
+                   << " failed " << failed_ << " ETA " << fmt_duration(eta) << "   " << std::flush;
+    } else {
+      *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << r.id << (ok ? " ok " : " FAILED ") << fmt(secs) << " s, ETA "
+                   << fmt_duration(eta) << "\n";
+    }
+  }
+
+  const SweepFolder& folder_;
+  const SweepOptions& o_;
+  const std::vector<const SweepRun*> todo_;
+  const bool tty_;
+  const std::chrono::steady_clock::time_point t0_;
+  std::mutex mu_;
+  std::atomic<std::size_t> next_{0};
+  std::size_t done_ = 0, failed_ = 0;
+  std::size_t busy_ = 0;  // runs another live process holds the lock of
+};
+
+// A shard's own record: its runs' states, for `sweep --status` and people, never read as a result.
+void write_shard_progress(const SweepSpec& spec, const SweepOptions& o, const fs::path& dir, SweepOutcome& out) {
+  std::size_t runs = 0, done = 0, failed = 0;
+  for (const auto& r : spec.runs) {
+    if (static_cast<int>(r.index % o.shard_count) != o.shard_index) continue;
+    ++runs;
+    if (run_finished(dir, r)) ++done;
+    else if (fs::exists(dir / "failed" / (r.id + ".json"))) ++failed;
+  }
+  out.missing = runs - done - failed;
+  // Named as on the command line (--shard I/N, I from 0).
+  const std::string name = "shard-" + std::to_string(o.shard_index) + "-of-" + std::to_string(o.shard_count) + ".json";
+  fs::create_directories(dir / "progress");
+  write_file_atomic((dir / "progress" / name).string(),
+                    Json{{"shard", o.shard_index}, {"shards", o.shard_count}, {"runs", runs}, {"done", done}, {"failed", failed},
+                         {"missing", out.missing}, {"omniloc", build_info_json()}}
+                            .dump(2) + "\n");
+  char line[256];
+  std::snprintf(line, sizeof line, "shard %d/%d: %zu runs, %zu done, %zu failed, %zu missing; the sweep's aggregate is written by "
+                "`omniloc sweep SPEC --aggregate-only` once every shard is done\n", o.shard_index, o.shard_count, runs, done, failed,
+                out.missing);
+  out.table = line;
+}
+
+}  // namespace
+
+SweepOutcome run_sweep(const SweepSpec& spec, const SweepOptions& o) {
+  SweepOutcome out;
+  out.out_dir = o.out_dir.empty() ? "results/sweeps/" + spec.name : o.out_dir;
+  out.expected = spec.runs.size();
+  const SweepFolder folder = open_sweep_folder(out.out_dir, o);
+  SweepWorkers workers(folder, o, runs_to_do(spec, o, folder.dir, out.skipped));
+  share_rasterizer_threads(o.jobs);
+  workers.run();
+  out.ran = workers.done();
+  out.failed = workers.failed();
+  out.skipped += workers.busy();
+  if (o.shard_count > 1 && !o.aggregate_only) {
+    write_shard_progress(spec, o, folder.dir, out);
+    return out;
+  }
+  const AggregateOutcome a = write_final_aggregate(spec, folder.dir);
+  out.missing = a.missing;
+  out.table = a.table;
+  out.aggregate_written = a.written;
+  if (!a.written)
+    out.table += "incomplete: " + std::to_string(a.missing) + " of " + std::to_string(a.expected) +
+                 " runs missing; no aggregate written (run again with --resume, or see --status)\n";
+  return out;
+}
+
+}  // namespace omniloc::batch

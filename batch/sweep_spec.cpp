@@ -1,0 +1,240 @@
+#include "batch/sweep_spec.hpp"
+
+#include <filesystem>
+#include <set>
+
+#include "core/json_parse.hpp"
+#include "external/external_config.hpp"
+#include "harness/scenario.hpp"
+
+namespace omniloc::batch {
+
+namespace fs = std::filesystem;
+using harness::parse_scenario;
+
+namespace {
+
+// Largest number of scenario combinations a sweep may hold: every one is validated before any run.
+constexpr std::size_t kMaxCombinations = 10000;
+// Largest number of runs (combinations x seeds): the run list is held in memory with each run's scenario.
+constexpr std::size_t kMaxRuns = 1000000;
+
+std::string sanitize(const std::string& s) {
+  std::string o;
+  for (char c : s) o += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '=' || c == '+') ? c : '_';
+  return o.empty() ? "_" : o;
+}
+
+Json read_json_file(const std::string& path, const std::string& what_path) { return read_json_strict(path, what_path); }
+
+
+}  // namespace
+
+namespace {
+
+using Combo = std::vector<std::pair<std::string, Json>>;       // JSON pointer -> value
+using Localizers = std::vector<std::pair<std::string, Json>>;  // label, localizer JSON (null = scenario's own)
+
+// One entry of "scenarios": the scenario file read, with the localizers and parameter combinations it runs with.
+struct ScenarioEntry {
+  std::string name;
+  Json json;
+  Localizers locs;
+  std::vector<Combo> combos;
+};
+
+// "localizers": [{"type": ...}, ...] at `at`.
+Localizers parse_localizers(const Json& l, const std::string& at) {
+  if (!l.is_array() || l.empty()) throw ConfigError(at, json_brief(l), "a non-empty array of {\"type\": ...} objects");
+  Localizers locs;
+  for (std::size_t i = 0; i < l.size(); ++i) {
+    Json lj = l[i];
+    if (!lj.is_object() || !lj.contains("type")) throw ConfigError(json_child(at, i), json_brief(lj), "an object {\"type\": ...}");
+    const bool external = lj["type"] == "external";
+    // An external localizer's row is named after its script unless labelled (docs/protocol.md).
+    std::string label = lj.value("label", external ? external::default_label(lj) : lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
+    lj.erase("label");
+    external::anchor_external_paths(lj);
+    locs.emplace_back(sanitize(label), lj);
+  }
+  return locs;
+}
+
+// "parameters": {pointer: [values]} at `at`: the cross product of all of them, appended to `base_combos`.
+std::vector<Combo> parse_combos(const Json& pj, const std::string& at, const std::vector<Combo>& base_combos) {
+  if (!pj.is_object()) throw ConfigError(at, json_brief(pj), "an object {\"/json/pointer\": [values, ...]}");
+  std::vector<Combo> combos = base_combos;
+  for (auto it = pj.begin(); it != pj.end(); ++it) {
+    const std::string pp = json_child(at, it.key());
+    if (it.key().empty() || it.key()[0] != '/') throw ConfigError(pp, "\"" + it.key() + "\"", "a JSON pointer such as /robots/0/motion/speed");
+    if (!it.value().is_array() || it.value().empty()) throw ConfigError(pp, json_brief(it.value()), "a non-empty array of values");
+    // The cross product grows multiplicatively; refuse it before building it (each combination
+    // is validated as a scenario below, about 10 ms apiece).
+    if (combos.size() * it.value().size() > kMaxCombinations)
+      throw ConfigError(pp, "an array of " + std::to_string(it.value().size()) + " values, making " +
+                                std::to_string(combos.size() * it.value().size()) + " combinations",
+                        "at most " + std::to_string(kMaxCombinations) + " parameter combinations per scenario entry");
+    std::vector<Combo> next;
+    for (const auto& c : combos)
+      for (const auto& v : it.value()) {
+        auto c2 = c;
+        c2.emplace_back(it.key(), v);
+        next.push_back(c2);
+      }
+    combos = next;
+  }
+  return combos;
+}
+
+// Entry `sp` of "scenarios": a path, or {"file": ..., "parameters": ..., "localizers": ...}.
+ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, const fs::path& base, const Localizers& locs,
+                                  const std::vector<Combo>& combos) {
+  ScenarioEntry sc{"", Json(), locs, combos};
+  const Json* file = &entry;
+  std::string fp = sp;
+  if (entry.is_object()) {
+    JsonReader er(entry, sp);
+    er.allow("comment");
+    file = er.raw("file", true);
+    fp = json_child(sp, "file");
+    if (const Json* l = er.raw("localizers")) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
+    if (const Json* pj = er.raw("parameters")) sc.combos = parse_combos(*pj, json_child(sp, "parameters"), combos);
+    er.finish();
+  }
+  if (!file->is_string())
+    throw ConfigError(fp, json_brief(*file), "a scenario file path (relative to the sweep file), or {\"file\": path, \"parameters\": ..., \"localizers\": ...}");
+  fs::path p = file->get<std::string>();
+  if (p.is_relative()) p = base / p;
+  if (!fs::exists(p)) throw ConfigError(fp, json_brief(*file), "an existing scenario file (looked for " + p.string() + ")");
+  sc.json = read_json_file(p.string(), fp);
+  sc.name = sc.json.is_object() && sc.json.contains("name") && sc.json["name"].is_string() ? sc.json["name"].get<std::string>() : p.stem().string();
+  return sc;
+}
+
+std::vector<ScenarioEntry> read_scenario_entries(const Json& scen, const fs::path& base, const Localizers& locs,
+                                                 const std::vector<Combo>& combos) {
+  if (!scen.is_array() || scen.empty()) throw ConfigError("/scenarios", json_brief(scen), "a non-empty array of scenario file paths");
+  std::vector<ScenarioEntry> scenarios;
+  for (std::size_t i = 0; i < scen.size(); ++i)
+    scenarios.push_back(read_scenario_entry(scen[i], json_child("/scenarios", i), base, locs, combos));
+  return scenarios;
+}
+
+// "seeds": absent (seed 1), a list, or {"first": ..., "count": ...}.
+std::vector<std::uint64_t> read_seeds(const Json* sj) {
+  std::vector<std::uint64_t> seeds;
+  if (!sj) {
+    seeds = {1};
+  } else if (sj->is_array()) {
+    for (std::size_t i = 0; i < sj->size(); ++i) {
+      if (!(*sj)[i].is_number_unsigned() || (*sj)[i].get<std::uint64_t>() > (1ULL << 53))
+        throw ConfigError(json_child("/seeds", i), json_brief((*sj)[i]), "an integer seed in [0, 2^53] (what a scenario's seed accepts)");
+      seeds.push_back((*sj)[i].get<std::uint64_t>());
+    }
+  } else {
+    JsonReader s(*sj, "/seeds");
+    const auto first = s.integer("first", 1, 0, 1LL << 52);
+    const auto count = s.integer("count", std::nullopt, 1, 100000);
+    s.finish();
+    for (long long k = 0; k < count; ++k) seeds.push_back(static_cast<std::uint64_t>(first + k));
+  }
+  if (seeds.empty()) throw ConfigError("/seeds", "[]", "at least one seed");
+  if (seeds.size() > 1000000) throw ConfigError("/seeds", std::to_string(seeds.size()) + " seeds", "at most 1000000 seeds");
+  return seeds;
+}
+
+void check_sweep_size(const std::vector<ScenarioEntry>& scenarios, std::size_t seed_count) {
+  std::size_t total = 0;
+  for (const auto& sc : scenarios) total += sc.locs.size() * sc.combos.size();
+  if (total > kMaxCombinations)
+    throw ConfigError("/scenarios", std::to_string(total) + " scenario x localizer x parameter combinations",
+                      "at most " + std::to_string(kMaxCombinations) + " (split the sweep)");
+  if (total * seed_count > kMaxRuns)
+    throw ConfigError("/seeds", std::to_string(total * seed_count) + " runs (" + std::to_string(total) + " combinations x " +
+                                    std::to_string(seed_count) + " seeds)",
+                      "at most " + std::to_string(kMaxRuns) + " runs in one sweep (split it)");
+}
+
+// The scenario with the combination's values written in; `label` gets "leaf=value,..." of them.
+Json apply_combo(const Json& scenario, const Combo& combo, std::string& label) {
+  Json patched = scenario;
+  for (const auto& [ptr, v] : combo) {
+    try {
+      patched[Json::json_pointer(ptr)] = v;
+    } catch (const std::exception& e) {
+      throw ConfigError("/parameters" + ptr, json_brief(v), std::string("a pointer into the scenario (") + e.what() + ")");
+    }
+    const std::string leaf = ptr.substr(ptr.find_last_of('/') + 1);
+    label += (label.empty() ? "" : ",") + leaf + "=" + v.dump();
+  }
+  return patched;
+}
+
+// Validates every combination once, before any run, then adds one run per seed.
+void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenarios, const std::vector<std::uint64_t>& seeds,
+              SweepSpec& spec) {
+  std::set<std::string> ids;
+  for (const auto& sc : scenarios)
+    for (const auto& [llabel, lj] : sc.locs)
+      for (const auto& combo : sc.combos) {
+        std::string plabel;
+        Json patched = apply_combo(sc.json, combo, plabel);
+        if (!lj.is_null()) patched["localizer"] = lj;
+        if (patched.contains("localizer")) external::anchor_external_paths(patched["localizer"]);
+        const Json own = patched.value("localizer", Json::object());
+        const std::string loc_label = !lj.is_null() ? llabel
+                                      : own.value("type", Json()) == "external"
+                                          ? own.value("label", external::default_label(own))
+                                          : sanitize(own.value("type", std::string("odometry_only")));
+        try {
+          parse_scenario(patched, sc.name);
+        } catch (const ConfigError& e) {
+          throw ConfigError("sweep " + path + ", scenario \"" + sc.name + "\", localizer \"" + loc_label + "\"" +
+                                (plabel.empty() ? "" : ", " + plabel) + ": " + (e.path().empty() ? "/" : e.path()),
+                            e.value(), e.expected());
+        }
+        for (std::uint64_t seed : seeds) {
+          SweepRun run;
+          run.index = spec.runs.size();
+          run.scenario_name = sc.name;
+          run.localizer_label = loc_label;
+          run.params_label = plabel.empty() ? "default" : plabel;
+          run.seed = seed;
+          run.scenario = patched;
+          run.scenario["seed"] = seed;
+          run.scenario["name"] = sc.name;
+          run.id = sanitize(sc.name) + "__" + loc_label + "__" + sanitize(run.params_label) + "__s" + std::to_string(seed);
+          if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two combinations give the same run id; add \"label\"s)");
+          spec.runs.push_back(std::move(run));
+        }
+      }
+}
+
+}  // namespace
+
+SweepSpec load_sweep(const std::string& path) {
+  SweepSpec spec;
+  spec.source = path;
+  const Json j = read_json_file(path, "sweep file");
+  JsonReader r(j, "");
+  r.allow("comment");
+  spec.name = r.string("name", fs::path(path).stem().string());
+  spec.name = sanitize(spec.name);
+
+  // Sweep-wide localizers and parameters apply to every scenario entry; an entry written as
+  // {"file": ..., "parameters": {...}, "localizers": [...]} adds its own parameters to the sweep's and
+  // replaces the sweep's localizers, so one file can hold rows that vary different things (the paper suite).
+  Localizers locs = {{"", Json()}};
+  if (const Json* l = r.raw("localizers")) locs = parse_localizers(*l, "/localizers");
+  std::vector<Combo> combos = {{}};
+  if (const Json* pj = r.raw("parameters")) combos = parse_combos(*pj, "/parameters", combos);
+  const std::vector<ScenarioEntry> scenarios = read_scenario_entries(*r.raw("scenarios", true), fs::path(path).parent_path(), locs, combos);
+  const std::vector<std::uint64_t> seeds = read_seeds(r.raw("seeds"));
+  r.finish();
+
+  check_sweep_size(scenarios, seeds.size());
+  add_runs(path, scenarios, seeds, spec);
+  return spec;
+}
+
+}  // namespace omniloc::batch

@@ -1,0 +1,32 @@
+#pragma once
+// A sweep's list of runs: the cross product of scenarios x localizers x parameter values x seeds,
+// read from a sweep file and validated whole before any run (docs/extending.md, "Add a sweep").
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/json_reader.hpp"
+
+namespace omniloc::batch {
+
+struct SweepRun {
+  std::size_t index = 0;
+  std::string id;              ///< stable folder name: <scenario>__<localizer>__<params>__s<seed>
+  std::string scenario_name;
+  std::string localizer_label;
+  std::string params_label;
+  std::uint64_t seed = 0;
+  Json scenario;               ///< the scenario JSON with overrides applied
+  std::string group() const { return scenario_name + "|" + localizer_label + "|" + params_label; }
+};
+
+struct SweepSpec {
+  std::string name;
+  std::string source;
+  std::vector<SweepRun> runs;
+};
+
+/// Reads a sweep file; every scenario/localizer/override combination is validated here, before any run.
+SweepSpec load_sweep(const std::string& path);
+
+}  // namespace omniloc::batch
