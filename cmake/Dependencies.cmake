@@ -21,3 +21,6 @@ target_link_libraries(omniloc::opencv INTERFACE ${OPENCV_imgcodecs_LIB} ${OPENCV
 # configuration early, with the header's name, when a package is missing.
 find_path(OSMESA_INCLUDE_DIR GL/osmesa.h REQUIRED)
 find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)
+
+# SHA-256 of an external localizer's program and script (summary.json provenance).
+find_package(OpenSSL REQUIRED COMPONENTS Crypto)

@@ -1,7 +1,9 @@
 // libFuzzer target over the readers of user input: the strict JSON reader, then the scenario, sweep
 // and experiment-description parsers (chosen by the document's shape, as `omniloc validate` does).
 // The only acceptable failure is a ConfigError; any other exception, a crash, a sanitizer report or
-// a timeout is a finding. Every finding becomes a test in tests/robust_input_test.cpp.
+// a timeout is a finding. Inputs that start with "olp\n" are instead a byte stream from an external
+// localizer's client (docs/protocol.md): the olp/1 framing reader and the strict readers of ready and
+// estimate, where the only acceptable failure is a ProtocolError. Every finding becomes a test in tests/robust_input_test.cpp.
 // Built by scripts/fuzz.sh (clang-14, -fsanitize=fuzzer,address,undefined); seed corpus: scenarios/.
 #include <unistd.h>
 
@@ -14,6 +16,8 @@
 
 #include "core/json_parse.hpp"
 #include "experiments/cooperative_001.hpp"
+#include "external/external_localizer.hpp"
+#include "external/olp_framing.hpp"
 #include "harness/scenario.hpp"
 #include "harness/sweep.hpp"
 
@@ -34,8 +38,41 @@ const std::string& sweep_dir() {
 
 }  // namespace
 
+// A client's stdout as omniloc reads it: in pieces whose sizes come from the input itself (so the
+// fuzzer explores split lines and split binary parts), every whole message through the strict readers.
+void fuzz_olp_stream(std::string_view bytes) {
+  using namespace omniloc::external;
+  MessageReader reader;
+  std::size_t pos = 0, round = 0;
+  try {
+    while (pos < bytes.size()) {
+      const std::size_t piece = 1 + static_cast<unsigned char>(bytes[(round++ * 7) % bytes.size()]) * 3;
+      reader.feed(bytes.substr(pos, piece));
+      pos += std::min(piece, bytes.size() - pos);
+      while (auto m = reader.next()) {
+        if (m->type() == "ready") (void)ExternalLocalizer::parse_ready(m->header, {"mcl", "matching"});
+        else if (m->type() == "estimate") {
+          const auto k = m->header.find("k");
+          (void)ExternalLocalizer::parse_estimate(m->header, k != m->header.end() && k->is_number_integer() ? k->get<long long>() : 0);
+        }
+      }
+    }
+  } catch (const ProtocolError&) {
+    // The expected outcome for a faulty client: the run fails with this message.
+  }
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  if (text.rfind("olp\n", 0) == 0) {
+    try {
+      fuzz_olp_stream(std::string_view(text).substr(4));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "finding: olp stream: exception other than ProtocolError: %s\n", e.what());
+      std::abort();
+    }
+    return 0;
+  }
   try {
     const omniloc::Json j = omniloc::parse_json_strict(text, "fuzz input");
     if (j.is_object() && j.contains("experiment")) {

@@ -82,6 +82,7 @@ PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int rob
   out.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   out.vision_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   out.image = img;
+  out.obs.image = img;
   // Entropy auto-adjustment (paper 002) on what the robot sees; never while the lens is covered.
   if (exposure_.enabled && !cond.covered && out.obs.camera_ok) {
     auto ct = controllers_.find(robot_id);

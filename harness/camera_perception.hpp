@@ -45,6 +45,8 @@ class CameraPerception : public Perception {
   const sim::PanoramicCamera& camera() const { return *camera_; }
   sim::PanoramicCamera& camera() { return *camera_; }
   const CalibrationMap& calibration() const { return map_; }
+  const CalibrationMap* calibration_map() const override { return &map_; }
+  bool detects_blobs() const override { return blob_detector_ != nullptr; }
   const ColourTable& colour_table() const { return table_; }
   /// The exposure controller's parameters with the camera's exposure and gain ranges filled in.
   const ExposureParams& exposure_params() const { return exposure_; }

@@ -36,6 +36,15 @@ const std::vector<LocalizerInfo>& localizers() {
       {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },
        [] { return params_schema(LandmarkLocalizerParams::params()); }},
+      {"external", "a user's localizer in any language, run as its own process and spoken to in olp/1 (docs/protocol.md); named in results by the name the client reports", false, true,
+       [](JsonReader& r, const LocalizerContext& ctx) -> std::unique_ptr<Localizer> {
+         external::ExternalConfig cfg = external::ExternalConfig::from_json(r);
+         if (!ctx.session)
+           throw ConfigError(r.child_path("type"), "\"external\"", "a localizer that can run here (an external localizer runs only in a scenario run)");
+         return std::make_unique<external::ExternalLocalizer>(std::move(cfg), *ctx.session);
+       },
+       &external::ExternalConfig::schema,
+       [](JsonReader& r) { external::ExternalConfig::from_json(r); }},
   };
   return list;
 }
@@ -58,6 +67,17 @@ std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path
   auto loc = info.make(r, ctx);
   r.finish();
   return loc;
+}
+
+void check_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx) {
+  Json effective;
+  JsonReader r(j, path, &effective);
+  r.allow("comment");
+  const std::string type = r.string("type", std::nullopt);
+  const LocalizerInfo& info = localizer_info(type, r.child_path("type"));
+  if (info.check) info.check(r);
+  else info.make(r, ctx);
+  r.finish();
 }
 
 }  // namespace omniloc::harness

@@ -9,6 +9,7 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
+#include "external/external_localizer.hpp"
 #include "localization/localizer.hpp"
 
 namespace omniloc::harness {
@@ -19,6 +20,9 @@ struct LocalizerContext {
   const Field* field = nullptr;
   std::uint64_t seed = 0;
   std::string cache_dir;  ///< where distance maps etc. may be cached
+  /// What an external localizer's client is told in hello (robot, field, camera, log folder); null
+  /// outside a run (validation, experiments), where an external localizer cannot be built.
+  const external::Session* session = nullptr;
 };
 
 struct LocalizerInfo {
@@ -31,6 +35,9 @@ struct LocalizerInfo {
   std::function<std::unique_ptr<Localizer>(JsonReader& params, const LocalizerContext& ctx)> make;
   /// JSON Schema properties of its parameters (from the parameter structs' field lists).
   std::function<Json()> schema;
+  /// Checks the parameters without building (null: validation builds it with make). The external
+  /// localizer checks its program here; building would start it.
+  std::function<void(JsonReader& params)> check = nullptr;
 };
 
 const std::vector<LocalizerInfo>& localizers();
@@ -40,5 +47,9 @@ const LocalizerInfo& localizer_info(const std::string& type, const std::string& 
 /// Reads {"type": ..., params...} strictly and builds the localizer.
 std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx,
                                           Json* effective = nullptr);
+
+/// Reads {"type": ..., params...} strictly and checks it as far as possible without a run: built-in
+/// localizers are built (and dropped), an external one's program is checked, not started.
+void check_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx);
 
 }  // namespace omniloc::harness

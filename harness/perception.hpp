@@ -9,6 +9,7 @@
 #include "core/rng.hpp"
 #include "harness/scenario.hpp"
 #include "localization/localizer.hpp"
+#include "localization/vision/calibration_map.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/world_state.hpp"
 
@@ -37,6 +38,10 @@ class Perception {
   virtual ~Perception() = default;
   /// One camera frame of robot `robot_id` under the scripted conditions.
   virtual PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) = 0;
+  /// The image -> robot-frame calibration the vision uses (null when nothing is rendered).
+  virtual const CalibrationMap* calibration_map() const { return nullptr; }
+  /// Whether observations carry coloured blobs.
+  virtual bool detects_blobs() const { return false; }
 };
 
 /// No camera: empty observations (for localizers that need no vision, e.g. odometry_only).

@@ -19,6 +19,7 @@ struct FrameRecord {
   bool camera_ok = false; ///< the image was usable
   bool contact = false;   ///< the robot touched another body in the physics step
   LocalizerMode mode = LocalizerMode::kNone;
+  std::string mode_label;  ///< an external localizer's own mode word (written instead of mode when set)
   std::size_t points = 0; ///< line points found in the image
   double match_error = 0.0;
   std::map<std::string, double> extra;  ///< localizer extras and the camera settings (frames.csv columns)

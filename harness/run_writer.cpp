@@ -36,7 +36,7 @@ std::string frames_csv(const std::vector<RobotRecord>& robots) {
       csv += fmt("%.4f", r.t) + "," + std::to_string(robot.id) + "," + fmt("%.5f", r.truth.x) + "," + fmt("%.5f", r.truth.y) + "," +
              fmt("%.5f", r.truth.theta) + "," + fmt("%.5f", r.est.x) + "," + fmt("%.5f", r.est.y) + "," + fmt("%.5f", r.est.theta) + "," +
              fmt("%.5f", ex) + "," + fmt("%.5f", ey) + "," + fmt("%.5f", eth) + "," + fmt("%.5f", std::hypot(ex, ey)) + "," +
-             (r.valid ? "1" : "0") + "," + mode_name(r.mode) + "," + (r.camera_ok ? "1" : "0") + "," + std::to_string(r.points) + "," +
+             (r.valid ? "1" : "0") + "," + (r.mode_label.empty() ? std::string(mode_name(r.mode)) : r.mode_label) + "," + (r.camera_ok ? "1" : "0") + "," + std::to_string(r.points) + "," +
              fmt("%.6g", r.match_error) + "," + (r.contact ? "1" : "0");
       for (const auto& k : extra_keys) {
         auto it = r.extra.find(k);

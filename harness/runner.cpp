@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "core/version.hpp"
+#include "harness/external_session.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/perception.hpp"
 #include "harness/render_frame.hpp"
@@ -23,13 +24,16 @@ double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std
 // A localized robot: its localizer (robot side) and what the run records of it.
 struct Tracked {
   std::unique_ptr<Localizer> localizer;
-  LocalizerMode last_mode = LocalizerMode::kNone;
+  std::string last_mode;  // as written to events.jsonl
   RobotRecord record;
 };
 
 // One localizer per localized robot, each with its own random stream; tracking localizers start at
-// the true start pose (the papers' set-up). `effective` gets the localizer's effective parameters.
-std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const LocalizerInfo& info, Json& effective) {
+// the true start pose (the papers' set-up), and so do external ones that ask for it. `effective`
+// gets the localizer's effective parameters. An external localizer's client is started here (its
+// stderr log goes to `log_dir`, the run's staging folder) and told the camera `perception` uses.
+std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const LocalizerInfo& info, const Perception& perception,
+                                  const std::string& log_dir, Json& effective) {
   std::vector<Tracked> tracked;
   for (int id : sc.localized_robots()) {
     Tracked tr;
@@ -38,10 +42,16 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
     ctx.field = &sc.field;
     ctx.seed = derive_seed(seed, "localizer/" + std::to_string(id));
     ctx.cache_dir = "results/cache";
+    external::Session session;
+    if (info.type == "external") {
+      session = make_session(sc, id, perception, ctx.seed, log_dir);
+      ctx.session = &session;
+    }
     Json eff;
     tr.localizer = make_localizer(sc.localizer, "/localizer", ctx, &eff);
     effective["localizer"] = eff;
-    tr.localizer->reset(info.needs_start_pose ? std::optional<Pose2>(sc.robot(id)->spec.start) : std::nullopt);
+    const bool start = info.needs_start_pose || tr.localizer->wants_start_pose();
+    tr.localizer->reset(start ? std::optional<Pose2>(sc.robot(id)->spec.start) : std::nullopt);
     tracked.push_back(std::move(tr));
   }
   return tracked;
@@ -73,26 +83,33 @@ void robot_frame(Tracked& tr, Simulation& sim, Perception& perception, const sim
   const Estimate est = tr.localizer->update(po.obs, sensors.odometry, sensors.heading);
   const double loc_ms = ms_since(t0);
 
-  FrameRecord row{now.t, now.robot(id)->pose, est.pose, est.valid, po.obs.camera_ok, sim.in_contact(id), est.mode,
+  FrameRecord row{now.t, now.robot(id)->pose, est.pose, est.valid, po.obs.camera_ok, sim.in_contact(id), est.mode, est.mode_label,
                   po.obs.line_points.size(), est.match_error, est.extra, po.render_ms, po.vision_ms, loc_ms};
   if (po.image) {  // the camera settings the frame was taken with (exposure control, paper 002)
     row.extra["exposure_ms"] = po.settings.exposure_ms;
     row.extra["gain"] = po.settings.gain;
   }
   tr.record.frames.push_back(std::move(row));
-  if (est.mode != tr.last_mode) {
-    log.add(Json{{"t", now.t}, {"type", "mode"}, {"robot", id}, {"mode", mode_name(est.mode)}});
-    tr.last_mode = est.mode;
+  const std::string mode = est.mode_label.empty() ? mode_name(est.mode) : est.mode_label;
+  if (mode != tr.last_mode) {
+    log.add(Json{{"t", now.t}, {"type", "mode"}, {"robot", id}, {"mode", mode}});
+    tr.last_mode = mode;
   }
 }
 
 // Scores every robot and writes the result files; the table rows go to `result`.
-void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const std::vector<RobotRecord>& records,
-                   const EventLog& log, const Json& effective, RunDirectory& dir, RunResult& result) {
+// `localizer`: the name results carry; `external`: an external client's provenance (else null).
+void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const Json& external,
+                   const std::vector<RobotRecord>& records, const EventLog& log, const Json& effective, RunDirectory& dir,
+                   RunResult& result) {
   Json summary;
   summary["scenario"] = sc.name;
   summary["seed"] = seed;
   summary["localizer"] = localizer;
+  if (!external.is_null()) {
+    summary["localizer_type"] = "external";
+    summary["external"] = external;
+  }
   summary["noise_profile"] = sc.noise.name;
   summary["duration_s"] = sc.duration;
   summary["camera_rate_hz"] = sc.camera_rate;
@@ -134,8 +151,8 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   Json effective = sc.effective;
   effective["seed"] = seed;
   const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
-  std::vector<Tracked> tracked = make_tracked(sc, seed, info, effective);
   const auto perception = make_perception(sc, info.needs_vision || !opt.frames_dir.empty(), seed);
+  std::vector<Tracked> tracked = make_tracked(sc, seed, info, *perception, dir.staging(), effective);
 
   // simulate -> perceive -> localize -> record, at every camera frame (the first at t = 0 before any motion).
   const long long n_frames = static_cast<long long>(std::floor(sc.duration * sc.camera_rate + 1e-9)) + 1;
@@ -145,9 +162,12 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
     for (auto& tr : tracked) robot_frame(tr, sim, *perception, now, k, opt, log);
     if (opt.log && k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && k > 0) *opt.log << "  t = " << now.t << " s\n";
   }
+  for (auto& tr : tracked) tr.localizer->finish();  // an external client must end cleanly, or the run fails
+  const std::string name = tracked.empty() ? info.type : tracked.front().localizer->name();
+  const Json external = tracked.empty() ? Json(nullptr) : tracked.front().localizer->provenance();
   std::vector<RobotRecord> records;
   for (auto& tr : tracked) records.push_back(std::move(tr.record));
-  write_results(sc, seed, info.type, records, log, effective, dir, result);
+  write_results(sc, seed, name, external, records, log, effective, dir, result);
   result.out_dir = dir.final_dir();
   return result;
 }

@@ -335,6 +335,7 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   const Json* loc = r.raw("localizer");
   s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};
   if (!s.localizer.is_object()) throw ConfigError("/localizer", json_brief(s.localizer), "an object {\"type\": ...}");
+  external::anchor_external_paths(s.localizer);
 
   read_camera_and_vision(r, s);
   r.finish();
@@ -346,8 +347,7 @@ void validate_deep(const Scenario& s) {
   LocalizerContext ctx;
   ctx.field = &s.field;
   ctx.seed = s.seed;
-  Json eff;
-  make_localizer(s.localizer, "/localizer", ctx, &eff);
+  check_localizer(s.localizer, "/localizer", ctx);
 }
 
 Scenario load_scenario(const std::string& path) {

@@ -23,6 +23,7 @@
 #include <set>
 #include <thread>
 
+#include "external/external_config.hpp"
 #include "core/atomic_file.hpp"
 #include "core/json_parse.hpp"
 #include "harness/run_directory.hpp"
@@ -188,8 +189,11 @@ Localizers parse_localizers(const Json& l, const std::string& at) {
   for (std::size_t i = 0; i < l.size(); ++i) {
     Json lj = l[i];
     if (!lj.is_object() || !lj.contains("type")) throw ConfigError(json_child(at, i), json_brief(lj), "an object {\"type\": ...}");
-    std::string label = lj.value("label", lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
+    const bool external = lj["type"] == "external";
+    // An external localizer's row is named after its script unless labelled (docs/protocol.md).
+    std::string label = lj.value("label", external ? external::default_label(lj) : lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
     lj.erase("label");
+    external::anchor_external_paths(lj);
     locs.emplace_back(sanitize(label), lj);
   }
   return locs;
@@ -315,7 +319,12 @@ void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenari
         std::string plabel;
         Json patched = apply_combo(sc.json, combo, plabel);
         if (!lj.is_null()) patched["localizer"] = lj;
-        const std::string loc_label = lj.is_null() ? sanitize(patched.value("localizer", Json::object()).value("type", std::string("odometry_only"))) : llabel;
+        if (patched.contains("localizer")) external::anchor_external_paths(patched["localizer"]);
+        const Json own = patched.value("localizer", Json::object());
+        const std::string loc_label = !lj.is_null() ? llabel
+                                      : own.value("type", Json()) == "external"
+                                          ? own.value("label", external::default_label(own))
+                                          : sanitize(own.value("type", std::string("odometry_only")));
         try {
           parse_scenario(patched, sc.name);
         } catch (const ConfigError& e) {
@@ -535,6 +544,7 @@ struct Group {
   std::string scenario, localizer, params;
   std::size_t finished = 0, failed = 0, missing = 0;
   std::map<std::string, std::vector<double>> values;
+  Json external;  // an external client's provenance (summary.json "external"), one entry per distinct client
 };
 
 // What the folder holds of every run of the sweep, in run order.
@@ -569,6 +579,11 @@ Census take_census(const SweepSpec& spec, const fs::path& dir) {
         throw RuntimeFailure("cannot read the finished run " + r.id + ": " + e.what());
       }
       for (const auto& [k, v] : run_metrics(s)) g.values[k].push_back(v);
+      // Which client made the group's runs (a resume after the client changed may mix several).
+      if (s.contains("external")) {
+        if (g.external.is_null()) g.external = Json::array();
+        if (std::find(g.external.begin(), g.external.end(), s["external"]) == g.external.end()) g.external.push_back(s["external"]);
+      }
       ++c.run_versions[s.contains("omniloc") ? s["omniloc"].value("version", std::string("unknown")) : std::string("unrecorded")];
     } else if (fs::exists(dir / "failed" / (r.id + ".json"))) {
       status = "failed";
@@ -621,6 +636,7 @@ void write_aggregate(const SweepSpec& spec, const fs::path& dir, SweepOutcome& o
   for (const auto& g : census.groups) {
     Json gj{{"scenario", g.scenario}, {"localizer", g.localizer}, {"params", g.params}, {"finished", g.finished},
             {"failed", g.failed}, {"missing", g.missing}, {"metrics", Json::object()}};
+    if (!g.external.is_null()) gj["external"] = g.external;
     std::map<std::string, Interval> ivs;
     for (const auto& [k, v] : g.values) {
       const Interval iv = mean_ci95(v);

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "core/json_reader.hpp"
 #include "core/messages.hpp"
 #include "core/pose2.hpp"
 #include "localization/vision/colour_table.hpp"
@@ -54,6 +55,9 @@ struct Observations {
   /// Coloured blobs (regions and goal edges); empty unless blob detection ran (the scenario's
   /// "vision": {"blobs": ...}, by default whenever the field has coloured goals or landmarks).
   std::vector<Blob> blobs;
+  /// The image the observations were extracted from (null when nothing was rendered). Built-in
+  /// localizers use only the extracted observations; external ones may ask for the pixels.
+  std::shared_ptr<const Image> image;
 };
 
 /// What a localizer is doing in a frame. Written as text (mode_name) only in frames.csv and
@@ -99,6 +103,9 @@ struct Estimate {
   double match_error = 0.0; ///< localizer-specific quality figure (lower is better)
   /// Extra numbers for frames.csv (e.g. "global_ms", "particles"), stable keys per localizer.
   std::map<std::string, double> extra;
+  /// A mode word from an external localizer (docs/protocol.md); written instead of mode_name(mode)
+  /// when not empty. `mode` is set too when the word is one of ours.
+  std::string mode_label;
 };
 
 class Localizer {
@@ -111,6 +118,18 @@ class Localizer {
   /// One frame: odometry since the previous frame, observations of this frame, optional heading
   /// (world frame, radians) from compass / MTi.
   virtual Estimate update(const Observations& obs, const Odometry& odometry, std::optional<double> heading) = 0;
+  /// The name its results carry (summary.json "localizer"): type() for built-in ones, the client's
+  /// own name for an external localizer.
+  virtual std::string name() const { return type(); }
+  /// True when it asked for the true start pose itself (external localizers say so at start-up;
+  /// built-in ones are described by the registry).
+  virtual bool wants_start_pose() const { return false; }
+  /// What identifies the implementation beyond the build (an external client's command, files and
+  /// version); null for built-in localizers.
+  virtual Json provenance() const { return nullptr; }
+  /// Called once after the last frame, before the results are written; may throw RuntimeFailure
+  /// (an external client that does not end cleanly fails the run).
+  virtual void finish() {}
 };
 
 }  // namespace omniloc

@@ -23,10 +23,11 @@ ALLOWED = {
     "core": set(),
     "sim": {"core"},
     "localization": {"core"},  # never sim/: it gets what a real robot gets
-    "harness": {"core", "sim", "localization"},
-    "experiments": {"core", "sim", "localization", "harness"},
-    "apps": {"core", "sim", "localization", "harness", "experiments"},
-    "testing": {"core", "sim", "localization", "harness", "experiments"},
+    "external": {"core", "localization"},  # the olp/1 host: speaks to a process, never sees sim/
+    "harness": {"core", "sim", "localization", "external"},
+    "experiments": {"core", "sim", "localization", "external", "harness"},
+    "apps": {"core", "sim", "localization", "external", "harness", "experiments"},
+    "testing": {"core", "sim", "localization", "external", "harness", "experiments"},
 }
 UNSCANNED = {"tests", "bench", "fuzz"}
 LAYERS = set(ALLOWED) | UNSCANNED

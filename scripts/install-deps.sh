@@ -9,7 +9,8 @@ PKGS=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
   libbenchmark-dev libgtest-dev libgmock-dev
-  python3 python3-matplotlib python3-jsonschema
+  libssl-dev
+  python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
 )
 missing=()

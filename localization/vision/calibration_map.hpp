@@ -31,6 +31,10 @@ class CalibrationMap {
   std::optional<Eigen::Vector2d> to_robot(double u, double v) const;
   /// Image radius (pixels) at which a floor point at `distance` metres and `bearing` appears.
   std::optional<double> radius_for_distance(double distance, double bearing) const;
+  /// The tables set_tables() was given: per direction (bearing 2 pi i / N) the image radii (pixels)
+  /// and the floor distances (metres) of the calibration edges.
+  const std::vector<std::vector<double>>& radii_px() const { return radii_; }
+  const std::vector<std::vector<double>>& distances_m() const { return distances_; }
 
   /// Tables: for each of the directions (robot bearings evenly spaced from 0, anticlockwise), the
   /// increasing image radii of the calibration edges and their floor distances (metres). Radial:
