@@ -51,6 +51,10 @@ namespace omniloc_client {
 
 inline constexpr const char* kProtocol = "olp/1";
 inline constexpr std::size_t kMaxLineBytes = 16u * 1024u * 1024u;
+/// frames.csv's own columns: omniloc refuses them as Estimate::extra names.
+inline constexpr const char* kReservedExtra[] = {"t",        "robot",     "gt_x",  "gt_y",        "gt_theta", "est_x",     "est_y",
+                                                 "est_theta", "err_x",     "err_y", "err_theta",   "err_pos",  "valid",     "mode",
+                                                 "camera_ok", "line_points", "match_error", "contact", "exposure_ms", "gain"};
 using Json = nlohmann::json;
 
 /// Something this client cannot follow, or an estimate that would break the protocol.
@@ -246,7 +250,7 @@ struct Estimate {
   bool valid = true;
   std::optional<std::array<double, 9>> covariance;
   std::string mode;                    ///< empty: not sent
-  std::map<std::string, double> extra; ///< empty: not sent (sorted keys: deterministic bytes)
+  std::map<std::string, double> extra; ///< empty: not sent (sorted keys: deterministic bytes); not kReservedExtra
 };
 
 /// Derive from this. Set name/version/needs_start_pose/wants_image in the constructor or ready().
@@ -312,6 +316,8 @@ inline std::string estimate_line(const Estimate& e, long long k) {
     Json x = Json::object();
     for (const auto& [key, v] : e.extra) {
       if (!name_ok(key, 32, false, false)) throw ProtocolError("estimate: extra name '" + key + "' is not [A-Za-z0-9_]{1,32}");
+      for (const char* c : kReservedExtra)
+        if (key == c) throw ProtocolError("estimate: extra name '" + key + "' is a column of frames.csv already; choose another name");
       x[key] = check(v, "an extra value");
     }
     m["extra"] = x;

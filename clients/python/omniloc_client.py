@@ -64,6 +64,10 @@ MAX_LINE_BYTES = 16 * 1024 * 1024  # docs/protocol.md section 3
 _NAME_RE = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")
 _MODE_RE = re.compile(r"^[a-z0-9_]{1,32}$")
 _EXTRA_KEY_RE = re.compile(r"^[A-Za-z0-9_]{1,32}$")
+#: frames.csv's own columns: omniloc refuses them as `extra` names
+RESERVED_EXTRA = frozenset(["t", "robot", "gt_x", "gt_y", "gt_theta", "est_x", "est_y", "est_theta", "err_x", "err_y",
+                            "err_theta", "err_pos", "valid", "mode", "camera_ok", "line_points", "match_error", "contact",
+                            "exposure_ms", "gain"])
 
 
 class ProtocolError(Exception):
@@ -392,6 +396,8 @@ class Estimate:
                 value = float(self.extra[key])
                 if not _EXTRA_KEY_RE.match(key) or not math.isfinite(value):
                     raise ProtocolError(f"estimate for frame {k}: extra {key!r}: {value} (names [A-Za-z0-9_], finite numbers)")
+                if key in RESERVED_EXTRA:
+                    raise ProtocolError(f"estimate for frame {k}: extra {key!r} is a column of frames.csv already; choose another name")
                 extra[key] = value
             m["extra"] = extra
         return m

@@ -30,7 +30,7 @@ class CppClientTest(unittest.TestCase):
         for m, odo in zip(msgs[1:], [(0, 0, 0), (0.1, 0.02, 0.01), (0.1, -0.02, -0.3)]):
             pose = olp.compose_odometry(pose, odo)  # the C++ and Python helpers agree to the bit
             self.assertEqual(m["pose"], list(pose))
-            self.assertEqual((m["valid"], m["mode"], m["extra"]), (True, "dead_reckoning", {"line_points": 1.0}))
+            self.assertEqual((m["valid"], m["mode"], m["extra"]), (True, "dead_reckoning", {"n_line_points": 1.0}))
         self.assertEqual([m["k"] for m in msgs[1:]], [0, 1, 2])
         self.assertIn("frame 0", err)  # its printf went to stderr, not into the protocol
 

@@ -292,6 +292,8 @@ class HelperTest(unittest.TestCase):
             olp.Estimate((0, 0, 0), mode="Bad Mode").to_message(0)
         with self.assertRaises(olp.ProtocolError):
             olp.Estimate((0, 0, 0), covariance=[1, 2]).to_message(0)
+        with self.assertRaises(olp.ProtocolError):
+            olp.Estimate((0, 0, 0), extra={"line_points": 3}).to_message(0)  # a frames.csv column
 
 
 if __name__ == "__main__":

@@ -27,7 +27,7 @@ class DeadReckoning : public olp::Localizer {
     olp::Estimate e;
     e.pose = pose_;
     e.mode = "dead_reckoning";
-    e.extra["line_points"] = static_cast<double>(f.line_points.size());
+    e.extra["n_line_points"] = static_cast<double>(f.line_points.size());
     return e;
   }
 
