@@ -225,7 +225,7 @@ struct Blob {
 /// One camera frame: exactly what omniloc's built-in localizers get.
 struct Frame {
   long long k = 0;                    ///< frame number from 0
-  double t = 0;                       ///< seconds (k / camera_rate_hz)
+  double t = 0;                       ///< seconds: the first physics step at or after k / camera_rate_hz
   std::array<double, 3> odometry{};   ///< dx, dy, dtheta since the previous frame, in its robot frame
   std::optional<double> heading;      ///< compass, world frame, radians; nullopt without one
   bool camera_ok = true;              ///< false: image unusable, line_points empty

@@ -292,7 +292,7 @@ class Hello:
     robot: int
     scenario: str = ""
     omniloc: str = ""
-    camera_rate_hz: float = 30.0  #: frame k is taken at t = k / camera_rate_hz
+    camera_rate_hz: float = 30.0  #: frame k is taken at the first physics step at or after k / camera_rate_hz
     duration_s: float = 0.0       #: the last frame has k = floor(duration_s * camera_rate_hz)
     hello_timeout_s: float = 60.0
     frame_timeout_s: float = 10.0
@@ -347,7 +347,7 @@ class Frame:
     """One camera frame: exactly what omniloc's built-in localizers get."""
 
     k: int                          #: frame number, 0, 1, 2, ...
-    t: float                        #: seconds since the start (k / camera_rate_hz)
+    t: float                        #: seconds since the start: the first physics step at or after k / camera_rate_hz (0.035 for k = 1 at 30 Hz, 200 Hz physics)
     odometry: Pose                  #: (dx, dy, dtheta) since the previous frame, in its robot frame
     heading: Optional[float]        #: compass heading, world frame, radians; None without compass
     camera_ok: bool                 #: False: image unusable (covered), line_points empty

@@ -88,6 +88,8 @@ def check_error(omniloc, tmp, args, script):
     mean_cm, rmse_cm, valid = position_error_cm(Path(tmp) / "out")
     print(f"mean position error {mean_cm:.2f} cm (rmse {rmse_cm:.2f} cm, summary.json {100 * s['robots'][0]['position_m']['rmse']:.2f} cm), "
           f"{valid} valid frames; bound {args.max_mean_cm} cm")
+    if valid != round(args.seconds * 30) + 1:
+        sys.exit(f"{script}: {valid} valid frames; a tracking client from the true start pose should stand behind every frame")
     if not mean_cm < args.max_mean_cm:
         sys.exit(f"{script}: mean position error {mean_cm:.1f} cm is not below {args.max_mean_cm} cm")
 
