@@ -89,12 +89,6 @@ class ParticleFilter:
         self.p = np.asarray(pose, dtype=float) + self.rng.normal(0.0, 1.0, (self.n, 3)) * np.asarray(spread)
         self.logw = np.zeros(self.n)
 
-    def start_everywhere(self):
-        x0, x1, y0, y1 = self.field.bounds()
-        u = self.rng.random((self.n, 3))
-        self.p = np.column_stack([x0 + (x1 - x0) * u[:, 0], y0 + (y1 - y0) * u[:, 1], -np.pi + 2 * np.pi * u[:, 2]])
-        self.logw = np.zeros(self.n)
-
     def predict(self, odometry):
         dx, dy, dth = odometry
         dist = math.hypot(dx, dy)
