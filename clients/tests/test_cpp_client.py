@@ -30,9 +30,17 @@ class CppClientTest(unittest.TestCase):
         for m, odo in zip(msgs[1:], [(0, 0, 0), (0.1, 0.02, 0.01), (0.1, -0.02, -0.3)]):
             pose = olp.compose_odometry(pose, odo)  # the C++ and Python helpers agree to the bit
             self.assertEqual(m["pose"], list(pose))
-            self.assertEqual((m["valid"], m["mode"], m["extra"]), (True, "dead_reckoning", {"n_line_points": 1.0}))
+            self.assertEqual((m["valid"], m["mode"], m["extra"]["n_line_points"]), (True, "dead_reckoning", 1.0))
         self.assertEqual([m["k"] for m in msgs[1:]], [0, 1, 2])
         self.assertIn("frame 0", err)  # its printf went to stderr, not into the protocol
+
+    def test_image(self):
+        hello = dict(HELLO, params={"wants_image": True})
+        status, msgs, err = talk(GOOD.replace(line(HELLO), line(hello), 1))
+        self.assertEqual(status, 0, err)
+        self.assertTrue(msgs[0]["wants_image"])
+        for m in msgs[1:]:
+            self.assertEqual(m["extra"], {"image_last_blue": 23.0, "image_mean": 11.5, "image_width": 4.0, "n_line_points": 1.0})
 
     def test_byte_at_a_time(self):
         # a pipe that delivers one byte per write: the reader must assemble lines and parts
