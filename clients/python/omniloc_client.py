@@ -30,6 +30,8 @@ centres at integer + 0.5.
 
 stdout belongs to the protocol: while `serve` runs, `print()` (and anything else written to file
 descriptor 1) goes to stderr, which omniloc keeps in the run folder as client_r<robot>.stderr.log.
+Before `serve` starts nothing protects it: do not print at import or in your constructor (do heavy
+set-up in `Localizer.ready`, which also has hello's params and field).
 """
 
 from __future__ import annotations
