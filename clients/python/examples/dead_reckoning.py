@@ -17,6 +17,11 @@ class DeadReckoning(olp.Localizer):
     version = "1.0"
     needs_start_pose = True
 
+    def ready(self, hello):
+        # params {"wants_image": true}: take the image too (unused; bench/protocol_bench.cpp measures
+        # what receiving it costs a Python client).
+        self.wants_image = bool(hello.params.get("wants_image", False))
+
     def reset(self, seed, start):
         self.pose = start
 
