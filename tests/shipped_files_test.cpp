@@ -15,6 +15,10 @@
 namespace fs = std::filesystem;
 
 TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
+  // As users run them: from the repository root (relative paths in scenario files, such as an
+  // external localizer's command, are taken against omniloc's working directory; docs/protocol.md).
+  const fs::path before = fs::current_path();
+  fs::current_path(OMNILOC_SOURCE_DIR);
   int n = 0;
   for (const auto& e : fs::recursive_directory_iterator(fs::path(OMNILOC_SOURCE_DIR) / "scenarios")) {
     if (e.path().extension() != ".json") continue;
@@ -44,6 +48,7 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
     ++n;
   }
   EXPECT_GE(n, 4);
+  fs::current_path(before);
 }
 
 // The default main job runs scenarios/sweeps/paper_suite.json: every paper scenario must be in it,
