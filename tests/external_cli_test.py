@@ -144,6 +144,18 @@ class ExternalCli(unittest.TestCase):
         self.assertEqual(flaky["finished"], 2)
         self.assertEqual(flaky["external"][0]["name"], "faulty")
 
+    def test_slurm_submission_records_the_client(self):
+        self.write("scenario.json", scenario({"type": "odometry_only"}, duration=1.0))
+        sweep = self.write("sweep.json", {"name": "olp_slurm", "scenarios": ["scenario.json"],
+                                          "localizers": [{"type": "external", "command": [PY, FAULTY, "ok"]}], "seeds": [1, 2]})
+        out = self.tmp / "slurm_out"
+        self.omniloc("sweep", sweep, "--slurm", "--dry-run", "--tasks", "2", "-o", str(out))
+        sub = json.loads((out / "slurm" / "submission.json").read_text())
+        digest = subprocess.run(["sha256sum", FAULTY], capture_output=True, text=True).stdout.split()[0]
+        self.assertEqual(len(sub["external_clients"]), 1)
+        self.assertIn({"path": FAULTY, "sha256": digest}, sub["external_clients"][0]["files"])
+        self.assertEqual(sub["external_clients"][0]["cwd"], str(ROOT))  # anchored: tasks start it in the same place
+
     def interrupt(self, sig):
         pids = self.tmp / f"pids_{sig}"
         f = self.write(f"slow_{sig}.json", scenario({"type": "external", "command": [PY, FAULTY, "slow:0.05", str(pids)]}, duration=30))
