@@ -181,6 +181,9 @@ class ExternalCli(unittest.TestCase):
     def test_kill_9_ends_the_client(self):
         self.interrupt(signal.SIGKILL)
 
+    def test_sigterm_ends_the_client(self):  # what scancel and kill send first
+        self.interrupt(signal.SIGTERM)
+
 
 if __name__ == "__main__":
     unittest.main()
