@@ -10,6 +10,7 @@
 #include "harness/scenario.hpp"
 #include "localization/localizer.hpp"
 #include "sim/occlusion.hpp"
+#include "sim/render/egl_device.hpp"
 #include "sim/world_state.hpp"
 
 namespace omniloc::harness {
@@ -37,6 +38,8 @@ class Perception {
   virtual ~Perception() = default;
   /// One camera frame of robot `robot_id` under the scripted conditions.
   virtual PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) = 0;
+  /// The GL device the camera renders on (provenance); none without a camera.
+  virtual std::optional<sim::GlDeviceInfo> render_device() const { return std::nullopt; }
 };
 
 /// No camera: empty observations (for localizers that need no vision, e.g. odometry_only).
