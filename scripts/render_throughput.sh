@@ -62,7 +62,7 @@ for be in $backends; do
     done
     ok=1
     for pid in "${pids[@]}"; do wait "$pid" || ok=0; done
-    if [ $ok = 1 ]; then say "render $be 640x640, $p process(es): $(sum_fps "$out"/render_"${be}"_p"${p}"_*.json)"
+    if [ $ok = 1 ]; then say "render $be 640x640, $p process(es): $(sum_fps "$out"/render_"${be}"_p"${p}"_*.json), ended $(date +%s)"
     else say "render $be, $p process(es): failed ($(head -c 300 "$out/render_${be}_p${p}_1.err"))"; fi
   done
 done
@@ -99,7 +99,7 @@ import csv, statistics, sys
 be, p, n, t0, t1, timing = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5]), sys.argv[6]
 rows = list(csv.DictReader(open(timing)))
 med = {k: statistics.median(float(r[k]) for r in rows) for k in rows[0] if k.endswith("_ms")}
-print(f"end to end {be}, {p} process(es): {n / (t1 - t0):.0f} frames/s in all ({n} frames in {t1 - t0:.1f} s); "
+print(f"end to end {be}, {p} process(es): {n / (t1 - t0):.0f} frames/s in all ({n} frames in {t1 - t0:.1f} s, ended {t1:.0f}); "
       f"per frame (medians of run 1): " + ", ".join(f"{k} {v:.2f}" for k, v in med.items()))
 EOF
     done
