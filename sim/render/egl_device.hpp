@@ -12,7 +12,7 @@
 //                    sweep spread over them and share them when N is larger; the first that
 //                    creates a context is used.
 //   "<n>"            EGL device n of the enumeration (`omniloc gl-devices` lists them), nothing else.
-//   "surfaceless"    Mesa's surfaceless display only (the back-end's behaviour before devices).
+//   "surfaceless"    the surfaceless display only (the back-end's behaviour before devices).
 // OMNILOC_GL_BACKEND ("osmesa" or "egl") overrides every scenario's camera.backend (whole sweeps).
 #include <string>
 #include <vector>

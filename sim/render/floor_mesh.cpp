@@ -34,7 +34,7 @@ constexpr double kDistanceRange = 2.0;   // metres; farther is stored as 2 m
 // Shared by the floor shaders: line, carpet, outside are albedos (label ids / 255 for labels).
 // The pixel's extent is fwidthCoarse where GL_ARB_derivative_control exists: one derivative per 2 x 2
 // quad, which is what llvmpipe's fwidth is (OSMesa's bytes are the same either way), whereas NVIDIA's
-// plain fwidth is per pixel and gave 0.4-0.5 % fewer line points per frame than OSMesa, 4 seed-to-seed
+// plain fwidth is finer and gave 0.4-0.5 % fewer line points per frame than OSMesa, 4 seed-to-seed
 // standard deviations; with fwidthCoarse the H200's runs match OSMesa's (docs/performance.md "GPUs").
 const char* const kFloorCommon = R"(#version 130
 #extension GL_ARB_derivative_control : enable
