@@ -8,8 +8,8 @@
 #include <EGL/eglext.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <map>
 #include <mutex>
 
