@@ -30,6 +30,7 @@
 #include "batch/sweep.hpp"
 #include "harness/vision_setup.hpp"
 #include "sim/render/camera_config.hpp"
+#include "sim/render/gl_context.hpp"
 #include "sim/motion.hpp"
 
 using namespace omniloc;
@@ -53,6 +54,8 @@ commands:
                          learn the colour look-up table from labelled renders of the scenario's field
   validate FILE...       check a scenario, a sweep file or an experiment description (scenarios/experiments/);
                          exit 2 with the JSON path of the first problem
+  gl-devices             the EGL devices of this machine and the device each GL back-end renders on
+                         (OMNILOC_GL_BACKEND, OMNILOC_EGL_DEVICE: docs/camera.md "GPUs")
   list                   field presets, motion scripts, event kinds, localizers, noise profiles, experiments
   schema [--markdown] [-o FILE]
                          the JSON Schema of scenario files (for editors), or the parameter
@@ -61,7 +64,7 @@ commands:
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
   sweep SWEEP.json --slurm [--tasks N] [--partition P] [--time HH:MM:SS] [--cpus-per-task C]
-        [--sbatch-arg ARG]... [--dry-run] [--resubmit-missing] [-o DIR]
+        [--gpus-per-task G] [--sbatch-arg ARG]... [--dry-run] [--resubmit-missing] [-o DIR]
                          a Slurm job array of N shards and a merge job (docs/cluster.md);
                          --dry-run only writes DIR/slurm/
   sweep SWEEP.json --status [--tasks N] [-o DIR]
@@ -113,6 +116,10 @@ const cli::Command kValidate{"validate", "FILE...", 1, 1000000,
                              "its own process and a line \"[exit N] FILE\" (or \"[signal S] FILE\") follows it; the exit\n"
                              "code is then 0 when all passed, 2 when some had input errors, 1 when any failed otherwise.",
                              {}};
+const cli::Command kGlDevices{"gl-devices", "", 0, 0,
+                               "The EGL devices of this machine (EGL_EXT_device_enumeration) and the device each GL back-end\n"
+                               "renders on under the current OMNILOC_EGL_DEVICE; exit 1 when \"egl\" cannot render.",
+                               {}};
 const cli::Command kList{"list", "", 0, 0, "Field presets, motion scripts, event kinds, localizers, noise profiles, experiments.", {}};
 const cli::Command kSchema{"schema", "", 0, 0, "The JSON Schema of scenario files, or (--markdown) the parameter reference docs/localizers.md.",
                            {{"--markdown", "", "the parameter reference instead of the schema"},
@@ -131,6 +138,7 @@ const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                            {"--partition", "P", "Slurm partition"},
                            {"--time", "HH:MM:SS", "Slurm time limit per array task"},
                            {"--cpus-per-task", "C", "cores per array task (its -j), integer in [1, 1024], default 1"},
+                           {"--gpus-per-task", "G", "GPUs per array task (--gres=gpu:G; renders with egl), integer in [0, 16], default 0"},
                            {"--sbatch-arg", "ARG", "extra sbatch argument, repeatable (e.g. --account=X)"},
                            {"--dry-run", "", "with --slurm: write DIR/slurm/ without submitting"},
                            {"--resubmit-missing", "", "with --slurm: submit only the shards with missing or failed runs"},
@@ -228,6 +236,30 @@ int cmd_validate(const cli::Args& a) {
   return worst;
 }
 
+int cmd_gl_devices(const cli::Args&) {
+  std::vector<sim::EglDeviceDesc> devs;
+  try {
+    devs = sim::egl_devices();
+  } catch (const RuntimeFailure& e) {
+    std::cout << "no EGL device enumeration: " << e.what() << "\n";
+  }
+  std::cout << devs.size() << " EGL device(s)\n";
+  for (const auto& d : devs)
+    std::cout << "  " << d.index << ": " << (d.software ? "software" : "hardware") << (d.cuda_device >= 0 ? ", CUDA device " + std::to_string(d.cuda_device) : "")
+              << (d.drm_node.empty() ? "" : ", " + d.drm_node) << "\n    " << d.extensions << "\n";
+  int rc = 0;
+  for (const std::string& backend : sim::gl_backends()) {
+    try {
+      const auto ctx = sim::make_gl_context(backend);
+      std::cout << backend << " renders on " << ctx->device().line() << "\n";
+    } catch (const RuntimeFailure& e) {
+      std::cout << backend << " cannot render: " << e.what() << "\n";
+      if (backend == "egl") rc = 1;
+    }
+  }
+  return rc;
+}
+
 int cmd_run(const cli::Args& a) {
   const auto s = harness::load_scenario(a.positional[0]);
   harness::RunOptions o;
@@ -258,6 +290,7 @@ int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
   so.partition = a.value("--partition");
   so.time_limit = a.value("--time");
   so.cpus_per_task = static_cast<int>(a.integer("--cpus-per-task", 1, 1, 1024));
+  so.gpus_per_task = static_cast<int>(a.integer("--gpus-per-task", 0, 0, 1024));
   for (const auto& [k, v] : a.values)
     if (k == "--sbatch-arg") so.sbatch_args.push_back(v);
   so.dry_run = a.has("--dry-run");
@@ -270,7 +303,7 @@ int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
 
 int cmd_sweep(const cli::Args& a) {
   if (a.has("--slurm") || a.has("--status")) return cmd_sweep_slurm(a, batch::load_sweep(a.positional[0]));
-  for (const char* o : {"--tasks", "--partition", "--time", "--cpus-per-task", "--sbatch-arg", "--dry-run", "--resubmit-missing"})
+  for (const char* o : {"--tasks", "--partition", "--time", "--cpus-per-task", "--gpus-per-task", "--sbatch-arg", "--dry-run", "--resubmit-missing"})
     if (a.has(o)) throw UsageError(std::string(o) + " needs --slurm");
   batch::SweepOptions o;
   o.jobs = static_cast<int>(a.integer("-j", 1, 1, 256));
@@ -431,6 +464,7 @@ int main(int argc, char** argv) {
   };
   const Entry commands[] = {{&kValidate, cmd_validate},
                             {&kRun, cmd_run},
+                            {&kGlDevices, cmd_gl_devices},
                             {&kList, [](const cli::Args&) { return cmd_list(); }},
                             {&kSchema, cmd_schema},
                             {&kCalibrate, cmd_calibrate},

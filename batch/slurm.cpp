@@ -239,6 +239,8 @@ void check_slurm_options(const SweepSpec& spec, const SlurmOptions& o) {
                                                               std::to_string(runs) + " runs; more tasks would be empty)");
   if (o.cpus_per_task < 1 || o.cpus_per_task > 256)
     throw ConfigError("--cpus-per-task", std::to_string(o.cpus_per_task), "a core count in [1, 256]");
+  if (o.gpus_per_task < 0 || o.gpus_per_task > 16)
+    throw ConfigError("--gpus-per-task", std::to_string(o.gpus_per_task), "a GPU count in [0, 16]");
   static const std::regex time_re(R"(^([0-9]+-)?[0-9]{1,3}:[0-5][0-9]:[0-5][0-9]$)");
   if (!o.time_limit.empty() && !std::regex_match(o.time_limit, time_re))
     throw ConfigError("--time", "\"" + o.time_limit + "\"", "a time limit per task as HH:MM:SS or D-HH:MM:SS");
@@ -400,6 +402,18 @@ std::string shard_command_tail(const SlurmOptions& o, const SubmitPaths& p) {
   return " --resume -j " + std::to_string(o.cpus_per_task) + " -o " + shq(p.dir.string());
 }
 
+// --gpus-per-task: the GPUs as a generic resource, and rendering on them through EGL. Slurm sets
+// CUDA_VISIBLE_DEVICES to the task's GPUs, which the EGL device choice follows (egl_device.hpp).
+// (#SBATCH lines count only before the script's first command, so the two parts go apart.)
+std::string gpu_request(const SlurmOptions& o) {
+  return o.gpus_per_task > 0 ? "#SBATCH --gres=gpu:" + std::to_string(o.gpus_per_task) + "\n" : "";
+}
+std::string gpu_rendering(const SlurmOptions& o) {
+  if (o.gpus_per_task <= 0) return "";
+  return "# Render on the task's GPUs (an OMNILOC_GL_BACKEND set in env.sh is kept); the -j runs share them.\n"
+         "export OMNILOC_GL_BACKEND=\"${OMNILOC_GL_BACKEND:-egl}\"\n";
+}
+
 std::string array_script(const SweepSpec& spec, const SlurmOptions& o, const SubmitPaths& p, int tasks) {
   return "#!/bin/bash\n"
          "# omniloc sweep " + spec.name + ": array task I runs every " + std::to_string(tasks) + "-th run starting at run I\n"
@@ -408,13 +422,13 @@ std::string array_script(const SweepSpec& spec, const SlurmOptions& o, const Sub
          "# (sbatch --array=2,5 array.sbatch, or omniloc sweep --slurm --resubmit-missing) redoes only the rest.\n"
          "#SBATCH --job-name=omniloc-" + spec.name + "\n"
          "#SBATCH --array=0-" + std::to_string(tasks - 1) + "\n"
-         "#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n"
+         "#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n" + gpu_request(o) +
          "#SBATCH --output=" + (p.folder / "logs" / "task-%A_%a.log").string() + "\n" + common_header(o, p) +
          "# N is fixed here, not read from SLURM_ARRAY_TASK_COUNT: a resubmitted subset has another count.\n"
          "N=" + std::to_string(tasks) + "\n"
          "# llvmpipe would start one rendering thread per core of the whole node; the task owns only its\n"
          "# --cpus-per-task cores, shared by its -j runs (an LP_NUM_THREADS set in env.sh is kept).\n"
-         "export LP_NUM_THREADS=\"${LP_NUM_THREADS:-1}\"\n"
+         "export LP_NUM_THREADS=\"${LP_NUM_THREADS:-1}\"\n" + gpu_rendering(o) +
          "exec " + shq(p.exe) + " sweep " + shq(p.spec_abs.string()) + " --shard \"${SLURM_ARRAY_TASK_ID}/${N}\"" +
          shard_command_tail(o, p) + "\n";
 }
@@ -482,6 +496,7 @@ void describe_submission(Json& sub, const SweepSpec& spec, const SlurmOptions& o
   sub["omniloc"] = build_info_json();
   sub["omniloc_exe"] = p.exe;
   sub["cpus_per_task"] = o.cpus_per_task;
+  sub["gpus_per_task"] = o.gpus_per_task;
   sub["partition"] = o.partition;
   sub["time"] = o.time_limit;
   sub["sbatch_args"] = o.sbatch_args;

@@ -24,6 +24,9 @@ struct SlurmOptions {
   std::string partition;                 ///< --partition (empty: the cluster's default)
   std::string time_limit;                ///< per task, [D-]HH:MM:SS (empty: the partition's default)
   int cpus_per_task = 1;                 ///< cores per task; the shard runs with -j of this many
+  /// GPUs per task (--gres=gpu:N; 0: none). With GPUs the task renders with "egl" (OMNILOC_GL_BACKEND)
+  /// and its -j runs share them (docs/cluster.md "GPUs").
+  int gpus_per_task = 0;
   std::vector<std::string> sbatch_args;  ///< extra sbatch options, one "--opt=value" each, written as #SBATCH lines
   bool dry_run = false;                  ///< write the folder, do not call sbatch
   bool resubmit_missing = false;         ///< only the shards with missing or failed runs, N as first submitted

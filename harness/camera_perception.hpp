@@ -44,6 +44,7 @@ class CameraPerception : public Perception {
   PerceptionOutput observe(const sim::WorldState& world, int robot_id, double t, const FrameConditions& cond) override;
   const sim::PanoramicCamera& camera() const { return *camera_; }
   sim::PanoramicCamera& camera() { return *camera_; }
+  std::optional<sim::GlDeviceInfo> render_device() const override { return camera_->device(); }
   const CalibrationMap& calibration() const { return map_; }
   const CalibrationMap* calibration_map() const override { return &map_; }
   bool detects_blobs() const override { return blob_detector_ != nullptr; }

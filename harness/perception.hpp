@@ -11,6 +11,7 @@
 #include "localization/localizer.hpp"
 #include "localization/vision/calibration_map.hpp"
 #include "sim/occlusion.hpp"
+#include "sim/render/egl_device.hpp"
 #include "sim/world_state.hpp"
 
 namespace omniloc::harness {
@@ -42,6 +43,8 @@ class Perception {
   virtual const CalibrationMap* calibration_map() const { return nullptr; }
   /// Whether observations carry coloured blobs.
   virtual bool detects_blobs() const { return false; }
+  /// The GL device the camera renders on (provenance); none without a camera.
+  virtual std::optional<sim::GlDeviceInfo> render_device() const { return std::nullopt; }
 };
 
 /// No camera: empty observations (for localizers that need no vision, e.g. odometry_only).

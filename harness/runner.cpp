@@ -100,8 +100,8 @@ void robot_frame(Tracked& tr, Simulation& sim, Perception& perception, const sim
 // Scores every robot and writes the result files; the table rows go to `result`.
 // `localizer`: the name results carry; `external`: an external client's provenance (else null).
 void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const Json& external,
-                   const std::vector<RobotRecord>& records, const EventLog& log, const Json& effective, RunDirectory& dir,
-                   RunResult& result) {
+                   const std::vector<RobotRecord>& records, const EventLog& log, const Json& effective, const Perception& perception,
+                   RunDirectory& dir, RunResult& result) {
   Json summary;
   summary["scenario"] = sc.name;
   summary["seed"] = seed;
@@ -114,6 +114,8 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   summary["duration_s"] = sc.duration;
   summary["camera_rate_hz"] = sc.camera_rate;
   summary["omniloc"] = build_info_json();  // provenance; the regression gates compare everything else
+  // The renderer is provenance too: OSMesa and a GPU draw slightly different pixels (docs/camera.md "GPUs").
+  if (const auto dev = perception.render_device()) summary["omniloc"]["render"] = dev->to_json();
   std::vector<TableRow> rows;
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RobotRecord& rec = records[i];
@@ -152,6 +154,8 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   effective["seed"] = seed;
   const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
   const auto perception = make_perception(sc, info.needs_vision || !opt.frames_dir.empty(), seed);
+  if (opt.log)
+    if (const auto dev = perception->render_device()) *opt.log << "  rendering on " << dev->line() << "\n";
   std::vector<Tracked> tracked = make_tracked(sc, seed, info, *perception, dir.staging(), effective);
 
   // simulate -> perceive -> localize -> record, at every camera frame (the first at t = 0 before any motion).
@@ -167,7 +171,7 @@ RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   const Json external = tracked.empty() ? Json(nullptr) : tracked.front().localizer->provenance();
   std::vector<RobotRecord> records;
   for (auto& tr : tracked) records.push_back(std::move(tr.record));
-  write_results(sc, seed, name, external, records, log, effective, dir, result);
+  write_results(sc, seed, name, external, records, log, effective, *perception, dir, result);
   result.out_dir = dir.final_dir();
   return result;
 }

@@ -1,6 +1,7 @@
 #include "harness/scenario.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -11,6 +12,7 @@
 #include "harness/vision_setup.hpp"
 #include "harness/localizer_registry.hpp"
 #include "sim/render/camera_config.hpp"
+#include "sim/render/egl_device.hpp"
 #include "sim/motion.hpp"
 
 namespace omniloc::harness {
@@ -279,8 +281,18 @@ void read_camera_and_vision(JsonReader& r, Scenario& s) {
   }
   {
     Json eff;
-    sim::CameraConfig::from_json(s.camera, "/camera", &eff);  // validate now, record the effective values
+    const auto cam = sim::CameraConfig::from_json(s.camera, "/camera", &eff);  // validate now, record the effective values
     s.effective["camera"] = eff;
+    // An "egl" that cannot render on this machine (no device, a device index it lacks) is found
+    // now, before any work (exit 2), not at the first frame. "osmesa" is a build dependency.
+    if (cam.backend == "egl") {
+      const std::string problem = sim::gl_backend_problem("egl");
+      if (!problem.empty()) {
+        const char* env = std::getenv("OMNILOC_GL_BACKEND");
+        throw ConfigError(env && *env ? "$OMNILOC_GL_BACKEND" : "/camera/backend", "\"egl\"",
+                          "a GL back-end that can render on this machine (" + problem + ")");
+      }
+    }
   }
   const Json* vis = r.raw("vision");
   s.vision = vis ? *vis : Json::object();

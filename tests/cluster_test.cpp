@@ -300,3 +300,30 @@ TEST(Cluster, DryRunWritesTheSubmissionFolderWithoutSlurm) {
   // bash accepts both scripts.
   EXPECT_EQ(sh("bash -n " + (res / "slurm" / "array.sbatch").string() + " && bash -n " + (res / "slurm" / "merge.sbatch").string()).code, 0);
 }
+
+// --gpus-per-task (issue 32): the GPUs as a generic resource among the #SBATCH lines (sbatch reads
+// none after the first command) and rendering on them with egl; no Slurm needed.
+TEST(Cluster, DryRunRequestsGpusPerTask) {
+  const std::string sweep = make_sweep(3.0);
+  const fs::path res = test_dir() / "dry_gpu";
+  const Out bad = sh(exe() + " sweep " + sweep + " --slurm --dry-run --tasks 2 --gpus-per-task 17 -o " + res.string());
+  EXPECT_EQ(bad.code, 2) << bad.text;
+  EXPECT_NE(bad.text.find("--gpus-per-task"), std::string::npos) << bad.text;
+  EXPECT_FALSE(fs::exists(res));
+  const Out o = sh(exe() + " sweep " + sweep + " --slurm --dry-run --tasks 2 --cpus-per-task 4 --gpus-per-task 1 -o " + res.string());
+  ASSERT_EQ(o.code, 0) << o.text;
+  const std::string array = read_file((res / "slurm" / "array.sbatch").string());
+  const auto gres = array.find("#SBATCH --gres=gpu:1\n");
+  ASSERT_NE(gres, std::string::npos) << array;
+  // Every line before it is a comment or an #SBATCH line.
+  for (std::size_t at = 0; at < gres; at = array.find('\n', at) + 1) EXPECT_EQ(array[at], '#') << array.substr(at, 40);
+  EXPECT_NE(array.find("export OMNILOC_GL_BACKEND=\"${OMNILOC_GL_BACKEND:-egl}\"\n"), std::string::npos) << array;
+  EXPECT_EQ(submission(res)["gpus_per_task"], 1);
+  EXPECT_EQ(sh("bash -n " + (res / "slurm" / "array.sbatch").string()).code, 0);
+  // Without GPUs, neither line.
+  const fs::path cpu = test_dir() / "dry_cpu";
+  ASSERT_EQ(sh(exe() + " sweep " + sweep + " --slurm --dry-run --tasks 2 -o " + cpu.string()).code, 0);
+  const std::string plain = read_file((cpu / "slurm" / "array.sbatch").string());
+  EXPECT_EQ(plain.find("--gres"), std::string::npos);
+  EXPECT_EQ(plain.find("OMNILOC_GL_BACKEND"), std::string::npos);
+}

@@ -46,6 +46,8 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
   c.read_noise = r.number("read_noise", 1.5, 0.0, 50.0);
   c.shot_noise = r.number("shot_noise", 0.35, 0.0, 10.0);
   c.backend = r.string("backend", std::string("osmesa"), gl_backends());
+  // A sweep renders on a GPU without editing its scenarios: the variable wins over the file.
+  c.backend = effective_gl_backend(c.backend);
   c.quality = r.string("quality", std::string("default"), {"low", "default", "high"});
   c.exposure_min = r.positive("exposure_min", 1.0, 1000.0);
   c.exposure_max = r.positive("exposure_max", 60.0, 1000.0);
@@ -60,6 +62,7 @@ CameraConfig CameraConfig::from_json(const Json& j, const std::string& path, Jso
   if (c.initial.gain < c.gain_min || c.initial.gain > c.gain_max)
     throw ConfigError(r.child_path("gain"), std::to_string(c.initial.gain), "a gain within [gain_min, gain_max]");
   r.finish();
+  if (effective) (*effective)["backend"] = c.backend;
   return c;
 }
 

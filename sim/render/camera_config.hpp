@@ -30,7 +30,7 @@ struct CameraConfig {
   double vibration_std = 0.0052;        ///< per-frame roll/pitch std, radians (0.3 deg: a robot on carpet)
   double read_noise = 1.5;              ///< DN at gain 18
   double shot_noise = 0.35;             ///< DN^(1/2): shot-noise std = shot_noise * sqrt(value * gain / 18)
-  std::string backend = "osmesa";       ///< "osmesa" or "egl"
+  std::string backend = "osmesa";       ///< "osmesa" or "egl" (OMNILOC_GL_BACKEND overrides the JSON; egl_device.hpp)
   std::string quality = "default";      ///< "low" (coarse floor mesh), "default", "high" (2x2 supersampling)
   CameraSettings initial;               ///< settings of the first frame
   double exposure_min = 1.0, exposure_max = 60.0;  ///< ms

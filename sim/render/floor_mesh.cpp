@@ -32,14 +32,23 @@ const Eigen::Vector3f kHallFloor(0.30f, 0.29f, 0.27f);
 constexpr double kDistanceTexel = 0.02;  // metres
 constexpr double kDistanceRange = 2.0;   // metres; farther is stored as 2 m
 // Shared by the floor shaders: line, carpet, outside are albedos (label ids / 255 for labels).
+// The pixel's extent is fwidthCoarse where GL_ARB_derivative_control exists: one derivative per 2 x 2
+// quad, which is what llvmpipe's fwidth is (OSMesa's bytes are the same either way), whereas NVIDIA's
+// plain fwidth is finer and gave 0.4-0.5 % fewer line points per frame than OSMesa, 4 seed-to-seed
+// standard deviations; with fwidthCoarse the H200's runs match OSMesa's (docs/performance.md "GPUs").
 const char* const kFloorCommon = R"(#version 130
+#extension GL_ARB_derivative_control : enable
 uniform sampler2D distance_map;
 uniform float range, half_width;
 uniform vec3 line, carpet, outside;
 float distance_to_line(vec2 uv) { return texture(distance_map, uv).r * range; }
 // Share of a box as wide as the pixel's extent across the line that the line covers.
 float line_cover(float d) {
+#ifdef GL_ARB_derivative_control
+  float fw = max(fwidthCoarse(d), 1e-4);
+#else
   float fw = max(fwidth(d), 1e-4);
+#endif
   return clamp((min(d + 0.5 * fw, half_width) - max(d - 0.5 * fw, -half_width)) / fw, 0.0, 1.0);
 }
 bool on_floor(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }

@@ -2,8 +2,6 @@
 
 #include <dlfcn.h>
 
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
 #include <GL/osmesa.h>
 
 #include <cstring>
@@ -22,6 +20,14 @@ void GlContext::load(void* (*proc)(const char*)) {
   OMNILOC_GL_FUNCS(OMNILOC_GL_LOAD)
 #undef OMNILOC_GL_LOAD
   if (!missing.empty()) throw RuntimeFailure("GL back-end \"" + backend_ + "\": missing entry points " + missing);
+  auto str = [&](GLenum name) {
+    const auto* v = reinterpret_cast<const char*>(gl_.GetString(name));
+    return std::string(v ? v : "");
+  };
+  device_.backend = backend_;
+  device_.vendor = str(GL_VENDOR);
+  device_.renderer = str(GL_RENDERER);
+  device_.version = str(GL_VERSION);
 }
 
 bool GlContext::has_extension(const std::string& name) const {
@@ -118,14 +124,13 @@ void* open_library(const std::string& backend, const char* lib) {
 
 // The resolver handed to GlContext::load needs a plain function; each back-end sets its own.
 thread_local void* (*t_osmesa_gpa)(const char*) = nullptr;
-thread_local void* (*t_egl_gpa)(const char*) = nullptr;
 void* osmesa_proc(const char* n) { return t_osmesa_gpa(n); }
-void* egl_proc(const char* n) { return t_egl_gpa(n); }
 
 class OsmesaContext : public GlContext {
  public:
   OsmesaContext() {
     backend_ = "osmesa";
+    device_.platform = "osmesa";
     lib_ = open_library(backend_, "libOSMesa.so.8");
     create_ = reinterpret_cast<OSMesaContext (*)(const int*, OSMesaContext)>(::dlsym(lib_, "OSMesaCreateContextAttribs"));
     make_ = reinterpret_cast<GLboolean (*)(OSMesaContext, void*, GLenum, GLsizei, GLsizei)>(::dlsym(lib_, "OSMesaMakeCurrent"));
@@ -157,71 +162,13 @@ class OsmesaContext : public GlContext {
   void (*destroy_)(OSMesaContext) = nullptr;
 };
 
-class EglContext : public GlContext {
- public:
-  EglContext() {
-    backend_ = "egl";
-    lib_ = open_library(backend_, "libEGL.so.1");
-    t_egl_gpa = reinterpret_cast<void* (*)(const char*)>(::dlsym(lib_, "eglGetProcAddress"));
-    auto sym = [&](const char* n) {
-      void* p = ::dlsym(lib_, n);
-      if (!p) throw RuntimeFailure(std::string("GL back-end \"egl\": libEGL lacks ") + n);
-      return p;
-    };
-    auto initialize = reinterpret_cast<EGLBoolean (*)(EGLDisplay, EGLint*, EGLint*)>(sym("eglInitialize"));
-    auto bind_api = reinterpret_cast<EGLBoolean (*)(EGLenum)>(sym("eglBindAPI"));
-    auto choose = reinterpret_cast<EGLBoolean (*)(EGLDisplay, const EGLint*, EGLConfig*, EGLint, EGLint*)>(sym("eglChooseConfig"));
-    auto create = reinterpret_cast<EGLContext (*)(EGLDisplay, EGLConfig, EGLContext, const EGLint*)>(sym("eglCreateContext"));
-    make_ = reinterpret_cast<EGLBoolean (*)(EGLDisplay, EGLSurface, EGLSurface, EGLContext)>(sym("eglMakeCurrent"));
-    destroy_ = reinterpret_cast<EGLBoolean (*)(EGLDisplay, EGLContext)>(sym("eglDestroyContext"));
-    auto get_error = reinterpret_cast<EGLint (*)()>(sym("eglGetError"));
-    if (!t_egl_gpa) throw RuntimeFailure("GL back-end \"egl\": libEGL lacks eglGetProcAddress");
-    auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(t_egl_gpa("eglGetPlatformDisplayEXT"));
-    if (!get_display) throw RuntimeFailure("GL back-end \"egl\": no eglGetPlatformDisplayEXT (EGL_EXT_platform_base)");
-    dpy_ = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    EGLint major = 0, minor = 0;
-    if (dpy_ == EGL_NO_DISPLAY || !initialize(dpy_, &major, &minor))
-      throw RuntimeFailure("GL back-end \"egl\": no surfaceless Mesa display (EGL error 0x" + std::to_string(get_error()) + ")");
-    if (!bind_api(EGL_OPENGL_API)) throw RuntimeFailure("GL back-end \"egl\": desktop OpenGL API not available");
-    // Surfaceless rendering needs no config (EGL_KHR_no_config_context); fall back to choosing one.
-    EGLConfig cfg = EGL_NO_CONFIG_KHR;
-    const EGLint cfg_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-    EGLint n = 0;
-    auto query = reinterpret_cast<const char* (*)(EGLDisplay, EGLint)>(sym("eglQueryString"));
-    const char* exts = query(dpy_, EGL_EXTENSIONS);
-    if (!exts || !std::strstr(exts, "EGL_KHR_no_config_context")) {
-      if (!choose(dpy_, cfg_attribs, &cfg, 1, &n) || n < 1) throw RuntimeFailure("GL back-end \"egl\": no OpenGL config and no EGL_KHR_no_config_context");
-    }
-    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0, EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                  EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT, EGL_NONE};
-    ctx_ = create(dpy_, cfg, EGL_NO_CONTEXT, ctx_attribs);
-    if (ctx_ == EGL_NO_CONTEXT) throw RuntimeFailure("GL back-end \"egl\": eglCreateContext failed (error 0x" + std::to_string(get_error()) + ")");
-    make_current();
-    load(egl_proc);
-  }
-  ~EglContext() override {
-    release_framebuffer();
-    if (ctx_ != EGL_NO_CONTEXT) destroy_(dpy_, ctx_);
-  }
-  void make_current() override {
-    if (!make_(dpy_, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx_)) throw RuntimeFailure("GL back-end \"egl\": eglMakeCurrent (surfaceless) failed");
-  }
-
- private:
-  void* lib_ = nullptr;
-  EGLDisplay dpy_ = EGL_NO_DISPLAY;
-  EGLContext ctx_ = EGL_NO_CONTEXT;
-  EGLBoolean (*make_)(EGLDisplay, EGLSurface, EGLSurface, EGLContext) = nullptr;
-  EGLBoolean (*destroy_)(EGLDisplay, EGLContext) = nullptr;
-};
-
 }  // namespace
 
 std::vector<std::string> gl_backends() { return {"osmesa", "egl"}; }
 
 std::unique_ptr<GlContext> make_gl_context(const std::string& backend) {
   if (backend == "osmesa") return std::make_unique<OsmesaContext>();
-  if (backend == "egl") return std::make_unique<EglContext>();
+  if (backend == "egl") return make_egl_context();
   throw RuntimeFailure("unknown GL back-end \"" + backend + "\" (known: osmesa, egl)");
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Off-screen GL behind a small interface with two back-ends chosen at run time: "osmesa" (Mesa's
-// OSMesa, llvmpipe) and "egl" (EGL_PLATFORM_SURFACELESS_MESA). Both libraries are loaded with dlopen
+// OSMesa, llvmpipe) and "egl" (an EGL device: a GPU, Mesa's software device or Mesa's surfaceless
+// display; egl_device.hpp says which is chosen). Both libraries are loaded with dlopen
 // and every GL entry point is resolved through the back-end's own GetProcAddress into GlApi, so
 // neither glvnd's libGL nor libOSMesa is linked and their gl* symbols can never clash. Rendering
 // always goes into a framebuffer object that is read back with glReadPixels, the same on both.
@@ -11,6 +12,8 @@
 
 #include <GL/gl.h>
 #include <GL/glext.h>
+
+#include "sim/render/egl_device.hpp"
 
 namespace omniloc::sim {
 
@@ -85,6 +88,8 @@ class GlContext {
   virtual ~GlContext();
   const GlApi& gl() const { return gl_; }
   const std::string& backend() const { return backend_; }
+  /// The device the context renders on (GL strings filled once the context is current).
+  const GlDeviceInfo& device() const { return device_; }
   /// Makes the context current on this thread (contexts are per camera, cameras per run).
   virtual void make_current() = 0;
   /// (Re)creates the framebuffer object for rendering at width x height and binds it.
@@ -99,16 +104,21 @@ class GlContext {
   unsigned fragment_program(const char* source, const std::string& what) const;
 
  protected:
+  /// Resolves the entry points and reads the GL vendor, renderer and version into device_.
   void load(void* (*proc)(const char*));
   void release_framebuffer();
   GlApi gl_;
   std::string backend_;
+  GlDeviceInfo device_;
   unsigned fbo_ = 0, color_ = 0, depth_ = 0;
   int fb_w_ = 0, fb_h_ = 0;
 };
 
-/// "osmesa" or "egl". Throws omniloc::RuntimeFailure naming the back-end and why it failed.
+/// "osmesa" or "egl". Throws omniloc::RuntimeFailure naming the back-end and why it failed
+/// (for "egl": every device tried and what each answered).
 std::unique_ptr<GlContext> make_gl_context(const std::string& backend);
+/// The "egl" back-end on the device egl_device.hpp's rules choose (egl_device.cpp).
+std::unique_ptr<GlContext> make_egl_context();
 std::vector<std::string> gl_backends();
 
 }  // namespace omniloc::sim

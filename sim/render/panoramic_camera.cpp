@@ -53,6 +53,7 @@ PanoramicCamera::PanoramicCamera(const CameraConfig& config, const Field& field)
 PanoramicCamera::~PanoramicCamera() = default;
 
 const std::string& PanoramicCamera::backend() const { return impl_->ctx->backend(); }
+const GlDeviceInfo& PanoramicCamera::device() const { return impl_->ctx->device(); }
 
 Eigen::Vector2d PanoramicCamera::centre() const {
   return cfg_.mirror_centre_px();

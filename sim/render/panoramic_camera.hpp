@@ -75,6 +75,8 @@ class PanoramicCamera {
   const CameraConfig& config() const { return cfg_; }
   const MirrorProfile& mirror() const { return mirror_; }
   const std::string& backend() const;
+  /// The device the camera renders on (back-end, EGL device, GL vendor and renderer).
+  const GlDeviceInfo& device() const;
   /// Settings clamped into the camera's ranges; `clamped` says whether anything changed.
   CameraSettings clamp(const CameraSettings& s, bool* clamped = nullptr) const;
   /// Pixel value (before noise and saturation) of a surface of albedo a under illumination 1 and the
