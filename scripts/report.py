@@ -303,6 +303,70 @@ class Report:
         tmp.replace(self.out / f"{self.page}.html")
 
 
+class TextReport:
+    """The Report interface written to the terminal (scripts/paper_table.py): tables aligned (or
+    as markdown), figures left out. With only=ANCHOR just the section of that heading anchor."""
+
+    def __init__(self, only=None, markdown=False):
+        self.only, self.markdown_tables, self.on, self.printed = only, markdown, only is None, False
+        self.plotted, self.n_img = set(), 0
+
+    def clean(self, text):
+        return str(text)
+
+    def heading(self, text, level=2, anchor=None):
+        anchor = anchor or slug(text)
+        if self.only is not None:
+            self.on = anchor == self.only
+        if self.on:
+            print(("#" * level + " " if self.markdown_tables else "== ") + text + "\n")
+            self.printed = True
+        return anchor
+
+    def para(self, text, cls=None):
+        if self.on:
+            print(text + "\n")
+
+    def table(self, header, rows, caption=None, row_classes=None):
+        if not self.on:
+            return
+        if caption:
+            print(caption)
+        cells = [[str(c) for c in header]] + [[str(c) for c in r] for r in rows]
+        if self.markdown_tables:
+            for k, r in enumerate(cells):
+                print("| " + " | ".join(r) + " |")
+                if k == 0:
+                    print("|" + "---|" * len(r))
+        else:
+            w = [max(len(r[i]) for r in cells) for i in range(len(header))]
+            for r in cells:
+                print("  ".join(c.rjust(w[i]) if i and numeric_class(c) else c.ljust(w[i]) for i, c in enumerate(r)).rstrip())
+        print()
+
+    def figure(self, fig, name, caption, dpi=80):
+        plt.close(fig)
+
+    def image(self, path, caption):
+        pass
+
+    def markdown(self, text, skip=()):
+        if self.on:
+            print(text)
+
+    def details(self, summary):
+        pass
+
+    def end_details(self):
+        pass
+
+    def mark_toc(self):
+        pass
+
+    def raw_html(self, fragment, md=None):
+        pass
+
+
 def compress_png(path):
     """Re-encodes a PNG as an optimised 256-colour palette image where that is smaller (plots have
     few colours; this is what keeps report.html, which embeds every picture, under 3 MB). Without
