@@ -88,6 +88,8 @@ def slug(text):
 
 
 TOC_MARK = "<!--toc-->"
+# The part before a repository folder of an absolute path (/any/checkout/scenarios/x.json -> scenarios/x.json).
+REPO_PATH = re.compile(r"(?<![\w.~-])/(?:[\w.+-]+/)+?(?=(?:scenarios|results|build|docs|scripts|data|experiments|tests)/)")
 
 
 class Report:
@@ -99,7 +101,7 @@ class Report:
         self.out = pathlib.Path(out)
         self.page = page
         (self.out / "img").mkdir(parents=True, exist_ok=True)
-        for old in (self.out / "img").glob(f"{page}_*.png"):  # pictures of an earlier report in the same folder
+        for old in (self.out / "img").glob(f"{page}_*"):  # pictures of an earlier report in the same folder
             old.unlink()
         self.md = [f"# {title}", ""]
         self.html = []
@@ -133,7 +135,9 @@ class Report:
         for root in self.roots:
             if root != "/" and root in text:
                 text = re.sub(re.escape(root) + r"(/[^\s'\"<>,;:()\[\]]*)?", rel, text)
-        return text
+        # A path of another checkout (an experiment records the description file it read, with the
+        # folder omniloc was built in): from the repository's own folder on.
+        return REPO_PATH.sub("", text)
 
     def heading(self, text, level=2, anchor=None):
         text = self.clean(text)
@@ -253,8 +257,7 @@ class Report:
         path = self.out / "img" / f"{self.page}_{self.n_img:03d}_{name}.png"
         fig.savefig(path, dpi=dpi, bbox_inches="tight")
         plt.close(fig)
-        compress_png(path)
-        self._embed(path, caption)
+        self._embed(compress_png(path), caption)
 
     def image(self, path, caption):
         """A picture an experiment wrote: copied next to the report, compressed, embedded."""
@@ -262,15 +265,15 @@ class Report:
         self.n_img += 1
         dst = self.out / "img" / f"{self.page}_{self.n_img:03d}_{path.name}"
         dst.write_bytes(path.read_bytes())
-        compress_png(dst)
-        self._embed(dst, caption)
+        self._embed(compress_png(dst), caption)
 
     def _embed(self, path, caption):
         caption = self.clean(caption)
         rel = path.relative_to(self.out)
         self.md += [f"![{caption}]({rel.as_posix()})", "", f"*{caption}*", ""]
         b64 = base64.b64encode(path.read_bytes()).decode()
-        self.html.append(f'<figure><img src="data:image/png;base64,{b64}" alt="{html.escape(caption)}"><figcaption>{inline_markdown(caption)}</figcaption></figure>')
+        mime = "image/jpeg" if path.suffix == ".jpg" else "image/png"
+        self.html.append(f'<figure><img src="data:{mime};base64,{b64}" alt="{html.escape(caption)}"><figcaption>{inline_markdown(caption)}</figcaption></figure>')
 
     def toc_html(self):
         items = "".join(f'<li><a href="#{html.escape(a)}">{html.escape(t)}</a></li>' for a, t in self.toc)
@@ -368,22 +371,37 @@ class TextReport:
 
 
 def compress_png(path):
-    """Re-encodes a PNG as an optimised 256-colour palette image where that is smaller (plots have
-    few colours; this is what keeps report.html, which embeds every picture, under 3 MB). Without
-    PIL (Debian's python3-pil, a dependency of python3-matplotlib) the file stays as it is."""
+    """Re-encodes a picture so that report.html, which embeds every one, stays under 3 MB without
+    leaving one out: plots (few colours) as an optimised 256-colour palette PNG; camera frames and
+    other photographic pictures, which stay large as a palette PNG, as JPEG (quality 85). Keeps the
+    original where that is smaller. Returns the path written (the suffix may change to .jpg).
+    Without PIL (Debian's python3-pil, a dependency of python3-matplotlib) nothing changes."""
     try:
         from PIL import Image
     except ImportError:
-        return
+        return path
     import io
     with Image.open(path) as im:
         im.load()
-    src = im.convert("RGBA") if im.mode in ("RGBA", "LA", "P") else im.convert("RGB")
-    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if src.mode == "RGBA" else src.quantize(colors=256)
+    has_alpha = im.mode in ("RGBA", "LA") or (im.mode == "P" and "transparency" in im.info)
+    src = im.convert("RGBA") if has_alpha else im.convert("RGB")
+    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if has_alpha else src.quantize(colors=256)
     buf = io.BytesIO()
     q.save(buf, format="PNG", optimize=True)
-    if buf.tell() < path.stat().st_size:
-        path.write_bytes(buf.getvalue())
+    best, data = path.stat().st_size, None
+    if buf.tell() < best:
+        best, data = buf.tell(), buf.getvalue()
+    if best > 120_000 and not has_alpha:  # still large: a photograph-like picture
+        jbuf = io.BytesIO()
+        src.save(jbuf, format="JPEG", quality=85, optimize=True)
+        if jbuf.tell() < best / 2:
+            path.unlink()
+            path = path.with_suffix(".jpg")
+            path.write_bytes(jbuf.getvalue())
+            return path
+    if data is not None:
+        path.write_bytes(data)
+    return path
 
 
 # ---- provenance ---------------------------------------------------------------------------
@@ -467,7 +485,8 @@ def scorecard(rep, ctx):
                    fnum(c["ratio"], 2) if c["ratio"] is not None else "-", c["verdict"]]
             if field_claims is not None:
                 f = field_claims[c["id"]]
-                row += [f["ours_text"], f["verdict"]] if c["uses_runs"] else ["same as robot (experiment)", "-"]
+                row += [f["ours_text"].replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json"), f["verdict"]] \
+                    if c["uses_runs"] else ["same as robot (experiment)", "-"]
             rows.append(row + [c["rule_text"]])
         header = ["paper", "claim", "ours (robot profile)", "paper's", "ours / paper", "verdict"]
         if field_claims is not None:
@@ -486,7 +505,7 @@ SEED_METRICS = [("x_cm/mean", "mean x cm", 2), ("y_cm/mean", "mean y cm", 2), ("
 
 def seed_values_text(sel, values, flagged, digits):
     """'s1 3.10, s2 806.00 (outlier), s3 2.90': every seed's value beside the mean."""
-    return ", ".join(f"s{r.seed} {fnum(v, digits)}" + (" (outlier)" if i in flagged else "") for i, (r, v) in enumerate(zip(sel, values)))
+    return ", ".join(f"s{r.seed}\u00a0{fnum(v, digits)}" + ("\u00a0(outlier)" if i in flagged else "") for i, (r, v) in enumerate(zip(sel, values)))
 
 
 def interval_text(st, digits):
@@ -634,6 +653,13 @@ def log_axis(axis, ax, which):
 
 
 
+def command(cmd):
+    """The command that runs a missing row: under the field_robot profile, its own suite."""
+    if R.DEFAULT_PROFILE == "field_robot":
+        return cmd.replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json")
+    return cmd
+
+
 def error_table(rep, papers, table, runs):
     t = papers[table]
     rep.heading(f"{t.get('source', table)}", 3, table)
@@ -665,8 +691,11 @@ def error_table(rep, papers, table, runs):
                 classes.append("ratio")
     rep.table(header, rows, row_classes=classes)
     missing = [p for p in pairs if not p["runs"]]
-    for p in missing:
-        rep.para(f"Not run: \"{p['label']}\" ({R.describe_key(p['key'])}). Run: {p['command']}")
+    if missing:  # one line each, collapsed: the command is what a reader needs, not a page of it
+        rep.details(f"{len(missing)} row(s) not run, and the command that runs them")
+        for p in missing:
+            rep.para(f"Not run: \"{p['label']}\" ({R.describe_key(p['key'])}). Run: `{command(p['command'])}`")
+        rep.end_details()
     # Every seed beside its mean, and the outlying seeds plotted with their cause.
     rows_runs = [(p["label"], p["runs"]) for p in pairs] + [(f"{p['label']} (external: {q['name']})", q["runs"]) for p in pairs for q in p.get("peers", [])]
     flagged = seed_table(rep, rows_runs)
@@ -690,17 +719,19 @@ def kidnap_table(rep, papers, runs):
                 after = R.stats([r.metric("recovery/after_recovery/x_cm/mean", "all") for r in sel])
                 phase = R.stats([r.metric("x_cm/mean", "tracking") for r in sel])
                 allf = R.stats([r.metric("x_cm/mean", "all") for r in sel])
+                per_seed = ", ".join(f"s{r.seed}\u00a0{r.metric('recovery/recovered', 'all') or 0:.0f}/{r.metric('recovery/episodes', 'all') or 0:.0f}"
+                                     f"\u00a0{fnum(r.metric('x_cm/mean', 'tracking'), 2)}" for r in sel)
                 rows.append([f"{table}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}", fnum(med["mean"], 2), fnum(after["mean"], 2),
-                             fnum(phase["mean"], 2), fnum(allf["mean"], 1), len(sel)])
+                             fnum(phase["mean"], 2), fnum(allf["mean"], 1), per_seed, len(sel)])
                 classes.append("")
             else:
-                rows.append([f"{table}: {label}", "not run", "-", "-", "-", "-", "-", "-", 0])
+                rows.append([f"{table}: {label}", "not run", "-", "-", "-", "-", "-", "-", "-", 0])
                 classes.append("missing")
-            rows.append([f"{table}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-"])
+            rows.append([f"{table}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-", "-"])
             classes.append("paper")
     rep.table(["case", "source", "recovered / kidnaps", "false recoveries", "median recovery s", "after recovery: mean x cm",
-               "tracking phase: mean x cm", "all frames: mean x cm", "seeds"], rows,
-              "Over all seeds. Recovered: error under 0.3 m and 0.2 rad for 1 s. The tracking phase leaves out the carried period and the time to recovery; "
+               "tracking phase: mean x cm", "all frames: mean x cm", "per seed: recovered, tracking-phase mean x cm", "seeds"], rows,
+              "Over all seeds, and every seed beside the means. Recovered: error under 0.3 m and 0.2 rad for 1 s. The tracking phase leaves out the carried period and the time to recovery; "
               "'all frames' includes them (that is why it is large).", classes)
 
 
