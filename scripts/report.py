@@ -219,7 +219,7 @@ class Report:
                 flush()
                 level = min(6, len(ln) - len(ln.lstrip("#")) + 2)
                 self.html.append(f"<h{level}>{inline_markdown(ln.lstrip('#').strip())}</h{level}>")
-                kept.append(ln)
+                kept.append("#" * level + " " + ln.lstrip("#").strip())  # below the report's own sections, as in the HTML
             elif ln.startswith("|"):
                 flush()
                 rows, block = [], []
@@ -583,7 +583,7 @@ def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
             st = R.stats(vals)
             if st["method"]:
                 methods.add(st["method"])
-            flagged = {i for i, r in enumerate(sel) if r in out}
+            flagged = {i for i, r in enumerate(sel) if r in out} if metric == "x_cm/mean" else set()  # the metric flagged on
             row += [seed_values_text(sel, vals, flagged, digits), fnum(st["median"], digits), interval_text(st, digits)]
         row.append("; ".join(f"s{r.seed}: {outlier_cause(r)}" for r in out) or "-")
         rows.append(row)

@@ -312,6 +312,204 @@ class ReportEndToEnd(unittest.TestCase):
             self.assertIn("abc123", doc)  # provenance
 
 
+def write_frames(folder, rows, events=()):
+    """frames.csv (robot 0) from (t, err_pos m, valid, mode) and events.jsonl for an outlier's cause."""
+    folder = pathlib.Path(folder)
+    head = "t,robot,gt_x,gt_y,gt_theta,est_x,est_y,est_theta,err_x,err_y,err_theta,err_pos,valid,mode"
+    lines = [head] + [f"{t},0,0,0,0,0,0,0,{e},0,0,{e},{1 if v else 0},{m}" for t, e, v, m in rows]
+    (folder / "frames.csv").write_text("\n".join(lines) + "\n")
+    (folder / "events.jsonl").write_text("".join(json.dumps(e) + "\n" for e in events))
+
+
+def mcl_runs_with_outlier(folder):
+    """Three MCL seeds on the tracking path: 3.0, 806.0 (converged to a wrong pose), 3.1 cm."""
+    folder = pathlib.Path(folder)
+    for seed, x in ((1, 3.0), (2, 806.0), (3, 3.1)):
+        write_run(folder / f"mcl_s{seed}", "tracking", "mcl", seed, {}, robot(x))
+    write_frames(folder / "mcl_s2", [(0.0, 6.7, False, "global")] + [(0.5 * k, 8.06, True, "converged") for k in range(1, 11)])
+
+
+class FewSeeds(unittest.TestCase):
+    """Issue 30: every seed beside its mean, outlying seeds flagged with their cause."""
+
+    def test_outlier_cause_is_read_from_the_frames(self):
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            mcl_runs_with_outlier(tmp)
+            run = R.Run(pathlib.Path(tmp) / "mcl_s2")
+            self.assertEqual(report.outlier_cause(run), "converged to a wrong pose at t = 0.5 s: 8.06 m from the truth (median), "
+                             "mode 'converged' in 91 % of the frames from the start to the end; never within 0.5 m")
+            lost = pathlib.Path(tmp) / "lost"
+            write_run(lost, "kidnap_002", "hybrid", 1, {}, robot(50.0))
+            write_frames(lost, [(0.5 * k, 0.1, True, "tracking") for k in range(5)] + [(2.5 + 0.5 * k, 3.0, False, "lost") for k in range(4)],
+                         [{"type": "kidnap", "t": 2.4, "robot": 0}])
+            self.assertEqual(report.outlier_cause(R.Run(lost)),
+                             "lost from t = 2.5 s, after the kidnap at t = 2.4 s: no estimate, no confident estimate (mode 'lost') to the end")
+            fine = pathlib.Path(tmp) / "fine"
+            write_run(fine, "tracking", "matching", 1, {}, robot(2.0))
+            write_frames(fine, [(0.0, 0.1, True, "tracking"), (1.0, 0.9, True, "tracking"), (2.0, 0.2, True, "tracking")])
+            self.assertEqual(report.outlier_cause(R.Run(fine)), "error peaked at 0.90 m at t = 1.0 s, below 0.5 m at the end")
+
+    def test_seed_table_shows_every_seed_and_flags_the_outlier(self):
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            mcl_runs_with_outlier(pathlib.Path(tmp) / "runs")
+            runs, _, _ = R.discover([pathlib.Path(tmp) / "runs"])
+            rep = report.Report(pathlib.Path(tmp) / "out", "t")
+            flagged = report.seed_table(rep, [("MCL alone", sorted(runs, key=lambda r: r.seed))])
+            self.assertEqual([r.seed for r in flagged], [2])
+            rep.write()
+            md = (pathlib.Path(tmp) / "out" / "report.md").read_text()
+            nb = "\u00a0"
+            self.assertIn(f"s1{nb}3.00, s2{nb}806.00{nb}(outlier), s3{nb}3.10", md)
+            # Exact bootstrap over the 27 resamples of (3.0, 806.0, 3.1): the 2.5 % point lies 0.65 of
+            # the way from 3.0 (all three 3.0) to 3.033 (two 3.0, one 3.1); the 97.5 % point 0.35 of
+            # the way from 538.37 (two 806, one 3.1) to 806. Student t would give [-881, 1422].
+            lo, top2 = 3.0 + 0.65 * 0.1 / 3, (2 * 806.0 + 3.1) / 3
+            self.assertIn(f"270.70 [{lo:.2f}, {top2 + 0.35 * (806.0 - top2):.2f}]", md)
+            self.assertIn(f"s1{nb}1.00, s2{nb}1.00, s3{nb}1.00", md)  # the flag marks the metric it is about (mean x)
+            self.assertIn("s2: converged to a wrong pose at t = 0.5 s", md)
+            self.assertIn("bootstrap percentile", md)
+            one = report.Report(pathlib.Path(tmp) / "one", "t")
+            report.seed_table(one, [("one seed", runs[:1])])
+            one.write()
+            self.assertIn("(n = 1: one seed, no interval)", (pathlib.Path(tmp) / "one" / "report.md").read_text())
+
+
+class Verdicts(unittest.TestCase):
+    def test_claims_are_counted_apart_by_kind(self):
+        ctx = C.Context(R.load_papers(), [], [])
+        kinds = {c["id"]: c["kind"] for c in C.evaluate_claims(ctx)}
+        self.assertEqual({k for k, v in kinds.items() if v == "timing"}, {"timing_mcl", "timing_matching", "timing_global", "timing_tracking"})
+        self.assertEqual(kinds["tracking_accuracy"], "accuracy")
+        self.assertEqual(kinds["kidnap_002"], "robustness")
+        t = C.totals([{"kind": "accuracy", "verdict": "holds"}, {"kind": "accuracy", "verdict": "does not"}, {"kind": "timing", "verdict": "holds"}])
+        self.assertEqual(C.totals_text(t), "accuracy: 1 holds, 1 does not; timing: 1 holds")
+
+    def test_tracking_claim_is_judged_on_heading_too(self):
+        # Mean x and y at the paper's figures, heading 0.15x the paper's: x and y hold, heading does
+        # not, so the claim holds only partly (it used to look at mean x alone: "holds").
+        with tempfile.TemporaryDirectory() as tmp:
+            for seed in (1, 2, 3):
+                write_run(pathlib.Path(tmp) / f"t{seed}", "tracking", "matching", seed, {}, robot(5.907, 5.967, 0.0066))
+            runs, _, _ = R.discover([tmp])
+            c = [c for c in C.evaluate_claims(C.Context(R.load_papers(), runs, [])) if c["id"] == "tracking_accuracy"][0]
+            self.assertEqual([(ch["label"], ch["verdict"]) for ch in c["checks"]],
+                             [("mean x", "holds"), ("mean y", "holds"), ("mean heading", "does not")])
+            self.assertAlmostEqual(c["checks"][2]["ratio"], 0.15, places=9)
+            self.assertEqual(c["verdict"], "partly")
+
+    def test_field_robot_rows_are_judged_in_their_own_column(self):
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run(pathlib.Path(tmp) / "robot", "tracking", "matching", 1, {}, robot(5.9, 5.9, 0.044))
+            write_run(pathlib.Path(tmp) / "field", "tracking", "matching", 1, {"noise_profile": "field_robot"}, robot(30.0, 5.9, 0.044))
+            runs, _, _ = R.discover([tmp])
+            rep = report.Report(pathlib.Path(tmp) / "out", "t")
+            claims, field, totals = report.scorecard(rep, C.Context(R.load_papers(), runs, []))
+            robot_c = [c for c in claims if c["id"] == "tracking_accuracy"][0]
+            self.assertEqual(robot_c["verdict"], "holds")
+            self.assertAlmostEqual(field["tracking_accuracy"]["checks"][0]["ours"], 30.0)
+            self.assertEqual(field["tracking_accuracy"]["verdict"], "partly")  # x 5.1x the paper's: does not; y, heading hold
+            self.assertIn("| field_robot: accuracy: 1 partly", totals)
+            rep.write()
+            self.assertIn("verdict (field_robot)", (pathlib.Path(tmp) / "out" / "report.md").read_text())
+
+
+class ReaderReport(unittest.TestCase):
+    """The report as a reader sees it: scorecard and contents first, no absolute paths, markdown
+    rendered, text left and numbers right, developer charts on their own page."""
+
+    def test_cells_and_inline_markdown(self):
+        import report
+        self.assertEqual(report.numeric_class("50 % occlusion degrades the mean error only mildly"), "")
+        self.assertEqual(report.numeric_class("002 / 000"), "")  # a paper's number is a name
+        for cell in ("50 %", "2.42 [2.36, 2.48]", "3 / 3", "0.296 ms", "-1.5", "4.750 (n = 1: no interval)"):
+            self.assertEqual(report.numeric_class(cell), " class='num'", cell)
+        self.assertEqual(report.inline_markdown("run `omniloc x` for **all** <rows> *now*, 5 * 3"),
+                         "run <code>omniloc x</code> for <b>all</b> &lt;rows&gt; <i>now</i>, 5 * 3")
+
+    def test_layout_paths_and_history_page(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            write_occlusion_sweep(tmp / "results" / "s", [0.0, 0.5])
+            mcl_runs_with_outlier(tmp / "results" / "mcl")
+            (tmp / "hist").mkdir()
+            (tmp / "hist" / "icount.jsonl").write_text(json.dumps({"commit": "bbb", "instructions": {"matching": 150}}) + "\n")
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(tmp / "results"), "-o", str(tmp / "rep"), "--history", str(tmp / "hist")],
+                                 capture_output=True, text=True, cwd=str(tmp))
+            self.assertEqual(out.returncode, 0, out.stderr)
+            self.assertIn("scorecard: accuracy:", out.stdout)  # the totals, for the terminal
+            doc = (tmp / "rep" / "report.html").read_text()
+            md = (tmp / "rep" / "report.md").read_text()
+            h2 = [m for m in __import__("re").findall(r"<h2 id=\"([^\"]+)\"", doc)]
+            self.assertEqual(h2[:2], ["scorecard", "provenance"])
+            self.assertLess(doc.index('id="scorecard"'), doc.index('<nav id="contents">'))
+            self.assertLess(doc.index('<nav id="contents">'), doc.index('id="provenance"'))
+            for text in (doc, md):
+                self.assertNotIn(str(tmp), text)
+                self.assertNotIn(str(ROOT), text)
+            self.assertNotIn("Speed over commits", doc)
+            self.assertIn("<a href='history.html'>", doc)
+            self.assertIn("Speed over commits", (tmp / "rep" / "history.html").read_text())
+            self.assertIn("<details>", doc)
+            self.assertIn("outlying seed: tracking / mcl / seed 2", doc)  # the outlier is plotted, with its cause
+            self.assertNotIn("**", __import__("re").sub(r"<[^>]+>", "", doc.split("<body>")[1]))
+            self.assertIn(report_cpu(), doc)
+
+
+def report_cpu():
+    import report
+    return report.cpu_model()
+
+
+class Tools(unittest.TestCase):
+    def test_paper_table_reads_the_profile_from_the_runs_and_prints_every_table(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run(pathlib.Path(tmp) / "field", "tracking", "matching", 1, {"noise_profile": "field_robot"}, robot(7.25))
+            run = lambda *args: subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), tmp] + list(args), capture_output=True, text=True)
+            out = run("--paper", "000_tracking")
+            self.assertEqual(out.returncode, 0, out.stderr)
+            row = [l for l in out.stdout.splitlines() if l.startswith("tracking ") and "omniloc" in l][0]
+            self.assertEqual(row.split()[2], "7.250")
+            self.assertIn("noise profile: field_robot (read from the runs)", out.stdout)
+            out = run("--paper", "000_tracking", "--profile", "robot")
+            self.assertIn("not run: tracking (", out.stdout)
+            out = run("--paper", "all")
+            self.assertEqual(out.returncode, 0, out.stderr)
+            for text in ("== Kidnap recovery", "== Timings", "== Paper 004 table 1", "== Paper 003", "001_real_mean_error_cm:"):
+                self.assertIn(text, out.stdout)
+            self.assertEqual(run("--paper", "list").stdout.split(), [k for k in R.load_papers() if k not in ("comment", "claims")])
+
+    def test_compare_fits_100_columns_names_differences_and_pairs_localizers(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            for frac, x in ((0.125, 2.5), (0.25, 3.0)):
+                for s in (1, 2, 3):
+                    occ = {"occlusion": {"fraction": frac, "sectors": 2}}
+                    write_run(tmp / "A" / f"o{frac}_{s}", "tracking", "matching", s, occ, robot(x + s / 100))
+                    # B: a newer build that writes one more default into every configuration.
+                    write_run(tmp / "B" / f"o{frac}_{s}", "tracking", "matching", s, dict(occ, new_default=1), robot(x + 1 + s / 100))
+                    write_run(tmp / "C" / f"m{frac}_{s}", "tracking", "mcl", s, occ, robot(x * 10))
+            out = subprocess.run([PY, str(ROOT / "scripts/compare.py"), str(tmp / "A"), str(tmp / "B")], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            lines = out.stdout.splitlines()[2:]  # the first two name the folders
+            self.assertLessEqual(max(len(l) for l in lines), 100)
+            self.assertNotIn("only in", out.stdout)
+            self.assertNotIn("...", out.stdout)
+            self.assertEqual(out.stdout.count("differs: /new_default: absent -> 1"), 2)
+            self.assertIn("tracking / matching / /occlusion/fraction=0.125", out.stdout)
+            self.assertIn("tracking / matching / /occlusion/fraction=0.25", out.stdout)
+            x = [l.split() for l in lines if l.strip().startswith("x_cm/mean")]
+            self.assertEqual([r[5] for r in x], ["1.0000", "1.0000"])  # B - A per variant
+            # Two localizers on the same scenario and configuration: paired, with numbers.
+            _, rows = compare.compare_rows(*(R.discover([tmp / d])[0] for d in ("A", "C")))
+            xr = [r for r in rows if r[1] == "x_cm/mean"]
+            self.assertEqual(len(xr), 2)
+            self.assertIn("localizer: matching -> mcl", xr[0][0])
+            self.assertAlmostEqual(float(xr[0][6]), 25.0 - 2.52, places=4)
+
+
 if __name__ == "__main__":
     unittest.main()
 
