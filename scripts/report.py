@@ -647,7 +647,10 @@ def log_axis(axis, ax, which):
     """A log axis with several labelled ticks (1, 2, 5 per decade) in plain numbers, not one lone 10^k."""
     from matplotlib.ticker import LogLocator, FuncFormatter, NullFormatter
     (ax.set_xscale if which == "x" else ax.set_yscale)("log")
-    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0), numticks=15))
+    lo, hi = ax.get_xlim() if which == "x" else ax.get_ylim()
+    decades = math.log10(hi / lo) if lo > 0 and hi > lo else 1.0
+    # 1-2-5 per decade on a short axis; on a long one they would collide: decades only.
+    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0) if decades <= 3.2 else (1.0,), numticks=15))
     axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     axis.set_minor_formatter(NullFormatter())
 
