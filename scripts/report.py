@@ -134,7 +134,8 @@ class Report:
                 return "/".join(p.parts[-2:]) if len(p.parts) > 2 else p.name
         for root in self.roots:
             if root != "/" and root in text:
-                text = re.sub(re.escape(root) + r"(/[^\s'\"<>,;:()\[\]]*)?", rel, text)
+                # The root as a whole folder name: /root must not eat the start of /rootfs.
+                text = re.sub(re.escape(root) + r"(?![\w.-])(/[^\s'\"<>,;:()\[\]]*)?", rel, text)
         # A path of another checkout (an experiment records the description file it read, with the
         # folder omniloc was built in): from the repository's own folder on.
         return REPO_PATH.sub("", text)
