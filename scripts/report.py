@@ -585,17 +585,17 @@ def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
             if st["method"]:
                 methods.add(st["method"])
             flagged = {i for i, r in enumerate(sel) if r in out} if metric == "x_cm/mean" else set()  # the metric flagged on
-            row += [seed_values_text(sel, vals, flagged, digits), fnum(st["median"], digits), interval_text(st, digits)]
+            # One cell per metric (the mean with its interval, the median, every seed): a table a
+            # reader takes in without scrolling sideways.
+            row.append(f"mean {interval_text(st, digits)}; median {fnum(st['median'], digits)}; seeds: {seed_values_text(sel, vals, flagged, digits)}")
         row.append("; ".join(f"s{r.seed}: {outlier_cause(r)}" for r in out) or "-")
         rows.append(row)
         classes.append("outlier" if out else "")
     if not rows:
         return []
-    header = ["row", "n"]
-    for _, name, _ in SEED_METRICS:
-        header += [f"{name}: per seed", "median", "mean [95 % interval]"]
+    header = ["row", "n"] + [name for _, name, _ in SEED_METRICS]
     rep.table(header + ["outlying seeds and cause"], rows,
-              "Every seed beside the mean. 95 % interval of the mean over seeds: "
+              "Every seed beside the mean: mean [95 % interval of the mean]; median; each seed's value. The interval: "
               + ("bootstrap percentile (exact over all resamples for n <= 6; it stays within the seeds' range and never below zero)" if R.BOOTSTRAP in methods
                  else "none (n = 1)") + "; n = 1 is marked and has no interval. A seed is flagged as an outlier when its mean x error lies above 3x "
               "the median of the other seeds and further from it than 3x their range; its cause is read from its frames.csv and events.jsonl."
