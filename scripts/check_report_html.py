@@ -18,7 +18,6 @@ message; scripts/install-deps.sh --report-check installs Debian's chromium).
 """
 import argparse
 import html
-import os
 import pathlib
 import re
 import shutil

@@ -542,7 +542,7 @@ def outlier_cause(run, wrong_m=0.5):
                 events.append(e)
     err = [(float(f["t"]), float(f["err_pos"]) if f.get("valid") == "1" else math.nan, f.get("mode", "")) for f in frames]
     bad = lambda e: not (e <= wrong_m)  # a frame without an estimate counts as wrong
-    t_end, e_end = err[-1][0], err[-1][1]
+    e_end = err[-1][1]
     if bad(e_end):
         k = len(err) - 1
         while k > 0 and bad(err[k - 1][1]):
