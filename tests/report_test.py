@@ -429,6 +429,20 @@ class ReaderReport(unittest.TestCase):
         self.assertEqual(report.inline_markdown("run `omniloc x` for **all** <rows> *now*, 5 * 3"),
                          "run <code>omniloc x</code> for <b>all</b> &lt;rows&gt; <i>now</i>, 5 * 3")
 
+    def test_an_experiments_table_shown_in_its_own_section_is_not_repeated(self):
+        import report
+        md = ("# error_budget: which error source dominates\n\nDescription file `/some/checkout/scenarios/experiments/error_budget.json`.\n\n"
+              "| source | RMSE cm |\n|---|---:|\n| baseline | 1.00 |\n\n## Notes\n\nText with **bold**.\n\n| other | x |\n|---|---|\n| a | 2 |\n")
+        with tempfile.TemporaryDirectory() as tmp:
+            rep = report.Report(tmp, "t")
+            rep.markdown(md, skip=report.SHOWN_ELSEWHERE["error_budget"])
+            doc = "\n".join(rep.html)
+            self.assertNotIn("baseline", doc)  # the table the error-budget section shows
+            self.assertIn("<td class='num'>2</td>", doc)  # another table stays
+            self.assertIn("href='#error_budget'", doc)
+            self.assertIn("<code>scenarios/experiments/error_budget.json</code>", doc)  # path made relative, markdown rendered
+            self.assertIn("<b>bold</b>", doc)
+
     def test_layout_paths_and_history_page(self):
         with tempfile.TemporaryDirectory() as tmp:
             tmp = pathlib.Path(tmp)
