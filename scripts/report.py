@@ -5,22 +5,28 @@ usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N] [--baseline RES
 
 RESULTS are folders: a run (summary.json), a sweep (aggregate.json with runs/ inside), an
 experiment (PNG / JSON / markdown files written by `omniloc experiment`), or any folder holding
-such folders (searched recursively). The report shows, in this order:
-  - provenance: which omniloc builds (git describe, compiler, build type) made the results;
+such folders (searched recursively). The report is laid out for a reader with ten minutes
+(issue 30; docs/results.md), in this order:
   - the reproduction scorecard: every claim of results/reference/papers.json with our figure, the
-    paper's, the ratio and the verdict computed by the rule written next to the claim;
+    paper's, the ratio and the verdict computed by the rule written next to the claim, counted
+    apart by kind (accuracy / robustness / timing), judged on every axis a published row states,
+    with the field_robot runs judged by the same rules in their own column; then the contents;
+  - provenance: which omniloc builds (git describe, compiler, build type) made the results, when,
+    and the machine (CPU model, cores);
   - every published table beside the runs that reproduce it, paired BY KEY (scenario, localizer,
     configuration values; scripts/omniloc_results.py), never by position; a row whose runs are
-    missing says "not run" and prints the command that runs it;
+    missing says "not run" and prints the command that runs it; below each, every seed beside the
+    mean (bootstrap intervals, n = 1 marked), a strip plot of the seeds, and each outlying seed
+    plotted with its cause read from its frames.csv and events.jsonl;
   - with --baseline: our metrics against another result set (e.g. another commit), per metric
     with the difference and Welch's t-test over seeds (scripts/compare.py);
-  - every sweep's aggregate and every run's error table (headings carry the swept parameters,
-    in the aggregate's order), trajectory plots over the field, position and heading error over
-    time with the events marked, error CDFs, timing per stage;
-  - every experiment's tables (as HTML tables) and pictures;
-  - with --history DIR (default results/history when it exists): instruction counts
-    (scripts/icount.sh, icount.jsonl) and benchmark wall times (scripts/bench.sh, bench.jsonl)
-    per workload over the commits that were measured.
+  - every sweep's aggregate and per-seed table, each run's table and plots (collapsed), error
+    CDFs, timing per stage;
+  - every experiment's pictures and notes (tables a section above shows are not repeated);
+  - on a page of its own (history.html, linked), for developers: instruction counts and benchmark
+    wall times per workload over the commits (--history DIR, default results/history).
+Pictures are embedded, compressed (palette PNG, JPEG for camera frames) so that report.html stays
+under 3 MB; no absolute path reaches the report (Report.clean).
 Everything except the published numbers is read from the result files. Needs Python 3 and
 Debian's python3-matplotlib (no PyPI).
 """
