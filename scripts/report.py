@@ -115,6 +115,7 @@ class Report:
         self.n_img = 0
         self.title = title
         self.anchors = set()
+        self.titles = {}
         self.plotted = set()
         # Absolute paths never reach the report (it is shared): every folder the report could name
         # is shown relative to the working folder, or by its last two parts when outside it.
@@ -152,6 +153,7 @@ class Report:
         while anchor in self.anchors:  # unique ids: two runs can share a title
             anchor += "-"
         self.anchors.add(anchor)
+        self.titles[anchor] = text
         if level == 2:
             self.toc.append((anchor, text))
         self.md += ["#" * level + " " + text, ""]
@@ -238,7 +240,7 @@ class Report:
                     i += 1
                 shown = [(h, a) for h, a in skip if h in current]
                 if shown:
-                    note = f"(This table is shown once, in the section \"{shown[0][0]}\" above.)"
+                    note = f"(This table is shown once, in the section \"{self.titles.get(shown[0][1], shown[0][0])}\" above.)"
                     self.html.append(f"<p class='caption'><a href='#{html.escape(shown[0][1])}'>{html.escape(note)}</a></p>")
                     kept += [note, ""]
                     continue
