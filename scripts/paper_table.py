@@ -108,13 +108,17 @@ def print_other_table(papers, key, runs, experiments, markdown):
     return 0
 
 
+def report_command(cmd):
+    import report
+    return report.command(cmd)  # under field_robot: the field_robot suite's command
+
+
 def print_error_table(papers, key, runs, labels, markdown):
     try:
         rows = C.pair_table(papers, key, runs, labels)
     except KeyError as e:
         print(f"error: {e.args[0]}", file=sys.stderr)
         return 2
-    a = argparse.Namespace(paper=key, markdown=markdown)
     head = ["row", "source"] + SHORT + ["line points / frame", "seeds"]
     lines, notes = [], []
     for p in rows:
@@ -124,7 +128,7 @@ def print_error_table(papers, key, runs, labels, markdown):
                          [f"{st[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] + [f"{st['line_points/mean']['mean']:.0f}", str(st["x_cm/mean"]["n"])])
         else:
             lines.append([p["label"], "not run"] + ["-"] * 9 + ["-", "0"])
-            notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {p['command']}")
+            notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {report_command(p['command'])}")
         for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario and configuration
             pst = peer["stats"]
             lines.append([p["label"], f"external: {peer['name']}"] + [f"{pst[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] +
@@ -134,7 +138,7 @@ def print_error_table(papers, key, runs, labels, markdown):
             if p["runs"]:
                 lines.append([p["label"], "ours/paper"] + [f"{st[f'{c}/{s}']['mean'] / v:.2f}" if v else "-"
                                                             for (c, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
-    if a.markdown:
+    if markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
         for l in lines:
@@ -145,7 +149,7 @@ def print_error_table(papers, key, runs, labels, markdown):
             print("  ".join(x.ljust(w[i]) if i < 2 else x.rjust(w[i]) for i, x in enumerate(l)))
     for n in notes:
         print(n)
-    print(f"\nunits: x, y in cm, th in rad; paper: {papers[a.paper]['source']}\n")
+    print(f"\nunits: x, y in cm, th in rad; paper: {papers[key]['source']}\n")
     return 0
 
 
