@@ -376,6 +376,29 @@ class FewSeeds(unittest.TestCase):
             self.assertIn("(n = 1: one seed, no interval)", (pathlib.Path(tmp) / "one" / "report.md").read_text())
 
 
+class ExternalPeers(unittest.TestCase):
+    def test_an_external_localizer_sits_beside_the_built_in_row_with_its_seeds(self):
+        # docs/protocol.md: a client's runs pair by the row's key with the client's name as localizer.
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            write_occlusion_sweep(tmp / "results" / "s", [0.0])
+            for seed, x in ((1, 4.0), (2, 5.0)):
+                write_run(tmp / "results" / "ext" / f"s{seed}", "tracking", "perl_client", seed, {}, robot(x))
+                summary = json.loads((tmp / "results" / "ext" / f"s{seed}" / "summary.json").read_text())
+                summary["localizer_type"] = "external"
+                (tmp / "results" / "ext" / f"s{seed}" / "summary.json").write_text(json.dumps(summary))
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(tmp / "results"), "-o", str(tmp / "rep"), "--history", "none"],
+                                 capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            md = (tmp / "rep" / "report.md").read_text()
+            self.assertIn("| 0 % | external: perl_client | 4.500 |", md)
+            # Two seeds: the 4 resamples have means 4, 4.5, 4.5, 5; the 2.5 % point lies 0.075 of the way from 4 to 4.5.
+            self.assertIn("| 0 % (external: perl_client) | 2 | mean 4.50 [4.04, 4.96]; median 4.50; seeds: s1\u00a04.00, s2\u00a05.00 |", md)
+            table = subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), str(tmp / "results"), "--paper", "002_table1_occlusion", "--rows", "0 %"],
+                                   capture_output=True, text=True).stdout
+            self.assertIn("external: perl_client", table)
+
+
 class Verdicts(unittest.TestCase):
     def test_claims_are_counted_apart_by_kind(self):
         ctx = C.Context(R.load_papers(), [], [])
