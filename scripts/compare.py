@@ -7,7 +7,10 @@ usage: compare.py A B [--markdown] [--alpha P] [--all-metrics]
 A and B are result folders (runs, sweeps, or folders holding them), e.g. the paper suite of two
 commits. Runs are grouped by scenario, localizer and effective configuration (config.json without
 the seed and the run's name): the same condition on both sides pairs BY KEY, whatever folder or
-position a run has. Per group and metric: mean over seeds of A and of B (n each), B - A, and
+position a run has. Conditions left over pair with their nearest counterpart (same scenario and
+localizer, fewest differing values; then the same scenario with another localizer, to compare
+two localizers), and every value that differs is named ("differs: /occlusion/fraction: 0.125 ->
+0.25"). The text output fits 100 columns; --markdown gives one wide table. Per group and metric: mean over seeds of A and of B (n each), B - A, and
 Welch's unequal-variance t-test over the seeds; "yes" where p < alpha (default 0.05), i.e. the
 difference exceeds the seed-to-seed spread. With fewer than two seeds on a side there is no spread
 to compare with, and the difference is shown alone ("n < 2"). Identical numbers give "same".
@@ -17,6 +20,7 @@ import argparse
 import json
 import pathlib
 import sys
+import textwrap
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import omniloc_results as R  # noqa: E402
@@ -48,17 +52,28 @@ def flatten(obj, prefix=""):
     return out
 
 
+def flat_config(key):
+    return flatten(json.loads(key[2]))
+
+
+def differing(fa, fb, skip_localizer=False):
+    """The JSON pointers whose values differ between two flattened configurations, all of them."""
+    ptrs = sorted(p for p in set(fa) | set(fb) if fa.get(p) != fb.get(p))
+    return [p for p in ptrs if not (skip_localizer and p.startswith("/localizer"))]
+
+
 def labels(keys):
-    """'scenario / localizer', plus the configuration values that tell apart conditions sharing both."""
+    """'scenario / localizer', plus EVERY configuration value that tells apart conditions sharing both
+    (no '...': two variants must never look identical)."""
     by = {}
     for k in keys:
         by.setdefault(k[:2], []).append(k)
     out = {}
     for sl, ks in by.items():
-        flat = {k: flatten(json.loads(k[2])) for k in ks}
+        flat = {k: flat_config(k) for k in ks}
         ptrs = sorted({p for f in flat.values() for p in f if len({f.get(p) for f in flat.values()}) > 1})
         for k in ks:
-            extra = ", ".join(f"{p}={flat[k].get(p, '-')}" for p in ptrs[:3]) + (" ..." if len(ptrs) > 3 else "")
+            extra = ", ".join(f"{p}={flat[k].get(p, 'absent')}" for p in ptrs)
             out[k] = f"{sl[0]} / {sl[1]}" + (f" / {extra}" if extra else "")
     return out
 
@@ -80,39 +95,106 @@ def verdict(w, a, b, alpha):
     return "yes" if w["p"] < alpha else "no"
 
 
-def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
+def mutual_nearest(left_a, left_b, same, skip_localizer=False):
+    """Pairs (ka, kb) of leftover groups for which same(ka, kb) holds and each is the other's unique
+    nearest (fewest differing configuration values): a variant finds its counterpart even when
+    every run of one side also differs in some value (e.g. a default a newer build added)."""
+    def nearest(k, pool, fk):
+        cands = [(len(differing(fk, flat_config(o), skip_localizer)), o) for o in pool if same(k, o)]
+        if not cands:
+            return None
+        cands.sort(key=lambda c: c[0])
+        return cands[0][1] if len(cands) == 1 or cands[0][0] < cands[1][0] else None
+    pairs = []
+    for ka in left_a:
+        kb = nearest(ka, left_b, flat_config(ka))
+        if kb is not None and nearest(kb, left_a, flat_config(kb)) == ka:
+            pairs.append((ka, kb))
+    return pairs
+
+
+def compare_pairs(runs_a, runs_b):
+    """The conditions of A and B paired BY KEY: [(ka, kb, differences)], then A's and B's unpaired
+    keys. First identical keys (scenario, localizer, configuration); then, among the rest, the
+    same scenario and localizer with the nearest configuration; then the same scenario with
+    another localizer (comparing two localizers on one scenario). differences: 'localizer: a -> b'
+    and every differing configuration value 'pointer: a -> b'."""
     ga, gb = groups(runs_a), groups(runs_b)
-    keys = sorted(set(ga) & set(gb))
-    # A condition whose configuration changed between the two sets still pairs by scenario and
-    # localizer when that is unambiguous on both sides, marked "config differs".
-    loose_a = {k[:2]: k for k in ga if k not in gb}
-    loose_b = {k[:2]: k for k in gb if k not in ga}
-    pairs = [(k, k, "") for k in keys]
-    for sl, ka in loose_a.items():
-        if sl in loose_b and sum(1 for k in ga if k[:2] == sl) == 1 and sum(1 for k in gb if k[:2] == sl) == 1:
-            pairs.append((ka, loose_b[sl], " (config differs)"))
-    names = labels(set(ga) | set(gb))
+    pairs = [(k, k) for k in sorted(set(ga) & set(gb))]
+    left_a, left_b = [k for k in sorted(ga) if k not in gb], [k for k in sorted(gb) if k not in ga]
+    for same, skip in ((lambda x, y: x[:2] == y[:2], False), (lambda x, y: x[0] == y[0], True)):
+        found = mutual_nearest(left_a, left_b, same, skip)
+        pairs += found
+        left_a = [k for k in left_a if k not in {p[0] for p in found}]
+        left_b = [k for k in left_b if k not in {p[1] for p in found}]
+    out = []
+    for ka, kb in sorted(pairs, key=lambda p: (p[0][0], p[0][1])):
+        diffs = [] if ka[1] == kb[1] else [f"localizer: {ka[1]} -> {kb[1]}"]
+        fa, fb = flat_config(ka), flat_config(kb)
+        diffs += [f"{p}: {fa.get(p, 'absent')} -> {fb.get(p, 'absent')}" for p in differing(fa, fb, skip_localizer=ka[1] != kb[1])]
+        out.append((ka, kb, diffs))
+    return out, left_a, left_b, ga, gb
+
+
+def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
+    """[header, rows]: one row per paired condition and metric, then the unpaired conditions."""
+    pairs, only_a, only_b, ga, gb = compare_pairs(runs_a, runs_b)
+    names = side_labels(ga, gb)
     header = ["scenario / localizer / differing configuration", "metric", "A mean", "n", "B mean", "n", "B - A", "p (Welch)", "exceeds spread"]
     rows = []
-    for ka, kb, note in sorted(pairs, key=lambda p: p[0][:2]):
-        label = names[ka] + note
-        for m in metrics:
-            a = [r.metric(m) for r in ga[ka]]
-            b = [r.metric(m) for r in gb[kb]]
-            a = [x for x in a if isinstance(x, (int, float))]
-            b = [x for x in b if isinstance(x, (int, float))]
-            if not a and not b:
-                continue
-            sa, sb, w = R.stats(a), R.stats(b), R.welch(a, b)
+    for ka, kb, diffs in pairs:
+        label = names[ka] + (f" (A vs B: {'; '.join(diffs)})" if diffs else "")
+        for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, metrics):
             rows.append([label, m, R.fnum(sa["mean"], 4), sa["n"], R.fnum(sb["mean"], 4), sb["n"],
-                         R.fnum(w["diff"], 4), R.fnum(w["p"], 3) if w["p"] is not None else "-", verdict(w, a, b, alpha)])
-    only_a = sorted(set(ga) - {p[0] for p in pairs})
-    only_b = sorted(set(gb) - {p[1] for p in pairs})
+                         R.fnum(w["diff"], 4), R.fnum(w["p"], 3) if w["p"] is not None else "-", v])
     for k in only_a:
         rows.append([names[k], "(only in A)", "", len(ga[k]), "", "", "", "", ""])
     for k in only_b:
         rows.append([names[k], "(only in B)", "", "", "", len(gb[k]), "", "", ""])
     return header, rows
+
+
+def side_labels(ga, gb):
+    """Labels made within each side (A's variants told apart among A's, B's among B's): what tells
+    A from B is listed separately, as the pair's differences."""
+    names = labels(set(gb))
+    names.update(labels(set(ga)))
+    return names
+
+
+def metric_rows(ra, rb, alpha, metrics):
+    for m in metrics:
+        a = [x for x in (r.metric(m) for r in ra) if isinstance(x, (int, float))]
+        b = [x for x in (r.metric(m) for r in rb) if isinstance(x, (int, float))]
+        if not a and not b:
+            continue
+        sa, sb, w = R.stats(a), R.stats(b), R.welch(a, b)
+        yield m, sa, sb, w, verdict(w, a, b, alpha)
+
+
+def print_text(runs_a, runs_b, alpha, width=100):
+    """Readable at `width` columns: a block per paired condition, its name and every difference on
+    lines of their own (wrapped, never cut), then the metrics in narrow columns."""
+    pairs, only_a, only_b, ga, gb = compare_pairs(runs_a, runs_b)
+    names = side_labels(ga, gb)
+    wrap = lambda text, indent: textwrap.fill(text, width, initial_indent=indent, subsequent_indent=indent + "    ")
+    head = ["metric", "A mean", "n", "B mean", "n", "B - A", "p", "exceeds"]
+    widths = [31, 11, 3, 11, 3, 11, 6, 8]
+    line = lambda cells: "  " + "  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+    for ka, kb, diffs in pairs:
+        print(wrap(names[ka], ""))
+        for d in diffs:
+            print(wrap("differs: " + d, "  "))
+        print(line(head))
+        for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, METRICS):
+            print(line([m, R.fnum(sa["mean"], 4), str(sa["n"]), R.fnum(sb["mean"], 4), str(sb["n"]), R.fnum(w["diff"], 4),
+                        R.fnum(w["p"], 3) if w["p"] is not None else "-", v]))
+        print()
+    for side, keys, g in (("A", only_a, ga), ("B", only_b, gb)):
+        for k in keys:
+            print(wrap(f"only in {side} ({len(g[k])} runs): {names[k]}", ""))
+    print()
+    print(textwrap.fill(EXPLANATION + " p: Welch's t-test over seeds.", width))
 
 
 def versions(runs):
@@ -144,20 +226,18 @@ def main():
         if not rs:
             print(f"compare: no runs (summary.json) under {name}", file=sys.stderr)
             return 2
-    header, rows = compare_rows(ra, rb, a.alpha)
     print(f"A: {a.a}: {len(ra)} runs, omniloc {versions(ra)}")
     print(f"B: {a.b}: {len(rb)} runs, omniloc {versions(rb)}")
     if a.markdown:
+        header, rows = compare_rows(ra, rb, a.alpha)
         print("| " + " | ".join(header) + " |")
         print("|" + "---|" * len(header))
         for r in rows:
             print("| " + " | ".join(str(c) for c in r) + " |")
+        print("\n" + EXPLANATION)
     else:
-        cells = [header] + [[str(c) for c in r] for r in rows]
-        w = [max(len(r[i]) for r in cells) for i in range(len(header))]
-        for r in cells:
-            print("  ".join(c.ljust(w[i]) if i < 2 else c.rjust(w[i]) for i, c in enumerate(r)))
-    print("\n" + EXPLANATION)
+        print()
+        print_text(ra, rb, a.alpha)
     return 0
 
 

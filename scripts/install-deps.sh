@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs every Debian package omniloc needs, only when something is missing.
+# Usage: scripts/install-deps.sh [--report-check]
 # OpenCV: we take the split -dev packages (core, imgproc, imgcodecs); they are ~10x smaller than
 # libopencv-dev but ship no CMake config, so CMakeLists.txt finds headers and libraries itself.
 set -euo pipefail
@@ -13,6 +14,11 @@ PKGS=(
   python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
 )
+# --report-check: also Debian's chromium, for the headless check of report.html
+# (scripts/check_report_html.py; .ci/run). Not needed to build, test or run the suite.
+if [ "${1:-}" = "--report-check" ]; then
+  PKGS+=(chromium)
+fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -167,30 +167,147 @@ def judge(value, rule, published=None):
     return "does not"
 
 
+# What a claim is about, so that the scorecard counts them apart: four timing claims that hold by a
+# factor of 100 on another CPU say nothing about accuracy. A claim may name its own "kind" in
+# papers.json; otherwise: a timing quantity makes it "timing", these ids "robustness", the rest
+# "accuracy".
+KINDS = ("accuracy", "robustness", "timing")
+ROBUSTNESS = {"occlusion_mild", "lighting_autoadjust", "kidnap_002", "kidnap_000", "entropy_peak"}
+
+# The other axes of a published error-table row: a claim stated on mean x is judged on mean y and
+# mean heading too, since the paper states them in the same row.
+AXES = [("x_cm/mean", "x"), ("y_cm/mean", "y"), ("theta_rad/mean", "heading")]
+
+
+def _has(q, key):
+    """Whether a quantity selector (or any of its parts) uses `key` ("row", "timing", "experiment")."""
+    if not isinstance(q, dict):
+        return False
+    if key in q:
+        return True
+    return any(_has(x, key) for x in (q.get("ratio") or q.get("fraction") or []))
+
+
+def claim_kind(c):
+    if c.get("kind") in KINDS:
+        return c["kind"]
+    qs = [c.get("ours")] + [ch.get("ours") for ch in c.get("checks", [])]
+    if any(_has(q, "timing") for q in qs):
+        return "timing"
+    return "robustness" if c["id"] in ROBUSTNESS else "accuracy"
+
+
+def uses_runs(c):
+    """Whether a claim is judged from runs (which have a noise profile) rather than experiments."""
+    qs = [c.get("ours")] + [ch.get("ours") for ch in c.get("checks", [])]
+    return any(_has(q, "row") or _has(q, "timing") for q in qs)
+
+
+def _published_cell(papers, row, metric):
+    """The paper's number of a published error-table row for one metric (None for our extra rows)."""
+    table, label = row
+    t = papers.get(table) or {}
+    values = (t.get("rows") or {}).get(label)
+    if not isinstance(values, list):
+        return None
+    keys = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
+    return values[keys.index(metric)] if metric in keys else None
+
+
+def _on_axis(q, metric):
+    """The selector q with its mean-x metric replaced by `metric` (None when q is not all mean-x rows)."""
+    if "row" in q:
+        return dict(q, metric=metric) if q.get("metric") == "x_cm/mean" else None
+    for k in ("ratio", "fraction"):
+        if k in q:
+            parts = [_on_axis(x, metric) for x in q[k]]
+            return None if None in parts else {k: parts}
+    return None
+
+
+def _published_value(papers, q):
+    """What the paper's own table gives for a selector (a row's cell or a ratio of cells)."""
+    if "row" in q:
+        return _published_cell(papers, q["row"], q["metric"])
+    for k in ("ratio", "fraction"):
+        if k in q:
+            a, b = (_published_value(papers, x) for x in q[k])
+            return a / b if a is not None and b else None
+    return None
+
+
+def axis_checks(papers, label, q, rule, published=None):
+    """A check stated on mean x of published rows, split into one check per axis (x, y, heading)
+    that the paper states. An axis is judged only where the paper's own numbers satisfy the rule
+    (else the claim is not the paper's for that axis, and a note says so). Returns (checks, notes)
+    or (None, None) when the selector is not of that form."""
+    if _on_axis(q, "y_cm/mean") is None:
+        return None, None
+    checks, notes = [], []
+    for metric, axis in AXES:
+        qa = _on_axis(q, metric)
+        pub = _published_value(papers, qa)
+        if pub is None:
+            return None, None
+        if rule["kind"] == "ratio_to_published":
+            checks.append({"label": f"{label}{axis}", "ours": qa, "rule": rule, "published": pub})
+            continue
+        if judge(pub, rule) != "holds":
+            notes.append(f"{axis} not judged: the paper's own value {R.fnum(pub, 2)} is outside the rule")
+            continue
+        checks.append({"label": f"{label}{axis}", "ours": qa, "rule": rule, "published": pub})
+    return checks, notes
+
+
+def _combine(verdicts):
+    if any(v == "not run" for v in verdicts):
+        return "not run"
+    if all(v == "holds" for v in verdicts):
+        return "holds"
+    if any(v in ("holds", "partly") for v in verdicts):
+        return "partly"
+    return "does not"
+
+
 def evaluate_claims(ctx):
-    """One dict per claim: id, paper, claim, ours (number or None), ours_text, published, ratio,
-    verdict, rule_text, checks (for claims made of several checks)."""
+    """One dict per claim: id, paper, kind, claim, ours (number or None), ours_text, published,
+    ratio, verdict, rule_text, checks (for claims judged on several checks or axes), notes."""
     out = []
     for c in ctx.papers.get("claims", []):
-        row = {"id": c["id"], "paper": c["paper"], "claim": c["claim"], "published": c.get("published"), "unit": c.get("unit", ""),
-               "rule_text": c.get("rule_text", ""), "checks": [], "ratio": None}
-        if "checks" in c:
+        row = {"id": c["id"], "paper": c["paper"], "kind": claim_kind(c), "claim": c["claim"], "published": c.get("published"),
+               "unit": c.get("unit", ""), "rule_text": c.get("rule_text", ""), "checks": [], "ratio": None, "notes": [],
+               "uses_runs": uses_runs(c)}
+        checks = [dict(ch) for ch in c.get("checks", [])]
+        if not checks and c.get("ours") is not None and c.get("rule"):
+            pub = c.get("published") if isinstance(c.get("published"), (int, float)) else None
+            split, notes = axis_checks(ctx.papers, "mean ", c["ours"], c["rule"], pub)
+            if split:
+                checks, row["notes"] = split, notes
+        elif checks:
+            split_checks = []
+            for ch in checks:
+                split, notes = axis_checks(ctx.papers, ch["label"] + ": ", ch["ours"], ch["rule"])
+                split_checks += split if split else [ch]
+                row["notes"] += [f"{ch['label']}: {n}" for n in (notes or [])]
+            checks = split_checks
+        if checks:
             verdicts = []
-            for ch in c["checks"]:
+            for ch in checks:
                 v, note = quantity(ch["ours"], ctx)
-                verdict = judge(v, ch["rule"])
+                pub = ch.get("published") if ch["rule"]["kind"] == "ratio_to_published" else None
+                verdict = judge(v, ch["rule"], pub)
                 verdicts.append(verdict)
-                row["checks"].append({"label": ch["label"], "ours": v, "note": note, "verdict": verdict})
-            if any(v == "not run" for v in verdicts):
-                row["verdict"] = "not run"
-            elif all(v == "holds" for v in verdicts):
-                row["verdict"] = "holds"
-            elif any(v in ("holds", "partly") for v in verdicts):
-                row["verdict"] = "partly"
-            else:
-                row["verdict"] = "does not"
+                ratio = v / pub if v is not None and pub else None
+                row["checks"].append({"label": ch["label"], "ours": v, "note": note, "verdict": verdict, "ratio": ratio,
+                                      "published": ch.get("published")})
+            row["verdict"] = _combine(verdicts)
             row["ours"] = None
-            row["ours_text"] = "; ".join(f"{ch['label']}: {R.fnum(ch['ours'], 2)} ({ch['verdict']})" for ch in row["checks"])
+            row["ours_text"] = "; ".join(f"{ch['label']}: {R.fnum(ch['ours'], 3)}" + (f" ({R.fnum(ch['ratio'], 2)}x the paper's)" if ch["ratio"] is not None else "")
+                                         + f" {ch['verdict']}" for ch in row["checks"])
+            if all(ch["ours"] is None for ch in row["checks"]):  # nothing measured: say why once, not per axis
+                row["ours_text"] = "; ".join(dict.fromkeys(ch["note"] for ch in row["checks"]))
+            ratios = [ch["ratio"] for ch in row["checks"] if ch["ratio"] is not None]
+            row["ratio"] = ratios[0] if len(ratios) == 1 else None
         else:
             v, note = quantity(c.get("ours"), ctx)
             row["ours"] = v
@@ -200,3 +317,23 @@ def evaluate_claims(ctx):
             row["verdict"] = judge(v, c.get("rule"), c.get("published") if isinstance(c.get("published"), (int, float)) else None)
         out.append(row)
     return out
+
+
+def totals(claims):
+    """{kind: {verdict: count}} over the claims, for the scorecard's summary and the terminal."""
+    out = {k: {} for k in KINDS}
+    for c in claims:
+        d = out.setdefault(c["kind"], {})
+        d[c["verdict"]] = d.get(c["verdict"], 0) + 1
+    return out
+
+
+def totals_text(t):
+    """'accuracy: 3 holds, 1 partly; robustness: ...' (kinds without claims left out)."""
+    order = ["holds", "partly", "does not", "not run", "n/a"]
+    parts = []
+    for kind in KINDS:
+        d = t.get(kind) or {}
+        if d:
+            parts.append(f"{kind}: " + ", ".join(f"{d[v]} {v}" for v in order if d.get(v)))
+    return "; ".join(parts)

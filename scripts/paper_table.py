@@ -1,19 +1,26 @@
 #!/usr/bin/env python3
 """Prints omniloc results in a paper's table layout, each published row beside the runs that reproduce it.
 
-usage: paper_table.py RESULTS... --paper KEY [--rows LABEL ...] [--markdown]
+usage: paper_table.py RESULTS... --paper KEY [--rows LABEL ...] [--profile NAME] [--markdown]
 
 RESULTS are run or sweep folders, or folders holding them (e.g. results/sweeps/paper_suite). KEY
-names an error table of results/reference/papers.json: 002_table1_occlusion, 002_table2_lighting
-or 000_tracking. Rows pair BY KEY: each published row in papers.json names its scenario,
+names any published table of results/reference/papers.json (`--paper list` lists them, `--paper
+all` prints every one): the error tables 002_table1_occlusion, 002_table2_lighting and
+000_tracking in the papers' nine-column layout; the kidnap, timing and experiment tables as the
+report shows them. Rows pair BY KEY: each published row in papers.json names its scenario,
 localizer and configuration values ("reproduced_by"), and our runs are found by those, never by
-their position in a sweep. --rows keeps only the named rows (published or extra). A row without
-runs says "not run" and prints the command that runs it. Ours: mean over seeds (n shown); runs with
-kidnaps or covers use their tracking phase. Only the published numbers come from papers.json.
-External localizers (docs/protocol.md) found in RESULTS on a row's scenario and configuration are
-printed beside it, named "external: <the client's name>".
+their position in a sweep. --rows keeps only the named rows (published or extra) of an error table.
+A row without runs says "not run" and prints the command that runs it. Ours: mean over seeds (n
+shown); runs with kidnaps or covers use their tracking phase. Only the published numbers come from
+papers.json. External localizers (docs/protocol.md) found in RESULTS on a row's scenario and
+configuration are printed beside it, named "external: <the client's name>".
+
+Noise profile: rows pair runs of one profile. --profile NAME picks it (robot, field_robot, ...);
+without it the profile is read from the runs: robot where there are robot runs, else the one
+profile the runs have (e.g. the field_robot sweep), and the table says which.
 """
 import argparse
+import json
 import pathlib
 import sys
 
@@ -29,22 +36,91 @@ def main():
     ap.add_argument("results", nargs="+")
     ap.add_argument("--paper", required=True, help="a table key of results/reference/papers.json")
     ap.add_argument("--rows", nargs="+", metavar="LABEL", help="only these rows (published or extra row labels)")
+    ap.add_argument("--profile", help="noise profile of the runs to pair (default: read from the runs)")
     ap.add_argument("--markdown", action="store_true")
     ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (said in the output)")
     a = ap.parse_args()
     papers = R.load_papers()
-    tables = [k for k, v in papers.items() if isinstance(v, dict) and "columns" in v and "reproduced_by" in v and isinstance(v.get("rows"), dict)]
-    if a.paper not in tables:
-        print(f"error: no error table \"{a.paper}\" in papers.json; tables: {', '.join(tables)}", file=sys.stderr)
+    tables = error_tables(papers)
+    published = [k for k in papers if k not in ("comment", "claims")]
+    if a.paper == "list":
+        print("\n".join(published))
+        return 0
+    if a.paper not in published + ["all"]:
+        print(f"error: no published table \"{a.paper}\" in papers.json; tables: {', '.join(published)}", file=sys.stderr)
         return 2
     try:
-        runs, _, _ = R.discover(a.results, a.accept_incomplete)
-        rows = C.pair_table(papers, a.paper, runs, a.rows)
-    except KeyError as e:
-        print(f"error: {e.args[0]}", file=sys.stderr)
-        return 2
+        runs, _, experiments = R.discover(a.results, a.accept_incomplete)
     except SystemExit as e:
         print(f"error: cannot read results: {e}", file=sys.stderr)
+        return 2
+    profile, how = choose_profile(runs, a.profile)
+    if profile is None:
+        print(f"error: {how}", file=sys.stderr)
+        return 2
+    with R.pairing_profile(profile):
+        for key in (published if a.paper == "all" else [a.paper]):
+            if key in tables:
+                code = print_error_table(papers, key, runs, a.rows, a.markdown)
+            else:
+                code = print_other_table(papers, key, runs, experiments, a.markdown)
+            if code:
+                return code
+    print(f"noise profile: {profile} ({how})")
+    for d in R.INCOMPLETE:
+        print(f"note: {d} is an incomplete sweep (--accept-incomplete): only its finished runs are in these tables")
+    return 0
+
+
+def error_tables(papers):
+    return [k for k, v in papers.items() if isinstance(v, dict) and "columns" in v and "reproduced_by" in v and isinstance(v.get("rows"), dict)
+            and len(v.get("columns", [])) == len(R.TABLE_KEYS)]
+
+
+def profile_of(run):
+    found, prof = R.pointer(run.config, "/noise_profile")
+    return prof if found else R.SCENARIO_DEFAULT_PROFILE
+
+
+def choose_profile(runs, wanted):
+    """(profile, how it was chosen) or (None, error): robot where the runs have it, else their one profile."""
+    have = sorted({profile_of(r) for r in runs})
+    if wanted:
+        return wanted, "--profile" + ("" if wanted in have else f"; no runs of it here (the runs have: {', '.join(have) or 'none'})")
+    if not have or R.SCENARIO_DEFAULT_PROFILE in have:
+        return R.SCENARIO_DEFAULT_PROFILE, "the default" + (f"; the runs also have {', '.join(p for p in have if p != 'robot')}: --profile picks one"
+                                                           if len(have) > 1 else "")
+    if len(have) == 1:
+        return have[0], "read from the runs"
+    return None, f"the runs have several noise profiles ({', '.join(have)}) and none is robot: name one with --profile"
+
+
+def print_other_table(papers, key, runs, experiments, markdown):
+    """A kidnap, timing or experiment table, as the report shows it (scripts/report.py's section
+    functions, written as text): one implementation of each table."""
+    import report
+    ctx = C.Context(papers, runs, experiments)
+    anchor = "kidnapping" if key in ("002_kidnapping", "000_kidnapping") else key
+    rep = report.TextReport(only=anchor, markdown=markdown)
+    report.published_tables(rep, papers, ctx)
+    if not rep.printed:  # a published record without a table of its own (e.g. real-robot numbers)
+        t = papers[key]
+        print(f"{key}: " + (json.dumps(t) if not isinstance(t, dict) else "; ".join(f"{k}: {v}" for k, v in t.items() if k != "reproduced_by")))
+        print("not reproduced by a run or an experiment (see the report's scorecard)")
+    print()
+    return 0
+
+
+def report_command(cmd):
+    import report
+    return report.command(cmd)  # under field_robot: the field_robot suite's command
+
+
+def print_error_table(papers, key, runs, labels, markdown):
+    try:
+        rows = C.pair_table(papers, key, runs, labels)
+    except KeyError as e:
+        print(f"error: {e.args[0]}", file=sys.stderr)
         return 2
     head = ["row", "source"] + SHORT + ["line points / frame", "seeds"]
     lines, notes = [], []
@@ -55,7 +131,7 @@ def main():
                          [f"{st[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] + [f"{st['line_points/mean']['mean']:.0f}", str(st["x_cm/mean"]["n"])])
         else:
             lines.append([p["label"], "not run"] + ["-"] * 9 + ["-", "0"])
-            notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {p['command']}")
+            notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {report_command(p['command'])}")
         for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario and configuration
             pst = peer["stats"]
             lines.append([p["label"], f"external: {peer['name']}"] + [f"{pst[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] +
@@ -65,7 +141,7 @@ def main():
             if p["runs"]:
                 lines.append([p["label"], "ours/paper"] + [f"{st[f'{c}/{s}']['mean'] / v:.2f}" if v else "-"
                                                             for (c, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
-    if a.markdown:
+    if markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
         for l in lines:
@@ -76,9 +152,7 @@ def main():
             print("  ".join(x.ljust(w[i]) if i < 2 else x.rjust(w[i]) for i, x in enumerate(l)))
     for n in notes:
         print(n)
-    print(f"\nunits: x, y in cm, th in rad; paper: {papers[a.paper]['source']}")
-    for d in R.INCOMPLETE:
-        print(f"note: {d} is an incomplete sweep (--accept-incomplete): only its finished runs are in this table")
+    print(f"\nunits: x, y in cm, th in rad; paper: {papers[key]['source']}\n")
     return 0
 
 

@@ -5,22 +5,28 @@ usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N] [--baseline RES
 
 RESULTS are folders: a run (summary.json), a sweep (aggregate.json with runs/ inside), an
 experiment (PNG / JSON / markdown files written by `omniloc experiment`), or any folder holding
-such folders (searched recursively). The report shows, in this order:
-  - provenance: which omniloc builds (git describe, compiler, build type) made the results;
+such folders (searched recursively). The report is laid out for a reader with ten minutes
+(issue 30; docs/results.md), in this order:
   - the reproduction scorecard: every claim of results/reference/papers.json with our figure, the
-    paper's, the ratio and the verdict computed by the rule written next to the claim;
+    paper's, the ratio and the verdict computed by the rule written next to the claim, counted
+    apart by kind (accuracy / robustness / timing), judged on every axis a published row states,
+    with the field_robot runs judged by the same rules in their own column; then the contents;
+  - provenance: which omniloc builds (git describe, compiler, build type) made the results, when,
+    and the machine (CPU model, cores);
   - every published table beside the runs that reproduce it, paired BY KEY (scenario, localizer,
     configuration values; scripts/omniloc_results.py), never by position; a row whose runs are
-    missing says "not run" and prints the command that runs it;
+    missing says "not run" and prints the command that runs it; below each, every seed beside the
+    mean (bootstrap intervals, n = 1 marked), a strip plot of the seeds, and each outlying seed
+    plotted with its cause read from its frames.csv and events.jsonl;
   - with --baseline: our metrics against another result set (e.g. another commit), per metric
     with the difference and Welch's t-test over seeds (scripts/compare.py);
-  - every sweep's aggregate and every run's error table (headings carry the swept parameters,
-    in the aggregate's order), trajectory plots over the field, position and heading error over
-    time with the events marked, error CDFs, timing per stage;
-  - every experiment's tables (as HTML tables) and pictures;
-  - with --history DIR (default results/history when it exists): instruction counts
-    (scripts/icount.sh, icount.jsonl) and benchmark wall times (scripts/bench.sh, bench.jsonl)
-    per workload over the commits that were measured.
+  - every sweep's aggregate and per-seed table, each run's table and plots (collapsed), error
+    CDFs, timing per stage;
+  - every experiment's pictures and notes (tables a section above shows are not repeated);
+  - on a page of its own (history.html, linked), for developers: instruction counts and benchmark
+    wall times per workload over the commits (--history DIR, default results/history).
+Pictures are embedded, compressed (palette PNG, JPEG for camera frames) so that report.html stays
+under 3 MB; no absolute path reaches the report (Report.clean).
 Everything except the published numbers is read from the result files. Needs Python 3 and
 Debian's python3-matplotlib (no PyPI).
 """
@@ -32,8 +38,11 @@ import math
 import os
 import pathlib
 import platform
+import re
 import statistics
 import sys
+import tempfile
+import time
 
 import matplotlib
 
@@ -50,165 +59,617 @@ VERDICT_CLASS = {"holds": "ok", "partly": "partly", "does not": "no", "not run":
 fnum = R.fnum
 
 
+# A cell is a number (right-aligned) only when the WHOLE cell is one: a number with an optional
+# unit, an interval "[lo, hi]", an "(n=3 ...)" note or "a / b" counts. Claim text that starts with
+# a number ("50 % occlusion degrades ...") stays text (left-aligned).
+NUMERIC_CELL = re.compile(r"^[-+]?((0|[1-9]\d*)(\.\d*)?|\.\d+)(e[-+]?\d+)?( ?(%|cm|mm|m|ms|s|rad|deg|x|ns))?"
+                          r"( \[[^\]]*\])?( \([^)]*\))?( / [-+]?\d+(\.\d+)?)?$")
+
+
 def numeric_class(cell):
-    """Numbers right-aligned, text left-aligned."""
-    try:
-        float(str(cell).split(" ")[0])
-        return " class='num'"
-    except ValueError:
-        return ""
+    """Numbers right-aligned, text left-aligned (see NUMERIC_CELL)."""
+    return " class='num'" if NUMERIC_CELL.match(str(cell).strip()) else ""
+
+
+def inline_markdown(text):
+    """HTML of one line of markdown: `code`, **bold** and *italic*; everything else escaped. The
+    report's own text and the experiments' markdown use these three, and a reader must never see
+    the raw markers in the HTML."""
+    out, pos = [], 0
+    for m in re.finditer(r"`([^`]+)`|\*\*([^*]+)\*\*|(?<![\w*])\*([^*\s][^*]*?)\*(?![\w*])", text):
+        out.append(html.escape(text[pos:m.start()]))
+        if m.group(1) is not None:
+            out.append(f"<code>{html.escape(m.group(1))}</code>")
+        elif m.group(2) is not None:
+            out.append(f"<b>{html.escape(m.group(2))}</b>")
+        else:
+            out.append(f"<i>{html.escape(m.group(3))}</i>")
+        pos = m.end()
+    out.append(html.escape(text[pos:]))
+    return "".join(out)
+
+
+def slug(text):
+    return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:60] or "section"
+
+
+TOC_MARK = "<!--toc-->"
+# The part before a repository folder of an absolute path (/any/checkout/scenarios/x.json -> scenarios/x.json).
+REPO_PATH = re.compile(r"(?<![\w.~-])/(?:[\w.+-]+/)+?(?=(?:scenarios|results|build|docs|scripts|data|experiments|tests)/)")
 
 
 class Report:
-    def __init__(self, out, title):
+    """report.md and report.html built side by side. Sections are functions that call heading /
+    para / table / figure; a heading of level 2 becomes an entry of the table of contents, which
+    write() puts where mark_toc() was called (after the scorecard)."""
+
+    def __init__(self, out, title, page="report"):
         self.out = pathlib.Path(out)
+        self.page = page
         (self.out / "img").mkdir(parents=True, exist_ok=True)
-        for old in (self.out / "img").glob("*.png"):  # pictures of an earlier report in the same folder
+        for old in (self.out / "img").glob(f"{page}_*"):  # pictures of an earlier report in the same folder
             old.unlink()
         self.md = [f"# {title}", ""]
         self.html = []
+        self.toc = []
         self.n_img = 0
         self.title = title
+        self.anchors = set()
+        self.titles = {}
+        self.plotted = set()
+        # Absolute paths never reach the report (it is shared): every folder the report could name
+        # is shown relative to the working folder, or by its last two parts when outside it.
+        self.roots = sorted({str(p) for p in (pathlib.Path.cwd(), R.ROOT, pathlib.Path.home(), pathlib.Path(tempfile.gettempdir()),
+                                              self.out.resolve())}, key=len, reverse=True)
+
+    def add_root(self, path):
+        p = str(pathlib.Path(path).resolve())
+        self.roots = sorted(set(self.roots) | {p}, key=len, reverse=True)
+
+    def clean(self, text):
+        """text with every absolute path under a known root made relative (see __init__)."""
+        text = str(text)
+        if "/" not in text:
+            return text
+        cwd = pathlib.Path.cwd()
+
+        def rel(m):
+            p = pathlib.Path(m.group(0))
+            try:
+                return p.relative_to(cwd).as_posix() or "."
+            except ValueError:
+                return "/".join(p.parts[-2:]) if len(p.parts) > 2 else p.name
+        for root in self.roots:
+            if root != "/" and root in text:
+                # The root as a whole folder name: /root must not eat the start of /rootfs.
+                text = re.sub(re.escape(root) + r"(?![\w.-])(/[^\s'\"<>,;:()\[\]]*)?", rel, text)
+        # A path of another checkout (an experiment records the description file it read, with the
+        # folder omniloc was built in): from the repository's own folder on.
+        return REPO_PATH.sub("", text)
 
     def heading(self, text, level=2, anchor=None):
+        text = self.clean(text)
+        anchor = anchor or slug(text)
+        while anchor in self.anchors:  # unique ids: two runs can share a title
+            anchor += "-"
+        self.anchors.add(anchor)
+        self.titles[anchor] = text
+        if level == 2:
+            self.toc.append((anchor, text))
         self.md += ["#" * level + " " + text, ""]
-        a = f' id="{html.escape(anchor)}"' if anchor else ""
-        self.html.append(f"<h{level}{a}>{html.escape(text)}</h{level}>")
+        self.html.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(text)}</h{level}>')
+        return anchor
 
     def para(self, text, cls=None):
+        text = self.clean(text)
         self.md += [text, ""]
         c = f' class="{cls}"' if cls else ""
-        self.html.append(f"<p{c}>{html.escape(text)}</p>")
+        self.html.append(f"<p{c}>{inline_markdown(text)}</p>")
+
+    def raw_html(self, fragment, md=None):
+        self.html.append(fragment)
+        if md:
+            self.md += [md, ""]
+
+    def details(self, summary):
+        """Opens a collapsed block (HTML <details>); end_details() closes it. report.md keeps it flat."""
+        self.html.append(f"<details><summary>{inline_markdown(self.clean(summary))}</summary>")
+
+    def end_details(self):
+        self.html.append("</details>")
+
+    def mark_toc(self):
+        self.html.append(TOC_MARK)
 
     def table(self, header, rows, caption=None, row_classes=None):
-        """rows: lists of cells; row_classes: one CSS class per row (e.g. "paper" for published rows)."""
+        """rows: lists of cells; row_classes: one CSS class per row (e.g. "paper" for published rows).
+        A cell that is a verdict (holds, partly, ...) is coloured by itself."""
         if caption:
             self.para(caption, "caption")
+        header = [self.clean(c) for c in header]
+        rows = [[self.clean(c) for c in r] for r in rows]
         self.md.append("| " + " | ".join(header) + " |")
-        self.md.append("|" + "|".join("---" for _ in header) + "|")
+        # The first column labels the row (even "50 %"): left; the others by their cells.
+        self.md.append("|" + "|".join("---:" if i and rows and numeric_class(rows[0][i]) else "---" for i in range(len(header))) + "|")
         for k, r in enumerate(rows):
-            cells = [str(c) for c in r]
+            cells = [str(c).replace("|", "\\|") for c in r]
             if row_classes and row_classes[k] == "paper":
                 cells = [f"*{c}*" if c not in ("", "-") else c for c in cells]
             self.md.append("| " + " | ".join(cells) + " |")
         self.md.append("")
-        h = "<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(str(c))}</th>" for c in header) + "</tr>"
+        h = "<div class='scroll'><table><tr>" + "".join(f"<th>{inline_markdown(str(c))}</th>" for c in header) + "</tr>"
         for k, r in enumerate(rows):
             cls = row_classes[k] if row_classes and row_classes[k] else ""
-            h += (f"<tr class='{cls}'>" if cls else "<tr>") + "".join(f"<td{numeric_class(c)}>{html.escape(str(c))}</td>" for c in r) + "</tr>"
+            h += (f"<tr class='{cls}'>" if cls else "<tr>")
+            for i, c in enumerate(r):
+                v = VERDICT_CLASS.get(str(c))
+                h += f"<td class='v-{v}'>" if v else f"<td{numeric_class(c) if i else ''}>"
+                h += inline_markdown(str(c)) + "</td>"
+            h += "</tr>"
         self.html.append(h + "</table></div>")
 
-    def markdown(self, text):
-        """An experiment's markdown: headings, paragraphs and pipe tables as real HTML."""
-        self.md += [text, ""]
+    def markdown(self, text, skip=()):
+        """An experiment's markdown: headings, paragraphs and pipe tables as real HTML. skip: pairs
+        (heading text, anchor): a table under a heading containing that text is left out, with a
+        link to the section that shows it from the experiment's JSON (one copy of each table)."""
+        text = self.clean(text)
         lines = text.splitlines()
-        i, para = 0, []
+        i, para, kept = 0, [], []
+        current = ""
 
         def flush():
             if para:
-                self.html.append("<p>" + html.escape(" ".join(para)) + "</p>")
+                self.html.append("<p>" + inline_markdown(" ".join(para)) + "</p>")
                 para.clear()
         while i < len(lines):
             ln = lines[i].rstrip()
             if ln.startswith("#"):
+                current = ln
                 flush()
                 level = min(6, len(ln) - len(ln.lstrip("#")) + 2)
-                self.html.append(f"<h{level}>{html.escape(ln.lstrip('#').strip())}</h{level}>")
+                self.html.append(f"<h{level}>{inline_markdown(ln.lstrip('#').strip())}</h{level}>")
+                kept.append("#" * level + " " + ln.lstrip("#").strip())  # below the report's own sections, as in the HTML
             elif ln.startswith("|"):
                 flush()
-                rows = []
+                rows, block = [], []
                 while i < len(lines) and lines[i].strip().startswith("|"):
+                    block.append(lines[i])
                     cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
                     if not all(set(c) <= set("-: ") for c in cells):
                         rows.append(cells)
                     i += 1
+                shown = [(h, a) for h, a in skip if h in current]
+                if shown:
+                    note = f"(This table is shown once, in the section \"{self.titles.get(shown[0][1], shown[0][0])}\" above.)"
+                    self.html.append(f"<p class='caption'><a href='#{html.escape(shown[0][1])}'>{html.escape(note)}</a></p>")
+                    kept += [note, ""]
+                    continue
+                kept += block
                 if rows:
-                    h = "<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(c.replace('**', ''))}</th>" for c in rows[0]) + "</tr>"
+                    h = "<div class='scroll'><table><tr>" + "".join(f"<th>{inline_markdown(c)}</th>" for c in rows[0]) + "</tr>"
                     for r in rows[1:]:
-                        h += "<tr>" + "".join(f"<td>{html.escape(c.replace('**', ''))}</td>" for c in r) + "</tr>"
+                        h += "<tr>" + "".join(f"<td{numeric_class(c)}>{inline_markdown(c)}</td>" for c in r) + "</tr>"
                     self.html.append(h + "</table></div>")
                 continue
             elif not ln.strip():
                 flush()
+                kept.append("")
             else:
-                para.append(ln.replace("**", ""))
+                para.append(ln)
+                kept.append(ln)
             i += 1
         flush()
+        self.md += kept + [""]
 
-    def figure(self, fig, name, caption):
+    def figure(self, fig, name, caption, dpi=80):
         self.n_img += 1
-        path = self.out / "img" / f"{self.n_img:03d}_{name}.png"
-        fig.savefig(path, dpi=90, bbox_inches="tight")
+        path = self.out / "img" / f"{self.page}_{self.n_img:03d}_{name}.png"
+        fig.savefig(path, dpi=dpi, bbox_inches="tight")
         plt.close(fig)
-        self.image(path, caption)
+        self._embed(compress_png(path), caption)
 
     def image(self, path, caption):
+        """A picture an experiment wrote: copied next to the report, compressed, embedded."""
         path = pathlib.Path(path)
-        if path.parent != self.out / "img":
-            self.n_img += 1
-            dst = self.out / "img" / f"{self.n_img:03d}_{path.name}"
-            dst.write_bytes(path.read_bytes())
-            path = dst
+        self.n_img += 1
+        dst = self.out / "img" / f"{self.page}_{self.n_img:03d}_{path.name}"
+        dst.write_bytes(path.read_bytes())
+        self._embed(compress_png(dst), caption)
+
+    def _embed(self, path, caption):
+        caption = self.clean(caption)
         rel = path.relative_to(self.out)
         self.md += [f"![{caption}]({rel.as_posix()})", "", f"*{caption}*", ""]
         b64 = base64.b64encode(path.read_bytes()).decode()
-        self.html.append(f'<figure><img src="data:image/png;base64,{b64}" alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}</figcaption></figure>')
+        mime = "image/jpeg" if path.suffix == ".jpg" else "image/png"
+        self.html.append(f'<figure><img src="data:{mime};base64,{b64}" alt="{html.escape(caption)}"><figcaption>{inline_markdown(caption)}</figcaption></figure>')
+
+    def toc_html(self):
+        items = "".join(f'<li><a href="#{html.escape(a)}">{html.escape(t)}</a></li>' for a, t in self.toc)
+        return f'<nav id="contents"><h2>Contents</h2><ol>{items}</ol></nav>'
 
     def write(self):
-        tmp = self.out / "report.md.tmp"
-        tmp.write_text("\n".join(self.md) + "\n")
-        tmp.replace(self.out / "report.md")
+        md = list(self.md)
+        toc_md = ["## Contents", ""] + [f"{k + 1}. [{t}](#{a})" for k, (a, t) in enumerate(self.toc)] + [""]
+        if "<!--toc-->" in md:
+            k = md.index("<!--toc-->")
+            md[k:k + 1] = toc_md
+        tmp = self.out / f"{self.page}.md.tmp"
+        tmp.write_text("\n".join(md) + "\n")
+        tmp.replace(self.out / f"{self.page}.md")
         style = ("body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;color:#222}"
                  ".scroll{overflow-x:auto}table{border-collapse:collapse;margin:0.5em 0 1.2em;font-size:13px}"
-                 "td,th{border:1px solid #bbb;padding:3px 7px;text-align:left;vertical-align:top}td.num{text-align:right}"
+                 "td,th{border:1px solid #bbb;padding:3px 7px;text-align:left;vertical-align:top}td.num{text-align:right;white-space:nowrap}"
                  "th{background:#eee}tr.paper td{background:#fff6dc;font-style:italic}tr.ratio td{color:#555;font-size:12px}"
-                 "tr.missing td{color:#999}tr.ok td:nth-last-child(2){background:#d8f5d8}tr.partly td:nth-last-child(2){background:#fff0b3}"
-                 "tr.no td:nth-last-child(2){background:#f8d0d0}tr.notrun td:nth-last-child(2){background:#e8e8e8}"
+                 "tr.missing td{color:#999}td.v-ok{background:#d8f5d8}td.v-partly{background:#fff0b3}"
+                 "td.v-no{background:#f8d0d0}td.v-notrun{background:#e8e8e8}tr.outlier td{background:#fde2e2}"
                  "figure{margin:1em 0}img{max-width:100%}p.caption{font-size:13px;color:#444;margin-bottom:0.2em}"
-                 "figcaption{font-size:13px;color:#555}h2{border-bottom:1px solid #ccc;padding-top:0.6em}code{background:#f3f3f3}")
+                 "figcaption{font-size:13px;color:#555}h2{border-bottom:1px solid #ccc;padding-top:0.6em}code{background:#f3f3f3}"
+                 "details{margin:0.4em 0 0.8em;border-left:3px solid #ddd;padding-left:0.7em}summary{cursor:pointer;font-weight:bold}"
+                 "p.totals{font-size:15px}nav#contents ol{columns:2;font-size:14px}")
+        body = "\n".join(self.html).replace(TOC_MARK, self.toc_html() if self.toc else "")
         doc = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(self.title)}</title><style>{style}</style></head>"
-               f"<body><h1>{html.escape(self.title)}</h1>" + "\n".join(self.html) + "</body></html>\n")
-        tmp = self.out / "report.html.tmp"
+               f"<body><h1>{html.escape(self.title)}</h1>" + body + "</body></html>\n")
+        tmp = self.out / f"{self.page}.html.tmp"
         tmp.write_text(doc)
-        tmp.replace(self.out / "report.html")
+        tmp.replace(self.out / f"{self.page}.html")
+
+
+class TextReport:
+    """The Report interface written to the terminal (scripts/paper_table.py): tables aligned (or
+    as markdown), figures left out. With only=ANCHOR just the section of that heading anchor."""
+
+    def __init__(self, only=None, markdown=False):
+        self.only, self.markdown_tables, self.on, self.printed = only, markdown, only is None, False
+        self.plotted, self.n_img = set(), 0
+
+    def clean(self, text):
+        return str(text)
+
+    def heading(self, text, level=2, anchor=None):
+        anchor = anchor or slug(text)
+        if self.only is not None:
+            self.on = anchor == self.only
+        if self.on:
+            print(("#" * level + " " if self.markdown_tables else "== ") + text + "\n")
+            self.printed = True
+        return anchor
+
+    def para(self, text, cls=None):
+        if self.on:
+            print(text + "\n")
+
+    def table(self, header, rows, caption=None, row_classes=None):
+        if not self.on:
+            return
+        if caption:
+            print(caption)
+        cells = [[str(c) for c in header]] + [[str(c) for c in r] for r in rows]
+        if self.markdown_tables:
+            for k, r in enumerate(cells):
+                print("| " + " | ".join(r) + " |")
+                if k == 0:
+                    print("|" + "---|" * len(r))
+        else:
+            w = [max(len(r[i]) for r in cells) for i in range(len(header))]
+            for r in cells:
+                print("  ".join(c.rjust(w[i]) if i and numeric_class(c) else c.ljust(w[i]) for i, c in enumerate(r)).rstrip())
+        print()
+
+    def figure(self, fig, name, caption, dpi=80):
+        plt.close(fig)
+
+    def image(self, path, caption):
+        pass
+
+    def markdown(self, text, skip=()):
+        if self.on:
+            print(text)
+
+    def details(self, summary):
+        pass
+
+    def end_details(self):
+        pass
+
+    def mark_toc(self):
+        pass
+
+    def raw_html(self, fragment, md=None):
+        pass
+
+
+def compress_png(path):
+    """Re-encodes a picture so that report.html, which embeds every one, stays under 3 MB without
+    leaving one out: plots (few colours) as an optimised 256-colour palette PNG; camera frames and
+    other photographic pictures, which stay large as a palette PNG, as JPEG (quality 85). Keeps the
+    original where that is smaller. Returns the path written (the suffix may change to .jpg).
+    Without PIL (Debian's python3-pil, a dependency of python3-matplotlib) nothing changes."""
+    try:
+        from PIL import Image
+    except ImportError:
+        return path
+    import io
+    with Image.open(path) as im:
+        im.load()
+    has_alpha = im.mode in ("RGBA", "LA") or (im.mode == "P" and "transparency" in im.info)
+    src = im.convert("RGBA") if has_alpha else im.convert("RGB")
+    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if has_alpha else src.quantize(colors=256)
+    buf = io.BytesIO()
+    q.save(buf, format="PNG", optimize=True)
+    best, data = path.stat().st_size, None
+    if buf.tell() < best:
+        best, data = buf.tell(), buf.getvalue()
+    if best > 120_000 and not has_alpha:  # still large: a photograph-like picture
+        jbuf = io.BytesIO()
+        src.save(jbuf, format="JPEG", quality=85, optimize=True)
+        if jbuf.tell() < best / 2:
+            path.unlink()
+            path = path.with_suffix(".jpg")
+            path.write_bytes(jbuf.getvalue())
+            return path
+    if data is not None:
+        path.write_bytes(data)
+    return path
 
 
 # ---- provenance ---------------------------------------------------------------------------
 
+def cpu_model():
+    """The CPU model of this machine (from /proc/cpuinfo; the platform's name elsewhere)."""
+    try:
+        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def machine_text():
+    return f"{cpu_model()}, {os.cpu_count()} cores, {platform.system()} {platform.machine()}"
+
+
 def provenance(rep, runs, sweeps):
+    """Which builds made the results, on what, when. summary.json's "omniloc" block names the build
+    (version, compiler, build type) and, where the build records them, the machine (cpu, cores) and
+    date; where it does not, the machine is the one that made this report (scripts/run.sh makes both
+    on the same machine) and the date is the run files' modification time."""
     versions = {}
     for r in runs:
         o = r.summary.get("omniloc") or {}
-        k = (o.get("version", "unrecorded"), o.get("compiler", "-"), o.get("build_type", "-"))
-        versions[k] = versions.get(k, 0) + 1
+        when = o.get("date") or time.strftime("%Y-%m-%d", time.gmtime((r.folder / "summary.json").stat().st_mtime))
+        k = (o.get("version", "unrecorded"), o.get("compiler", "-"), o.get("build_type", "-"),
+             f"{o['cpu']}, {o.get('cores', '?')} cores" if o.get("cpu") else "this report's machine (below)")
+        d = versions.setdefault(k, {"n": 0, "dates": set()})
+        d["n"] += 1
+        d["dates"].add(when)
     rep.heading("Provenance", 2, "provenance")
-    rows = [[v, c, b, n] for (v, c, b), n in sorted(versions.items())]
-    rep.table(["omniloc version (git describe)", "compiler", "build type", "runs"], rows,
-              f"Builds that made these results; machine of this report: {platform.node()}, {os.cpu_count()} cores, {platform.platform()}.")
+    rows = [[v, c, b, m, " to ".join(sorted({min(d["dates"]), max(d["dates"])})), d["n"]] for (v, c, b, m), d in sorted(versions.items())]
+    rep.table(["omniloc version (git describe)", "compiler", "build type", "machine", "runs dated (UTC)", "runs"], rows,
+              f"Builds that made these results. This report: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} on {machine_text()}.")
     if len(versions) > 1:
         rep.para("Warning: the results come from more than one build; compare like with like (scripts/compare.py).")
 
 
 # ---- scorecard and published tables ----------------------------------------------------------
 
+KIND_TEXT = {"accuracy": "Accuracy", "robustness": "Robustness",
+             "timing": "Timing (indicative: the papers' 1.66 GHz CPU against ours; not evidence of accuracy)"}
+
+
+def field_robot_runs(runs):
+    return [r for r in runs if profile_of(r) == "field_robot"]
+
+
 def scorecard(rep, ctx):
+    """The papers' claims with our verdicts, counted apart by kind (accuracy / robustness / timing),
+    for the robot profile and, in a column of their own by the same rules, the field_robot runs.
+    Returns (claims, field_claims or None, totals text) for the summary and the terminal."""
     rep.heading("Reproduction scorecard", 2, "scorecard")
-    rep.para("One line per published claim. The verdict is computed by the rule written next to the claim in "
-             "results/reference/papers.json (claims); claims that do not hold stay visible, and no model is tuned to turn one. "
-             "Timings compare our machine with the papers' 1.66 GHz CPU.")
-    rows, classes = [], []
     claims = C.evaluate_claims(ctx)
-    for c in claims:
-        pub = c["published"]
-        pub_text = (fnum(pub, 3) + ("" if c["unit"] in ("x", "", "recovered") else f" {c['unit']}")) if isinstance(pub, (int, float)) else (pub or "-")
-        rows.append([c["paper"], c["claim"], c["ours_text"], pub_text, fnum(c["ratio"], 2) if c["ratio"] is not None else "-", c["verdict"], c["rule_text"]])
-        classes.append(VERDICT_CLASS.get(c["verdict"], ""))
-    rep.table(["paper", "claim", "ours", "paper's", "ours / paper", "verdict", "rule"], rows, row_classes=classes)
-    counts = {}
-    for c in claims:
-        counts[c["verdict"]] = counts.get(c["verdict"], 0) + 1
-    rep.para("Verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + ".")
-    return claims
+    field = field_robot_runs(ctx.runs)
+    field_claims = None
+    if field:
+        with R.pairing_profile("field_robot"):
+            fctx = C.Context(ctx.papers, field, [])
+            fctx.experiments = ctx.experiments
+            field_claims = {c["id"]: c for c in C.evaluate_claims(fctx)}
+    totals = C.totals_text(C.totals(claims))
+    ftotals = C.totals_text(C.totals([field_claims[c["id"]] for c in claims if c["uses_runs"]])) if field_claims else None
+    rep.para(f"**Robot profile** — {totals}." + (f" **field_robot profile** (claims judged from runs) — {ftotals}." if ftotals else ""), "totals")
+    rep.para("One line per published claim, grouped by what it is about. The verdict is computed by the rule written next to the "
+             "claim in results/reference/papers.json; a claim stated on a row of a published error table is judged on every axis "
+             "the paper states there (mean x, y and heading): all hold: holds, some: partly. Claims that do not hold stay "
+             "visible, and no model is tuned to turn one.")
+    for kind in C.KINDS:
+        mine = [c for c in claims if c["kind"] == kind]
+        if not mine:
+            continue
+        rows = []
+        for c in mine:
+            pub = c["published"]
+            pub_text = (fnum(pub, 3) + ("" if c["unit"] in ("x", "", "recovered") else f" {c['unit']}")) if isinstance(pub, (int, float)) else (pub or "-")
+            row = [c["paper"], c["claim"], c["ours_text"] + ("" if not c["notes"] else " (" + "; ".join(c["notes"]) + ")"), pub_text,
+                   fnum(c["ratio"], 2) if c["ratio"] is not None else "-", c["verdict"]]
+            if field_claims is not None:
+                f = field_claims[c["id"]]
+                row += [f["ours_text"].replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json"), f["verdict"]] \
+                    if c["uses_runs"] else ["same as robot (experiment)", "-"]
+            rows.append(row + [c["rule_text"]])
+        header = ["paper", "claim", "ours (robot profile)", "paper's", "ours / paper", "verdict"]
+        if field_claims is not None:
+            header += ["ours (field_robot)", "verdict (field_robot)"]
+        cap = f"{KIND_TEXT[kind]}: " + C.totals_text({kind: C.totals(mine)[kind]}).split(": ", 1)[1] + "."
+        if kind == "timing":
+            cap += f" Ours: median wall time on {machine_text()}."
+        rep.table(header + ["rule"], rows, cap)
+    return claims, field_claims, totals + (f" | field_robot: {ftotals}" if ftotals else "")
+
+
+# ---- few seeds: every seed's value, intervals that say their method, outliers with their cause ----
+
+SEED_METRICS = [("x_cm/mean", "mean x cm", 2), ("y_cm/mean", "mean y cm", 2), ("theta_rad/mean", "mean th rad", 4)]
+
+
+def seed_values_text(sel, values, flagged, digits):
+    """'s1 3.10, s2 806.00 (outlier), s3 2.90': every seed's value beside the mean."""
+    return ", ".join(f"s{r.seed}\u00a0{fnum(v, digits)}" + ("\u00a0(outlier)" if i in flagged else "") for i, (r, v) in enumerate(zip(sel, values)))
+
+
+def interval_text(st, digits):
+    """'mean [lo, hi]' with the method, 'n = 1' marked, for one metric over seeds."""
+    if st["n"] == 0:
+        return "-"
+    if st["n"] == 1:
+        return f"{fnum(st['mean'], digits)} (n = 1: one seed, no interval)"
+    return f"{fnum(st['mean'], digits)} [{fnum(st['lo'], digits)}, {fnum(st['hi'], digits)}]"
+
+
+def flag_outliers(sel, metric="x_cm/mean", phase="tracking"):
+    """The runs of one row (seeds) whose error is far above the others' (R.outliers)."""
+    vals = [r.metric(metric, phase) for r in sel]
+    return [sel[i] for i in R.outliers(vals)] if None not in vals else []
+
+
+def outlier_cause(run, wrong_m=0.5):
+    """What happened in an outlying run, read from frames.csv (robot 0) and events.jsonl: when the
+    position error went above `wrong_m` for good and what the localizer said it was doing then."""
+    frames = [f for f in run.frames() if f.get("robot", "0") == "0"]
+    if not frames:
+        return "no frames.csv to read the cause from"
+    events = []
+    ev = run.folder / "events.jsonl"
+    if ev.exists():
+        for line in ev.read_text().splitlines():
+            try:
+                e = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if e.get("type") in EVENT_COLOURS:
+                events.append(e)
+    err = [(float(f["t"]), float(f["err_pos"]) if f.get("valid") == "1" else math.nan, f.get("mode", "")) for f in frames]
+    bad = lambda e: not (e <= wrong_m)  # a frame without an estimate counts as wrong
+    e_end = err[-1][1]
+    if bad(e_end):
+        k = len(err) - 1
+        while k > 0 and bad(err[k - 1][1]):
+            k -= 1
+        stretch = err[k:]
+        t0 = stretch[0][0]
+        valid = sorted(e for _, e, _ in stretch if not math.isnan(e))
+        typical = f"{fnum(R.percentile(valid, 0.5), 2)} m from the truth (median)" if valid else "no estimate"
+        before = [e for e in events if e["t"] <= t0 + 0.5]
+        after_event = f", after the {before[-1]['type']} at t = {before[-1]['t']:.1f} s" if before else ""
+        since = "from the start" if k == 0 else f"from t = {t0:.1f} s{after_event}"
+        # The localizer claimed a pose (a mode other than searching / lost) that was wrong: the
+        # worst failure, as it does not know it is lost.
+        sure = [(t, e, m) for t, e, m in stretch if not math.isnan(e) and m not in ("global", "lost", "coasting", "searching", "")]
+        if sure:
+            share = 100.0 * len(sure) / len(stretch)
+            return (f"converged to a wrong pose at t = {sure[0][0]:.1f} s: {typical}, mode '{sure[0][2]}' in {share:.0f} % of the frames "
+                    f"{since} to the end; " + (f"never within {wrong_m} m" if k == 0 else f"not within {wrong_m} m again"))
+        return f"lost {since}: {typical}, no confident estimate (mode '{stretch[-1][2]}') to the end"
+    worst = max(err, key=lambda x: -1 if math.isnan(x[1]) else x[1])
+    before = [e for e in events if e["t"] <= worst[0]]
+    return (f"error peaked at {fnum(worst[1], 2)} m at t = {worst[0]:.1f} s"
+            + (f" after the {before[-1]['type']} at t = {before[-1]['t']:.1f} s" if before else "") + f", below {wrong_m} m at the end")
+
+
+def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
+    """Per row: every seed's value of mean x, y and heading, their median, mean and 95 % interval
+    with its method, and the outlying seeds with their cause. rows_runs: [(label, runs sorted by
+    seed)]. Returns the outlying runs, which the caller plots."""
+    rows, classes, flagged_runs, methods = [], [], [], set()
+    for label, sel in rows_runs:
+        if not sel:
+            continue
+        out = flag_outliers(sel, phase=phase)
+        flagged_runs += out
+        row = [label, len(sel)]
+        for metric, _, digits in SEED_METRICS:
+            vals = [r.metric(metric, phase) for r in sel]
+            st = R.stats(vals)
+            if st["method"]:
+                methods.add(st["method"])
+            flagged = {i for i, r in enumerate(sel) if r in out} if metric == "x_cm/mean" else set()  # the metric flagged on
+            # One cell per metric (the mean with its interval, the median, every seed): a table a
+            # reader takes in without scrolling sideways.
+            row.append(f"mean {interval_text(st, digits)}; median {fnum(st['median'], digits)}; seeds: {seed_values_text(sel, vals, flagged, digits)}")
+        row.append("; ".join(f"s{r.seed}: {outlier_cause(r)}" for r in out) or "-")
+        rows.append(row)
+        classes.append("outlier" if out else "")
+    if not rows:
+        return []
+    header = ["row", "n"] + [name for _, name, _ in SEED_METRICS]
+    rep.table(header + ["outlying seeds and cause"], rows,
+              "Every seed beside the mean: mean [95 % interval of the mean]; median; each seed's value. The interval: "
+              + ("bootstrap percentile (exact over all resamples for n <= 6; it stays within the seeds' range and never below zero)" if R.BOOTSTRAP in methods
+                 else "none (n = 1)") + "; n = 1 is marked and has no interval. A seed is flagged as an outlier when its mean x error lies above 3x "
+              "the median of the other seeds and further from it than 3x their range; its cause is read from its frames.csv and events.jsonl."
+              + caption_extra, classes)
+    return flagged_runs
+
+
+def strip_plot(rep, title, rows_runs, phase="tracking"):
+    """Each seed's mean x error (cm) and mean heading error (rad) as dots per row, the mean as a bar:
+    a reader sees at once whether a mean is one seed's doing. Log scale where values span > 30x."""
+    rows_runs = [(l, s) for l, s in rows_runs if s]
+    if not rows_runs:
+        return
+    fig, axes = plt.subplots(1, 2, figsize=(10, 0.42 * len(rows_runs) + 1.3), sharey=True)
+    for ax, (metric, unit) in zip(axes, [("x_cm/mean", "mean x error per seed (cm)"), ("theta_rad/mean", "mean heading error per seed (rad)")]):
+        allv = []
+        for k, (label, sel) in enumerate(rows_runs):
+            vals = [r.metric(metric, phase) for r in sel]
+            vals = [v for v in vals if v is not None]
+            if not vals:
+                continue
+            out = set(R.outliers(vals))
+            jitter = [(i - (len(vals) - 1) / 2) * 0.12 for i in range(len(vals))]
+            ax.scatter([v for i, v in enumerate(vals) if i not in out], [k + jitter[i] for i in range(len(vals)) if i not in out],
+                       s=18, color="#1f77b4", zorder=3)
+            if out:
+                ax.scatter([vals[i] for i in out], [k + jitter[i] for i in out], s=30, color="#d62728", marker="D", zorder=4,
+                           label="outlying seed" if not ax.get_legend_handles_labels()[1] else None)
+            m = sum(vals) / len(vals)
+            ax.plot([m, m], [k - 0.3, k + 0.3], color="black", lw=1.5, zorder=2)
+            allv += vals
+        pos = [v for v in allv if v > 0]
+        if pos and max(pos) / max(min(pos), 1e-12) > 30:
+            log_axis(ax.xaxis, ax, "x")
+            unit += ", log scale"
+        else:
+            ax.set_xlim(left=0)
+            ax.xaxis.set_major_locator(MaxNLocator(6))
+        ax.set_xlabel(unit)
+        ax.grid(axis="x", alpha=0.3)
+        if ax.get_legend_handles_labels()[1]:
+            ax.legend(fontsize=7, loc="lower right")
+    axes[0].set_yticks(range(len(rows_runs)))
+    axes[0].set_yticklabels([l for l, _ in rows_runs], fontsize=8)
+    axes[0].invert_yaxis()
+    rep.figure(fig, "seeds", f"{title}: every seed (dots; red diamonds: outlying seeds), the mean over seeds (black bar)")
+
+
+def log_axis(axis, ax, which):
+    """A log axis with several labelled ticks (1, 2, 5 per decade) in plain numbers, not one lone 10^k."""
+    from matplotlib.ticker import LogLocator, FuncFormatter, NullFormatter
+    (ax.set_xscale if which == "x" else ax.set_yscale)("log")
+    lo, hi = ax.get_xlim() if which == "x" else ax.get_ylim()
+    decades = math.log10(hi / lo) if lo > 0 and hi > lo else 1.0
+    # 1-2-5 per decade on a short axis; on a long one they would collide: decades only.
+    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0) if decades <= 3.2 else (1.0,), numticks=15))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(NullFormatter())
+
+
+
+def command(cmd):
+    """The command that runs a missing row: under the field_robot profile, its own suite."""
+    if R.DEFAULT_PROFILE == "field_robot":
+        return cmd.replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json")
+    return cmd
 
 
 def error_table(rep, papers, table, runs):
@@ -218,7 +679,8 @@ def error_table(rep, papers, table, runs):
              "runs with kidnaps or covers use their tracking phase (see docs/results.md). Paper rows in italics, then ours / paper.")
     header = ["row", "source"] + R.TABLE_COLS + ["line points / frame", "seeds"]
     rows, classes = [], []
-    for p in C.pair_table(papers, table, runs):
+    pairs = C.pair_table(papers, table, runs)
+    for p in pairs:
         st = p["stats"]
         if p["runs"]:
             label = p["label"] + (" (tracking phase)" if p["phased"] else "")
@@ -240,16 +702,18 @@ def error_table(rep, papers, table, runs):
                 rows.append([p["label"], "ours / paper"] + [fnum(st[f"{a}/{s}"]["mean"] / v, 2) if v else "-" for (a, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
                 classes.append("ratio")
     rep.table(header, rows, row_classes=classes)
-    missing = [p for p in C.pair_table(papers, table, runs) if not p["runs"]]
-    for p in missing:
-        rep.para(f"Not run: \"{p['label']}\" ({R.describe_key(p['key'])}). Run: {p['command']}")
-    # Intervals where there are at least two seeds.
-    ci = []
-    for p in C.pair_table(papers, table, runs):
-        if p["runs"]:
-            ci.append([p["label"], R.fstat(p["stats"]["x_cm/mean"], 3), R.fstat(p["stats"]["y_cm/mean"], 3), R.fstat(p["stats"]["theta_rad/mean"], 4)])
-    if ci:
-        rep.table(["row", "mean x cm [95 % interval]", "mean y cm", "mean th rad"], ci, "Seed-to-seed spread: Student-t 95 % interval over seeds, only where n >= 2.")
+    missing = [p for p in pairs if not p["runs"]]
+    if missing:  # one line each, collapsed: the command is what a reader needs, not a page of it
+        rep.details(f"{len(missing)} row(s) not run, and the command that runs them")
+        for p in missing:
+            rep.para(f"Not run: \"{p['label']}\" ({R.describe_key(p['key'])}). Run: `{command(p['command'])}`")
+        rep.end_details()
+    # Every seed beside its mean, and the outlying seeds plotted with their cause.
+    rows_runs = [(p["label"], p["runs"]) for p in pairs] + [(f"{p['label']} (external: {q['name']})", q["runs"]) for p in pairs for q in p.get("peers", [])]
+    flagged = seed_table(rep, rows_runs)
+    strip_plot(rep, t.get("source", table), rows_runs)
+    for run in flagged:
+        plot_run(rep, run, f"outlying seed: {run_title(run)}: {outlier_cause(run)}")
 
 
 def kidnap_table(rep, papers, runs):
@@ -267,17 +731,19 @@ def kidnap_table(rep, papers, runs):
                 after = R.stats([r.metric("recovery/after_recovery/x_cm/mean", "all") for r in sel])
                 phase = R.stats([r.metric("x_cm/mean", "tracking") for r in sel])
                 allf = R.stats([r.metric("x_cm/mean", "all") for r in sel])
+                per_seed = ", ".join(f"s{r.seed}\u00a0{r.metric('recovery/recovered', 'all') or 0:.0f}/{r.metric('recovery/episodes', 'all') or 0:.0f}"
+                                     f"\u00a0{fnum(r.metric('x_cm/mean', 'tracking'), 2)}" for r in sel)
                 rows.append([f"{table}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}", fnum(med["mean"], 2), fnum(after["mean"], 2),
-                             fnum(phase["mean"], 2), fnum(allf["mean"], 1), len(sel)])
+                             fnum(phase["mean"], 2), fnum(allf["mean"], 1), per_seed, len(sel)])
                 classes.append("")
             else:
-                rows.append([f"{table}: {label}", "not run", "-", "-", "-", "-", "-", "-", 0])
+                rows.append([f"{table}: {label}", "not run", "-", "-", "-", "-", "-", "-", "-", 0])
                 classes.append("missing")
-            rows.append([f"{table}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-"])
+            rows.append([f"{table}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-", "-"])
             classes.append("paper")
     rep.table(["case", "source", "recovered / kidnaps", "false recoveries", "median recovery s", "after recovery: mean x cm",
-               "tracking phase: mean x cm", "all frames: mean x cm", "seeds"], rows,
-              "Over all seeds. Recovered: error under 0.3 m and 0.2 rad for 1 s. The tracking phase leaves out the carried period and the time to recovery; "
+               "tracking phase: mean x cm", "all frames: mean x cm", "per seed: recovered, tracking-phase mean x cm", "seeds"], rows,
+              "Over all seeds, and every seed beside the means. Recovered: error under 0.3 m and 0.2 rad for 1 s. The tracking phase leaves out the carried period and the time to recovery; "
               "'all frames' includes them (that is why it is large).", classes)
 
 
@@ -291,7 +757,7 @@ def timing_table(rep, papers, runs):
         rows.append([row, key["what"], fnum(med, 2) if med is not None else "not run", f"{lo}-{hi}", fnum(med / hi, 2) if med is not None else "-", frames])
         classes.append("" if med is not None else "missing")
     rep.table(["papers.json row", "what", "ours: median ms", "paper ms", "ours / paper's upper bound", "frames"], rows,
-              f"Ours: wall time on {platform.node()} ({os.cpu_count()} cores, {platform.machine()}), runs of a sweep share the cores; paper: {t['cpu']}.", classes)
+              f"Ours: wall time on {machine_text()}, runs of a sweep share the cores; paper: {t['cpu']}.", classes)
 
 
 def experiment_section(rep, ctx, key, title):
@@ -439,7 +905,7 @@ def error_budget_section(rep, ctx):
     ax.set_yticks([k + 0.4 - h / 2 for k in range(len(sources))])
     ax.set_yticklabels(sources)
     ax.invert_yaxis()
-    ax.set_xscale("log")
+    log_axis(ax.xaxis, ax, "x")
     ax.set_xlabel("position RMSE, cm (log scale)")
     ax.legend()
     ax.grid(axis="x", alpha=0.3)
@@ -481,8 +947,9 @@ def field_lines(ax, run):
 
 def plot_run(rep, run, title):
     frames = run.frames()
-    if not frames:
+    if not frames or run.folder in rep.plotted:  # each run's figure once (an outlier is plotted where it is flagged first)
         return
+    rep.plotted.add(run.folder)
     events = [json.loads(l) for l in (run.folder / "events.jsonl").read_text().splitlines() if l.strip()] if (run.folder / "events.jsonl").exists() else []
     by_robot = {}
     for f in frames:
@@ -512,20 +979,25 @@ def plot_run(rep, run, title):
         ax = axes[1 + k]
         for rid, fr in sorted(by_robot.items()):
             v = [f for f in fr if f["valid"] == "1"]
-            ax.plot([float(f["t"]) for f in v], [abs(float(f[col])) * scale for f in v], lw=0.8, label=f"r{rid}")
+            ax.plot([float(f["t"]) for f in v], [abs(float(f[col])) * scale for f in v], lw=0.8, label=f"r{rid}", zorder=3)
+        # Events: a triangle above the plotting area and a faint dashed line BEHIND the data, so a
+        # mark never hides the error it explains.
         for e in events:
             c = EVENT_COLOURS.get(e.get("type"))
             if c:
-                ax.axvline(e["t"], color=c, lw=0.8, alpha=0.7)
+                ax.axvline(e["t"], color=c, lw=0.6, ls=(0, (3, 3)), alpha=0.45, zorder=1)
+                ax.plot([e["t"]], [1.0], marker="v", color=c, ms=6, transform=ax.get_xaxis_transform(), clip_on=False, zorder=4)
         t_end = max(float(f["t"]) for f in frames)
         for r in run.summary.get("robots", []):  # left out of the tracking phase: shaded
             for a, b in (r.get("tracking_phase") or {}).get("excluded", []):
                 ax.axvspan(a, min(b, t_end), color="#999999", alpha=0.15, lw=0)
         ax.set_ylim(bottom=0)
+        ax.xaxis.set_major_locator(MaxNLocator(8))
+        ax.yaxis.set_major_locator(MaxNLocator(6))
         ax.set_xlabel("t (s)")
         ax.set_ylabel(f"{label} ({unit})")
         ax.grid(alpha=0.3)
-        ax.set_title(label + (" (lines: " + ", ".join(f"{k} {EVENT_COLOURS[k]}" for k in kinds) + ")" if kinds else ""), fontsize=9)
+        ax.set_title(label + (" (events, triangles: " + ", ".join(f"{k} {EVENT_COLOURS[k]}" for k in kinds) + ")" if kinds else ""), fontsize=9, pad=9)
     rep.figure(fig, "run", f"{title}: trajectory over the field, position and heading error over time"
                + (" (shaded: carried, blind or recovering, left out of the tracking phase)" if any("tracking_phase" in r for r in run.summary.get("robots", [])) else ""))
 
@@ -536,9 +1008,9 @@ def run_title(run, params=None):
     return " / ".join(str(p) for p in parts)
 
 
-def report_run(rep, run, plots, params=None):
+def report_run(rep, run, plots, params=None, note=None):
     s = run.summary
-    title = run_title(run, params)
+    title = run_title(run, params) + (f" ({note})" if note else "")
     rep.heading(f"Run {title}", 3)
     rows = []
     for r in s.get("robots", []):
@@ -595,21 +1067,23 @@ def report_sweep(rep, sweep, all_runs, max_runs):
                     [fnum(val(a, s), 3) for a, s in R.TABLE_KEYS] + [f"{g.get('finished', '-')}/{g.get('failed', 0)}", n])
     rep.table(["group"] + R.TABLE_COLS + ["runs ok/failed", "n"], rows,
               "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'.")
-    ci = []
-    for g in agg["groups"]:
-        v = g["metrics"].get("r0/position_m/rmse")
-        if v and v["n"] >= 2:
-            ci.append([f"{g.get('scenario')} / {g.get('localizer')} / {g.get('params')}", fnum(v["mean"], 4), f"[{fnum(v['ci95'][0], 4)}, {fnum(v['ci95'][1], 4)}]", v["n"]])
-    if ci:
-        rep.table(["group", "position RMSE m (all frames)", "95 % interval", "n"], ci, "intervals only where n >= 2")
     runs = sweep_runs(sweep, all_runs)
-    # Plots for the first seed of each group (every condition shown once), at most max_runs.
+    groups = {}
+    for run, params in runs:
+        groups.setdefault((run.scenario, run.localizer, params), []).append(run)
+    rows_runs = [(" / ".join(str(x) for x in k), sorted(v, key=lambda r: r.seed)) for k, v in groups.items()]
+    flagged = seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json keeps Student-t intervals for scripts; this report recomputes them from the runs.")
+    # Per run: its tables always; plots for the first seed of each group (every condition shown
+    # once, at most max_runs) and for every outlying seed, collapsed: a reader opens what they need.
+    rep.details(f"Runs of sweep {name}: {len(runs)} runs, tables and plots")
     plotted, seen = 0, set()
     for run, params in runs:
         first = (run.scenario, run.localizer, params) not in seen
         seen.add((run.scenario, run.localizer, params))
-        report_run(rep, run, plots=first and plotted < max_runs, params=params)
+        report_run(rep, run, plots=(first and plotted < max_runs) or run in flagged, params=params,
+                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None)
         plotted += first
+    rep.end_details()
     return [r for r, _ in runs]
 
 
@@ -645,7 +1119,7 @@ def cdf_and_timing(rep, runs):
         for loc, e in sorted(errs.items()):
             e = sorted(max(x, 1e-4) for x in e)
             ax.plot(e, [(i + 1) / len(e) for i in range(len(e))], label=f"{loc} ({len(e)} frames)")
-        ax.set_xscale("log")
+        log_axis(ax.xaxis, ax, "x")
         ax.set_ylim(0, 1)
         ax.set_xlabel("position error (m, log scale)")
         ax.set_ylabel("fraction of valid frames")
@@ -661,7 +1135,7 @@ def cdf_and_timing(rep, runs):
         for loc, d in sorted(timing.items()):
             rows.append([loc] + [fnum(statistics.median(v), 3) if v else "-" for v in d.values()] + [len(d["render_ms"])])
         rep.table(["localizer", "render ms (median)", "vision ms", "localize ms", "frames"], rows,
-                  f"wall time per frame on {platform.node()} ({os.cpu_count()} cores, {platform.machine()}); runs in a sweep share the cores. "
+                  f"wall time per frame on {machine_text()}; runs in a sweep share the cores. "
                   "For an external localizer (docs/protocol.md) 'localize' is the protocol's round trip: frame sent to estimate read, "
                   "the client's own computation included")
         fig, ax = plt.subplots(figsize=(7, 3.5))
@@ -725,7 +1199,7 @@ def report_history(rep, folder, reference=None):
     icount = load_jsonl(reference) + load_jsonl(folder / "icount.jsonl")
     bench = load_jsonl(folder / "bench.jsonl")
     if not (icount or bench):
-        return
+        return False
     rep.heading("Speed over commits", 2, "history")
     rep.para(f"From {reference} (committed baselines) and {folder} (this machine): every run of scripts/icount.sh and scripts/bench.sh appends its figures with the commit. "
              "Instruction counts (callgrind, fixed work) do not depend on the machine's load; wall times do, so compare "
@@ -738,6 +1212,7 @@ def report_history(rep, folder, reference=None):
         history_plot(rep, bench, "real_time_ns", "history_bench", "median wall time / first record",
                      "Google Benchmark median wall time per benchmark (scripts/bench.sh), relative to its first record",
                      lambda v: f"{v:,.1f} ns")
+    return True
 
 
 def picture_order(p):
@@ -745,12 +1220,25 @@ def picture_order(p):
     return str(p).replace("_before", "_0before").replace("_after", "_1after")
 
 
+# Tables of an experiment's markdown that a published-table section already shows (from the
+# experiment's JSON): (text of the heading they stand under, that section's anchor).
+SHOWN_ELSEWHERE = {
+    "cooperative_001": [("Error against the number of robots", "001_simulation_setup"), ("Growth-model benchmark", "001_growth_model")],
+    "error_budget": [("error_budget: which error source dominates", "error_budget")],
+}
+
+
 def report_experiment(rep, exp):
     rep.heading(f"Experiment {exp.name}", 2)
-    for md in sorted(exp.glob("*.md")):
-        rep.markdown(md.read_text())
-    for png in sorted(exp.glob("*.png"), key=picture_order):
+    pngs = sorted(exp.glob("*.png"), key=picture_order)
+    for png in pngs:
         rep.image(png, f"{exp.name}: {png.stem}")
+    mds = sorted(exp.glob("*.md"))
+    if mds:  # the experiment's own notes and tables, long: collapsed
+        rep.details(f"{exp.name}: the experiment's notes and tables ({', '.join(m.name for m in mds)})")
+        for md in mds:
+            rep.markdown(md.read_text(), skip=SHOWN_ELSEWHERE.get(exp.name, ()))
+        rep.end_details()
 
 
 def main():
@@ -768,13 +1256,16 @@ def main():
     if not (runs or sweeps or experiments):
         sys.exit("report.py: no results (summary.json, aggregate.json or experiment pictures) under " + " ".join(a.results))
     rep = Report(a.out, a.title)
+    for x in a.results + (a.baseline or []):
+        rep.add_root(x)
     rep.para(f"{len(sweeps)} sweep(s), {len(runs)} run(s), {len(experiments)} experiment(s). Published numbers: results/reference/papers.json; "
-             f"everything else is read from the result files.")
+             f"everything else is read from the result files. The scorecard comes first, then the contents; details follow.")
     for d in R.INCOMPLETE:
         rep.para(f"**Incomplete sweep** (--accept-incomplete): {pathlib.Path(d).name} has no final aggregate; only its finished runs are reported.")
-    provenance(rep, runs, sweeps)
     ctx = C.Context(papers, runs, experiments)
-    scorecard(rep, ctx)
+    _, _, totals = scorecard(rep, ctx)
+    rep.mark_toc()
+    provenance(rep, runs, sweeps)
     published_tables(rep, papers, ctx)
     field_robot_tables(rep, papers, runs)
     error_budget_section(rep, ctx)
@@ -792,16 +1283,27 @@ def main():
     loose = [r for r in runs if r.folder not in in_sweeps]
     if loose:
         rep.heading("Runs", 2)
+        rep.details(f"{len(loose)} runs outside sweeps: tables and plots")
         for run in loose:
             report_run(rep, run, plots=True)
+        rep.end_details()
     cdf_and_timing(rep, runs)
     for exp in experiments:
         report_experiment(rep, exp)
+    # Developers' charts (speed over commits) are not results: a page of their own, linked here.
     history = a.history or str(pathlib.Path(__file__).resolve().parent.parent / "results" / "history")
     if history != "none":
-        report_history(rep, pathlib.Path(history))
+        hist = Report(a.out, f"{a.title}: speed over commits", page="history")
+        if report_history(hist, pathlib.Path(history)):
+            hist.write()
+            rep.heading("For developers", 2, "developers")
+            rep.raw_html("<p>Instruction counts and benchmark times over the commits (not results of the papers' experiments): "
+                         "<a href='history.html'>history.html</a> beside this report.</p>",
+                         "Instruction counts and benchmark times over the commits: [history.md](history.md) beside this report.")
     rep.write()
-    print(f"report: {rep.out / 'report.md'} and {rep.out / 'report.html'} ({rep.n_img} pictures)")
+    html_path = rep.out / "report.html"
+    print(f"scorecard: {totals}")
+    print(f"report: {html_path} ({html_path.stat().st_size / 1e6:.1f} MB, {rep.n_img} pictures) and {rep.out / 'report.md'}")
 
 
 if __name__ == "__main__":

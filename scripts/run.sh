@@ -11,6 +11,10 @@
 #        scripts/run.sh FILE.json  one scenario, its error table printed
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# A header per phase, so a reader of the terminal knows where the run is and how long each took.
+t_start=$SECONDS
+phase() { echo; echo "=== $1 (at $(( (SECONDS - t_start) / 60 )) min)"; }
+phase "1/6 dependencies and build"
 scripts/install-deps.sh
 # Only the program it runs: the test and benchmark programs took 157 s of a fresh 9-minute build.
 OMNILOC_BUILD_TARGETS=omniloc scripts/build.sh
@@ -33,9 +37,11 @@ j["scenarios"]=[({**s,"file":base+s["file"]} if isinstance(s,dict) else base+s) 
 open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$spec" results/suites/paper_suite.json
   spec=results/suites/paper_suite.json
 fi
+phase "2/6 paper suite: $spec"
 ./build/omniloc sweep "$spec" -j "$jobs"
 results=(results/sweeps/paper_suite)
 # The same published rows under the field_robot profile (issue 17), shown beside them in the report.
+phase "3/6 paper suite under the field_robot profile"
 ./build/omniloc sweep scenarios/sweeps/paper_suite_field_robot.json -j "$jobs"
 results+=(results/sweeps/paper_suite_field_robot)
 if [ $full -eq 1 ]; then
@@ -46,11 +52,18 @@ if [ $full -eq 1 ]; then
 fi
 
 # The figures' experiments (quick versions by default).
+phase "4/6 experiments (the papers' figures)"
 quick=--quick; [ $full -eq 1 ] && quick=
 for e in $(./build/omniloc list | sed -n '/^experiments:/,/^$/p' | awk 'NR>1 && NF {print $1}'); do
+  echo "--- experiment $e"
   ./build/omniloc experiment "$e" $quick
   results+=("results/experiments/$e")
 done
 
-"$PY" scripts/report.py "${results[@]}" -o results/report --title "omniloc paper suite"
+phase "5/6 report"
 "$PY" scripts/paper_table.py results/sweeps/paper_suite --paper 002_table1_occlusion
+# report.py prints the scorecard's totals (accuracy, robustness and timing apart) and the report's
+# path last, so they are what the terminal shows at the end.
+phase "6/6 scorecard and report"
+"$PY" scripts/report.py "${results[@]}" -o results/report --title "omniloc paper suite"
+echo "open: $(pwd)/results/report/report.html (total $(( (SECONDS - t_start) / 60 )) min)"
