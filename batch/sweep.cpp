@@ -31,6 +31,13 @@ using harness::remove_stale_partials;
 
 namespace {
 
+// A run as a person reads it in progress lines ("tracking / mcl / occlusion={...}, seed 2"); the
+// folder id (sanitized for file names) stays in the files.
+std::string readable(const SweepRun& r) {
+  return r.scenario_name + " / " + r.localizer_label + (r.params_label == "default" ? "" : " / " + r.params_label) + ", seed " +
+         std::to_string(r.seed);
+}
+
 std::string fmt(double v) {
   char b[64];
   std::snprintf(b, sizeof b, "%.6g", v);
@@ -170,7 +177,7 @@ class SweepWorkers {
         ::close(lock_fd);
         std::lock_guard<std::mutex> lock(mu_);
         ++busy_;
-        if (o_.progress) *o_.progress << r.id << ": skipped, another process is running it\n";
+        if (o_.progress) *o_.progress << readable(r) << ": skipped, another process is running it\n";
         continue;
       }
       const Result result = run_locked(r, fail_marker, lock_path, lock_fd, secs);
@@ -211,7 +218,7 @@ class SweepWorkers {
       return ok ? Result::ok : Result::failed;
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mu_);
-      if (o_.progress) *o_.progress << r.id << ": FAILED: " << e.what() << "\n";
+      if (o_.progress) *o_.progress << readable(r) << ": FAILED: " << e.what() << "\n";
       try {
         write_file_atomic(fail_marker.string(), Json{{"id", r.id}, {"error", e.what()}}.dump(2) + "\n");
       } catch (const std::exception&) {
@@ -233,7 +240,7 @@ class SweepWorkers {
       *o_.progress << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done_ << "/" << todo_.size()
                    << " failed " << failed_ << " ETA " << fmt_duration(eta) << "   " << std::flush;
     } else {
-      *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << r.id << (ok ? " ok " : " FAILED ") << fmt(secs) << " s, ETA "
+      *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << readable(r) << (ok ? ": ok " : ": FAILED ") << fmt(secs) << " s, ETA "
                    << fmt_duration(eta) << "\n";
     }
   }

@@ -17,6 +17,9 @@ const BuildInfo& build_info();
 
 /// {"version": ..., "compiler": ..., "build_type": ...}: the "omniloc" block of result files.
 Json build_info_json();
+/// {"cpu": model name, "cores": hardware threads}: the machine a run ran on (no date: the result
+/// files stay byte-identical between reruns; their times are the files' own).
+Json host_info_json();
 
 /// One line for `omniloc --version`.
 std::string version_line();

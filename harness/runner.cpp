@@ -114,6 +114,7 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   summary["duration_s"] = sc.duration;
   summary["camera_rate_hz"] = sc.camera_rate;
   summary["omniloc"] = build_info_json();  // provenance; the regression gates compare everything else
+  summary["omniloc"]["host"] = host_info_json();  // the machine the run ran on (reports quote it)
   // The renderer is provenance too: OSMesa and a GPU draw slightly different pixels (docs/camera.md "GPUs").
   if (const auto dev = perception.render_device()) summary["omniloc"]["render"] = dev->to_json();
   std::vector<TableRow> rows;

@@ -437,7 +437,8 @@ def provenance(rep, runs, sweeps):
     on the same machine) and the date is the run files' modification time."""
     versions = {}
     for r in runs:
-        o = r.summary.get("omniloc") or {}
+        o = dict(r.summary.get("omniloc") or {})
+        o.update(o.get("host") or {})  # the run's machine (summary.json omniloc.host: cpu, cores)
         when = o.get("date") or time.strftime("%Y-%m-%d", time.gmtime((r.folder / "summary.json").stat().st_mtime))
         k = (o.get("version", "unrecorded"), o.get("compiler", "-"), o.get("build_type", "-"),
              f"{o['cpu']}, {o.get('cores', '?')} cores" if o.get("cpu") else "this report's machine (below)")
