@@ -208,3 +208,45 @@ TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
   EXPECT_LE(e.extra.at("particles"), 300.0);
   EXPECT_GE(e.extra.at("particles"), p.kld.min_particles);
 }
+
+// Issue 29: the map constraint. A cloud the odometry carries across the wall at x = +10 m
+// (msl2012: 18 m field, 1 m margin) keeps only its particles inside; a cloud wholly beyond the wall
+// is drawn again uniformly over the floor instead of being tracked out there.
+TEST(McL, ParticlesPushedThroughTheWallAreNotKept) {
+  const Field f = Field::preset("msl2012");
+  ASSERT_DOUBLE_EQ(f.half_floor_x(), 10.0);
+  Rng world(3);
+  McLLocalizer mcl(f, McLParams{}, 5, "");
+  // A tight cloud (5 cm) at x = 9.95: after a 5 cm step towards the wall about half of it is beyond.
+  const Pose2 start(9.95, 0.0, 0.0);
+  mcl.reset(start);
+  const Pose2 truth(9.98, 0.0, 0.0);
+  Odometry odo;
+  odo.delta = Pose2(0.05, 0.0, 0.0);
+  mcl.update(see(f, truth, world), odo, truth.theta);
+  std::size_t beyond = 0;
+  double mx = 0;
+  for (const auto& q : mcl.particles()) {
+    beyond += std::fabs(q.pose.x) > f.half_floor_x() || std::fabs(q.pose.y) > f.half_floor_y();
+    mx += q.pose.x / static_cast<double>(mcl.particles().size());
+  }
+  EXPECT_EQ(beyond, 0u);
+  EXPECT_NEAR(mx, 9.95, 0.1);  // the survivors are the cloud's inner half, not a new uniform set
+
+  // The whole cloud 40 cm beyond the wall: nothing possible is left, the set is drawn again.
+  mcl.reset(Pose2(9.9, 0.0, 0.0));
+  odo.delta = Pose2(0.5, 0.0, 0.0);
+  const Estimate e = mcl.update(see(f, truth, world), odo, truth.theta);
+  double sx = 0, sxx = 0;
+  beyond = 0;
+  for (const auto& q : mcl.particles()) {
+    beyond += std::fabs(q.pose.x) > f.half_floor_x() || std::fabs(q.pose.y) > f.half_floor_y();
+    sx += q.pose.x;
+    sxx += q.pose.x * q.pose.x;
+  }
+  const double n = static_cast<double>(mcl.particles().size());
+  EXPECT_EQ(beyond, 0u);
+  EXPECT_GT(std::sqrt(sxx / n - (sx / n) * (sx / n)), 1.0);  // spread over the field again
+  EXPECT_EQ(e.extra.at("resets"), 1.0);
+  EXPECT_FALSE(e.valid);
+}
