@@ -6,8 +6,10 @@ how often the localizer finds the right pose at all, and how well it tracks once
 that settles on a wrong pose 8 m away lifts the mean of twenty runs by 40 cm while the other
 nineteen track at 3 cm. So, per localizer over the runs (seeds) given:
 
-- **ended right**: runs whose every frame of the last second is valid and within 0.3 m / 0.2 rad
-  of the truth (the recovery tolerances of harness/recovery.hpp), with the Wilson score 95 %
+- **ended right**: runs that give a valid estimate in the last second and every valid one there
+  within 0.3 m / 0.2 rad of the truth (the recovery tolerances of harness/recovery.hpp; a frame
+  the localizer marks invalid, e.g. MCL's spread briefly over its threshold, says "not sure", not
+  "wrong"), with the Wilson score 95 %
   interval (Wilson 1927; the interval Brown, Cai and DasGupta 2001 recommend for small n: unlike
   the normal approximation it stays inside [0, 1] and does not collapse to a point at 0 or n);
 - **first correct convergence**: the first time from which the estimate stays valid and within
@@ -63,7 +65,7 @@ def score_run(rows, half_floor=None):
         outside = sum(1 for r in rows if r["valid"] == "1" and (abs(float(r["est_x"])) > half_floor[0] or abs(float(r["est_y"])) > half_floor[1]))
     ok = [v and ep <= POS_TOL and et <= THETA_TOL for (_, v, _, _, et, ep) in fr]
     t_end = fr[-1][0] if fr else 0.0
-    last = [o for (f, o) in zip(fr, ok) if f[0] > t_end - HOLD_S]
+    last = [o for (f, o) in zip(fr, ok) if f[0] > t_end - HOLD_S and f[1]]
     ended_right = bool(last) and all(last)
     # First t from which every frame for HOLD_S is ok (the run's end counts only if a full second fits).
     t_first, start = None, None
@@ -128,7 +130,10 @@ def collect(folders):
         if f.exists():
             j = json.loads(f.read_text())
             half = (0.5 * j["length"] + j.get("margin", 1.0), 0.5 * j["width"] + j.get("margin", 1.0))
-        by.setdefault(run.localizer, []).append((run.seed, score_run(run.frames(), half)))
+        # In a sweep the folder is scenario__label__params__sN: the label tells variants of one type apart.
+        parts = run.folder.name.split("__")
+        key = parts[1] if len(parts) == 4 else run.localizer
+        by.setdefault(key, []).append((run.seed, score_run(run.frames(), half)))
     return by
 
 

@@ -45,18 +45,20 @@ class ScoreRun(unittest.TestCase):
                 rows.append(row(t, 8.0, gx=3.0))  # estimate at x = 11: beyond a wall at 10
             else:
                 rows.append(row(t, 0.03, eth=0.01))
+        rows[-10]["valid"] = "0"  # unsure for one frame near the end: still ended right
+        rows[-10]["err_x"] = "3.0"
         r = G.score_run(rows, half_floor=(10.0, 7.0))
         self.assertTrue(r["ended_right"])
         self.assertAlmostEqual(r["t_first"], 5.0, places=3)
         self.assertEqual(r["wrong_frames"], 90)            # 2.0 .. 4.967 s
         self.assertEqual(r["outside_walls_frames"], 90)
-        self.assertEqual(r["right_frames"], 151)           # 5.0 .. 10.0 s
+        self.assertEqual(r["right_frames"], 150)           # 5.0 .. 10.0 s, less the unsure one
         s = G.summarise([r])
         self.assertAlmostEqual(s["right_mean_x_cm"], 3.0, places=6)
         self.assertAlmostEqual(s["right_mean_theta_rad"], 0.01, places=6)
         self.assertAlmostEqual(s["wrong_frame_fraction"], 90 / 301, places=9)
         # Mean over every valid frame: (90 x 8 m + 151 x 0.03 m) / 241, the figure that hides both.
-        self.assertAlmostEqual(s["all_mean_pos_cm"], 100 * (90 * 8 + 151 * 0.03) / 241, places=6)
+        self.assertAlmostEqual(s["all_mean_pos_cm"], 100 * (90 * 8 + 150 * 0.03) / 240, places=6)
 
     def test_ends_wrong_and_a_short_right_spell_is_no_convergence(self):
         rows = [row(k / 30, 0.05 if 30 <= k < 50 else 2.0) for k in range(0, 200)]  # right for 0.67 s only
