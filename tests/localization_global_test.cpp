@@ -250,3 +250,31 @@ TEST(McL, ParticlesPushedThroughTheWallAreNotKept) {
   EXPECT_EQ(e.extra.at("resets"), 1.0);
   EXPECT_FALSE(e.valid);
 }
+
+// Augmented MCL (Probabilistic Robotics, table 8.3) with amcl's alpha_slow 0.001 / alpha_fast 0.1 at
+// 30 frames a second: no injection while the fit is steady, random particles within a few frames of
+// a kidnap. With the averages started at 0 (before issue 29) w_slow needed ~1000 frames to catch up
+// and nothing was injected for the first half minute of a run.
+TEST(McL, AugmentedInjectsSoonAfterTheLikelihoodDrops) {
+  const Field f = Field::preset("msl2012");
+  Rng world(8);
+  McLParams p;
+  p.alpha_slow = 0.001;
+  p.alpha_fast = 0.1;
+  McLLocalizer mcl(f, p, 21, "");
+  const Pose2 a(-4.0, 1.0, 0.3), b(3.0, -2.5, 0.3);  // carried from a to b, heading kept
+  mcl.reset(a);
+  const auto far_from = [&](const Pose2& q, double r) {
+    std::size_t n = 0;
+    for (const auto& s : mcl.particles()) n += std::hypot(s.pose.x - q.x, s.pose.y - q.y) > r;
+    return n;
+  };
+  for (int k = 0; k < 30; ++k) mcl.update(see(f, a, world), Odometry{}, a.theta);
+  EXPECT_EQ(far_from(a, 1.0), 0u);  // steady fit: nothing injected
+  std::size_t injected = 0;
+  for (int k = 0; k < 10; ++k) {
+    mcl.update(see(f, b, world), Odometry{}, b.theta);
+    injected = std::max(injected, far_from(a, 1.0));
+  }
+  EXPECT_GT(injected, 0u);
+}
