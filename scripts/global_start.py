@@ -19,7 +19,9 @@ nineteen track at 3 cm. So, per localizer over the runs (seeds) given:
   frames that are not wrong (below), pooled over the runs: the papers' table, on correct frames;
 - **wrong frames**: valid frames more than 0.5 m or 0.35 rad off (the `wrong_frames` definition of
   harness/metrics.cpp), as a fraction of all frames, and the number of runs with any;
-- **mean over all**: mean position error over every valid frame, the statistic that hides both.
+- **mean over all**: mean position error over every valid frame, the statistic that hides both;
+- **beyond the walls**: frames whose estimate lies outside the floor (field.json beside the run),
+  valid ones and all (an invalid MCL estimate is still the set's mean, written to frames.csv).
 
 Usage: scripts/global_start.py FOLDER... [--markdown] [--json OUT]
 (folders: sweep folders or run folders, e.g. results/sweeps/global_tracking). Plain python3.
@@ -60,9 +62,11 @@ def score_run(rows, half_floor=None):
     whose estimate lies beyond the walls."""
     rows = [r for r in rows if r.get("robot", "0") == "0"]
     fr = [_frame(r) for r in rows]
-    outside = 0
+    outside = outside_any = 0
     if half_floor:
-        outside = sum(1 for r in rows if r["valid"] == "1" and (abs(float(r["est_x"])) > half_floor[0] or abs(float(r["est_y"])) > half_floor[1]))
+        beyond = [abs(float(r["est_x"])) > half_floor[0] or abs(float(r["est_y"])) > half_floor[1] for r in rows]
+        outside = sum(1 for r, b in zip(rows, beyond) if b and r["valid"] == "1")
+        outside_any = sum(beyond)
     ok = [v and ep <= POS_TOL and et <= THETA_TOL for (_, v, _, _, et, ep) in fr]
     t_end = fr[-1][0] if fr else 0.0
     last = [o for (f, o) in zip(fr, ok) if f[0] > t_end - HOLD_S and f[1]]
@@ -87,7 +91,7 @@ def score_run(rows, half_floor=None):
         "sum_th": sum(f[4] for f in right), "sum_p2": sum(f[5] ** 2 for f in right),
         "max_x": max((f[2] for f in right), default=0.0), "max_y": max((f[3] for f in right), default=0.0),
         "valid_frames": len(valid), "sum_pos_all": sum(f[5] for f in valid),
-        "outside_walls_frames": outside,
+        "outside_walls_frames": outside, "outside_walls_any_frames": outside_any,
     }
 
 
@@ -118,6 +122,7 @@ def summarise(per_run):
         "runs_with_wrong_frames": sum(1 for r in per_run if r["wrong_frames"] > 0),
         "all_mean_pos_cm": 100 * sum(r["sum_pos_all"] for r in per_run) / nv if nv else None,
         "outside_walls_frames": sum(r["outside_walls_frames"] for r in per_run),
+        "outside_walls_any_frames": sum(r["outside_walls_any_frames"] for r in per_run),
     }
 
 
@@ -143,15 +148,15 @@ def _f(v, fmt):
 
 def markdown(table):
     out = ["| localizer | runs | ended right | Wilson 95 % | first correct convergence median / max s | "
-           "error while right: mean x / y cm, th rad, pos RMSE cm | wrong frames (runs with any) | mean pos error over all valid frames cm |",
-           "|---|---|---|---|---|---|---|---|"]
+           "error while right: mean x / y cm, th rad, pos RMSE cm | wrong frames (runs with any) | mean pos error over all valid frames cm | frames beyond the walls: valid / all |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for loc, s in table.items():
         out.append(f"| {loc} | {s['runs']} | {s['ended_right']} ({_f(100 * s['ended_right_fraction'], '%.0f')} %) | "
                    f"{100 * s['wilson95'][0]:.0f}-{100 * s['wilson95'][1]:.0f} % | "
                    f"{_f(s['t_first_median_s'], '%.2f')} / {_f(s['t_first_max_s'], '%.2f')} ({s['converged_runs']} runs) | "
                    f"{_f(s['right_mean_x_cm'], '%.2f')} / {_f(s['right_mean_y_cm'], '%.2f')}, {_f(s['right_mean_theta_rad'], '%.4f')}, "
                    f"{_f(s['right_pos_rmse_cm'], '%.2f')} | {_f(100 * s['wrong_frame_fraction'], '%.2f')} % ({s['runs_with_wrong_frames']}) | "
-                   f"{_f(s['all_mean_pos_cm'], '%.1f')} | {s['outside_walls_frames']} |")
+                   f"{_f(s['all_mean_pos_cm'], '%.1f')} | {s['outside_walls_frames']} / {s['outside_walls_any_frames']} |")
     return "\n".join(out)
 
 
@@ -165,7 +170,8 @@ def main(argv=None):
     order = [loc for loc in ("mcl", "hybrid", "grid_global") if loc in by] + sorted(set(by) - {"mcl", "hybrid", "grid_global"})
     table = {loc: summarise([r for _, r in by[loc]]) for loc in order}
     per_run = {loc: [{"seed": seed, "ended_right": r["ended_right"], "t_first_s": r["t_first"], "wrong_frames": r["wrong_frames"],
-                      "outside_walls_frames": r["outside_walls_frames"], "frames": r["frames"]} for seed, r in sorted(by[loc], key=lambda x: x[0])] for loc in order}
+                      "outside_walls_frames": r["outside_walls_frames"],
+                      "outside_walls_any_frames": r["outside_walls_any_frames"], "frames": r["frames"]} for seed, r in sorted(by[loc], key=lambda x: x[0])] for loc in order}
     if a.json:
         pathlib.Path(a.json).write_text(json.dumps({"summary": table, "runs": per_run}, indent=1) + "\n")
     if a.markdown:

@@ -52,6 +52,7 @@ class ScoreRun(unittest.TestCase):
         self.assertAlmostEqual(r["t_first"], 5.0, places=3)
         self.assertEqual(r["wrong_frames"], 90)            # 2.0 .. 4.967 s
         self.assertEqual(r["outside_walls_frames"], 90)
+        self.assertEqual(r["outside_walls_any_frames"], 90)
         self.assertEqual(r["right_frames"], 150)           # 5.0 .. 10.0 s, less the unsure one
         s = G.summarise([r])
         self.assertAlmostEqual(s["right_mean_x_cm"], 3.0, places=6)
