@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "localization/filter/particle_set.hpp"
 #include "localization/matching.hpp"
@@ -52,6 +53,7 @@ void McLLocalizer::reset(const std::optional<Pose2>& start) {
   converged_ = false;
   initialised_ = false;
   w_slow_ = w_fast_ = 0.0;
+  resets_ = 0;
   if (start) {
     // A known start: a tight cloud around it (5 cm, 0.02 rad).
     for (int i = 0; i < p_.particles; ++i) ps_.push_back({filter::perturb(*start, {0.05, 0.02}, rng_), 0.0});
@@ -104,9 +106,31 @@ double McLLocalizer::log_likelihood(const Pose2& q, const std::vector<Eigen::Vec
   return lw;
 }
 
+bool McLLocalizer::possible(const Pose2& q) const {
+  return std::fabs(q.x) <= field_.half_floor_x() && std::fabs(q.y) <= field_.half_floor_y();
+}
+
 double McLLocalizer::weigh(const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading) {
+  // The map constraint (Thrun, Burgard, Fox, Probabilistic Robotics, 5.7: p(x | u, x', m) is
+  // proportional to p(x | u, x') p(x | m), and p(x | m) = 0 where the robot cannot be): a particle
+  // the motion model carried beyond the walls weighs nothing. Without it a set that converged on a
+  // wrong pose follows the odometry through the wall, every point there is clamped alike, and
+  // nothing ever tells the particles apart again (issue 29: tracked out to x = 15.6 m).
+  // nav2_amcl draws its initial and injected poses from free map cells only, for the same reason.
   logw_.resize(ps_.size());
-  for (std::size_t i = 0; i < ps_.size(); ++i) logw_[i] = ps_[i].logw = log_likelihood(ps_[i].pose, pts, heading);
+  std::size_t alive = 0;
+  for (std::size_t i = 0; i < ps_.size(); ++i) {
+    const bool ok = possible(ps_[i].pose);
+    alive += ok;
+    logw_[i] = ps_[i].logw = ok ? log_likelihood(ps_[i].pose, pts, heading) : -std::numeric_limits<double>::infinity();
+  }
+  if (alive == 0) {
+    // Every hypothesis is impossible: the set has lost the robot. Start the global search again
+    // (uniform over the floor), as at the first frame.
+    ++resets_;
+    init_uniform(heading);
+    for (std::size_t i = 0; i < ps_.size(); ++i) logw_[i] = ps_[i].logw = log_likelihood(ps_[i].pose, pts, heading);
+  }
   filter::weights_from_log(logw_, w_);
   return filter::weight_sum(w_);
 }
@@ -117,9 +141,20 @@ double McLLocalizer::injection_rate() {
   // likelihood; inject when the short one drops below the long one.
   double mean_lik = 0;
   for (const auto& q : ps_) mean_lik += std::exp(q.logw) / ps_.size();
+  // Both averages start at the first mean likelihood, not at 0 (as nav2_amcl's pf_update_sensor
+  // does): started at 0, w_slow needs about 1 / alpha_slow updates to approach the likelihood
+  // (1000 frames, 33 s at 30 Hz with amcl's 0.001) while w_fast gets there 100 times sooner, so
+  // w_fast / w_slow stayed far above 1 and no particle was injected for the first half minute,
+  // when a wrong global convergence happens.
+  if (w_slow_ == 0.0 || w_fast_ == 0.0) w_slow_ = w_fast_ = mean_lik;
   w_slow_ += p_.alpha_slow * (mean_lik - w_slow_);
   w_fast_ += p_.alpha_fast * (mean_lik - w_fast_);
-  return w_slow_ > 0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+  const double rate = w_slow_ > 0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+  // After an injection both averages restart (nav2_amcl pf_update_resample, "to avoid spiraling off
+  // into complete randomness"): the random particles lower the next mean likelihood, which would
+  // otherwise lower w_fast further and inject more, frame after frame at 30 Hz.
+  if (rate > 0) w_slow_ = w_fast_ = 0.0;
+  return rate;
 }
 
 void McLLocalizer::resample(double sum, double inject, std::optional<double> heading) {
@@ -171,6 +206,7 @@ Estimate McLLocalizer::estimate(bool see, const std::vector<Eigen::Vector2d>& pt
   e.match_error = see ? match_error(map_, pts, e.pose, 0.25) : 1.0;
   e.extra["particles"] = n;
   e.extra["spread_m"] = spread;
+  e.extra["resets"] = static_cast<double>(resets_);
   return e;
 }
 

@@ -70,7 +70,10 @@ class McLLocalizer : public Localizer {
   /// Log-likelihood of particle pose q: the line points' clamped distances (`pts`, robot frame;
   /// null when the camera saw too little) and the compass.
   double log_likelihood(const Pose2& q, const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading) const;
-  /// Sets every particle's logw and fills w_ with the relative weights; returns their sum.
+  /// Inside the walls (the floor the robot can stand on): the map constraint.
+  bool possible(const Pose2& q) const;
+  /// Sets every particle's logw (-inf beyond the walls) and fills w_ with the relative weights;
+  /// returns their sum. A set wholly beyond the walls is drawn again uniformly first.
   double weigh(const std::vector<Eigen::Vector2d>* pts, std::optional<double> heading);
   /// Augmented MCL: the fraction of random particles to inject (0 unless alpha_slow, alpha_fast set).
   double injection_rate();
@@ -84,6 +87,7 @@ class McLLocalizer : public Localizer {
   std::vector<double> logw_, w_;  ///< per-update scratch (kept to avoid reallocation)
   bool initialised_ = false, converged_ = false;
   double w_slow_ = 0.0, w_fast_ = 0.0;
+  int resets_ = 0;  ///< times the whole set was beyond the walls and drawn again
 };
 
 }  // namespace omniloc

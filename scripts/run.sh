@@ -5,9 +5,10 @@
 # comparison report (results/report/report.html and report.md) with the reproduction scorecard.
 #
 # Usage: scripts/run.sh            default size (see README for the measured time)
-#        scripts/run.sh --full     five seeds per scenario, the 200-kidnap sweep of each global
-#                                  localizer, the lighting table with auto-adjust on and off and the
-#                                  full-resolution experiments (a few hours on 2 cores)
+#        scripts/run.sh --full     five seeds per scenario, the field_robot rows at three seeds, the
+#                                  200-kidnap sweep of each global localizer, the global-start sweep
+#                                  (20 seeds x 4 localizers), the lighting table with auto-adjust on
+#                                  and off and the full-resolution experiments (a few hours on 2 cores)
 #        scripts/run.sh FILE.json  one scenario, its error table printed
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,12 +41,23 @@ fi
 phase "2/6 paper suite: $spec"
 ./build/omniloc sweep "$spec" -j "$jobs"
 results=(results/sweeps/paper_suite)
-# The same published rows under the field_robot profile (issue 17), shown beside them in the report.
+# The same published rows under the field_robot profile (issue 17), shown beside them in the report;
+# one seed by default, three with --full (issue 29: a profile contradiction needs seed-to-seed spread).
+fr_spec=scenarios/sweeps/paper_suite_field_robot.json
+if [ $full -eq 1 ]; then
+  mkdir -p results/suites
+  "$PY" -c 'import json,sys; j=json.load(open(sys.argv[1])); j["seeds"]={"first":1,"count":3}
+base="../../scenarios/sweeps/"
+j["scenarios"]=[({**s,"file":base+s["file"]} if isinstance(s,dict) else base+s) for s in j["scenarios"]]
+open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$fr_spec" results/suites/paper_suite_field_robot.json
+  fr_spec=results/suites/paper_suite_field_robot.json
+fi
 phase "3/6 paper suite under the field_robot profile"
-./build/omniloc sweep scenarios/sweeps/paper_suite_field_robot.json -j "$jobs"
+./build/omniloc sweep "$fr_spec" -j "$jobs"
 results+=(results/sweeps/paper_suite_field_robot)
 if [ $full -eq 1 ]; then
-  for s in kidnap_random; do
+  # global_tracking: global start judged per run over 20 seeds (issue 29; the report's "Global start" section).
+  for s in kidnap_random global_tracking; do
     ./build/omniloc sweep "scenarios/sweeps/$s.json" -j "$jobs" --resume
     results+=("results/sweeps/$s")
   done

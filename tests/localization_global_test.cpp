@@ -208,3 +208,73 @@ TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
   EXPECT_LE(e.extra.at("particles"), 300.0);
   EXPECT_GE(e.extra.at("particles"), p.kld.min_particles);
 }
+
+// Issue 29: the map constraint. A cloud the odometry carries across the wall at x = +10 m
+// (msl2012: 18 m field, 1 m margin) keeps only its particles inside; a cloud wholly beyond the wall
+// is drawn again uniformly over the floor instead of being tracked out there.
+TEST(McL, ParticlesPushedThroughTheWallAreNotKept) {
+  const Field f = Field::preset("msl2012");
+  ASSERT_DOUBLE_EQ(f.half_floor_x(), 10.0);
+  Rng world(3);
+  McLLocalizer mcl(f, McLParams{}, 5, "");
+  // A tight cloud (5 cm) at x = 9.95: after a 5 cm step towards the wall about half of it is beyond.
+  const Pose2 start(9.95, 0.0, 0.0);
+  mcl.reset(start);
+  const Pose2 truth(9.98, 0.0, 0.0);
+  Odometry odo;
+  odo.delta = Pose2(0.05, 0.0, 0.0);
+  mcl.update(see(f, truth, world), odo, truth.theta);
+  std::size_t beyond = 0;
+  double mx = 0;
+  for (const auto& q : mcl.particles()) {
+    beyond += std::fabs(q.pose.x) > f.half_floor_x() || std::fabs(q.pose.y) > f.half_floor_y();
+    mx += q.pose.x / static_cast<double>(mcl.particles().size());
+  }
+  EXPECT_EQ(beyond, 0u);
+  EXPECT_NEAR(mx, 9.95, 0.1);  // the survivors are the cloud's inner half, not a new uniform set
+
+  // The whole cloud 40 cm beyond the wall: nothing possible is left, the set is drawn again.
+  mcl.reset(Pose2(9.9, 0.0, 0.0));
+  odo.delta = Pose2(0.5, 0.0, 0.0);
+  const Estimate e = mcl.update(see(f, truth, world), odo, truth.theta);
+  double sx = 0, sxx = 0;
+  beyond = 0;
+  for (const auto& q : mcl.particles()) {
+    beyond += std::fabs(q.pose.x) > f.half_floor_x() || std::fabs(q.pose.y) > f.half_floor_y();
+    sx += q.pose.x;
+    sxx += q.pose.x * q.pose.x;
+  }
+  const double n = static_cast<double>(mcl.particles().size());
+  EXPECT_EQ(beyond, 0u);
+  EXPECT_GT(std::sqrt(sxx / n - (sx / n) * (sx / n)), 1.0);  // spread over the field again
+  EXPECT_EQ(e.extra.at("resets"), 1.0);
+  EXPECT_FALSE(e.valid);
+}
+
+// Augmented MCL (Probabilistic Robotics, table 8.3) with amcl's alpha_slow 0.001 / alpha_fast 0.1 at
+// 30 frames a second: no injection while the fit is steady, random particles within a few frames of
+// a kidnap. With the averages started at 0 (before issue 29) w_slow needed ~1000 frames to catch up
+// and nothing was injected for the first half minute of a run.
+TEST(McL, AugmentedInjectsSoonAfterTheLikelihoodDrops) {
+  const Field f = Field::preset("msl2012");
+  Rng world(8);
+  McLParams p;
+  p.alpha_slow = 0.001;
+  p.alpha_fast = 0.1;
+  McLLocalizer mcl(f, p, 21, "");
+  const Pose2 a(-4.0, 1.0, 0.3), b(3.0, -2.5, 0.3);  // carried from a to b, heading kept
+  mcl.reset(a);
+  const auto far_from = [&](const Pose2& q, double r) {
+    std::size_t n = 0;
+    for (const auto& s : mcl.particles()) n += std::hypot(s.pose.x - q.x, s.pose.y - q.y) > r;
+    return n;
+  };
+  for (int k = 0; k < 30; ++k) mcl.update(see(f, a, world), Odometry{}, a.theta);
+  EXPECT_EQ(far_from(a, 1.0), 0u);  // steady fit: nothing injected
+  std::size_t injected = 0;
+  for (int k = 0; k < 10; ++k) {
+    mcl.update(see(f, b, world), Odometry{}, b.theta);
+    injected = std::max(injected, far_from(a, 1.0));
+  }
+  EXPECT_GT(injected, 0u);
+}

@@ -1,0 +1,187 @@
+#!/usr/bin/env python3
+"""Global localisation from an unknown start, judged per run (issue 29).
+
+A mean error over every frame of a global-start run mixes two things that a reader must see apart:
+how often the localizer finds the right pose at all, and how well it tracks once it has. One run
+that settles on a wrong pose 8 m away lifts the mean of twenty runs by 40 cm while the other
+nineteen track at 3 cm. So, per localizer over the runs (seeds) given:
+
+- **ended right**: runs that give a valid estimate in the last second and every valid one there
+  within 0.3 m / 0.2 rad of the truth (the recovery tolerances of harness/recovery.hpp; a frame
+  the localizer marks invalid, e.g. MCL's spread briefly over its threshold, says "not sure", not
+  "wrong"), with the Wilson score 95 %
+  interval (Wilson 1927; the interval Brown, Cai and DasGupta 2001 recommend for small n: unlike
+  the normal approximation it stays inside [0, 1] and does not collapse to a point at 0 or n);
+- **first correct convergence**: the first time from which the estimate stays valid and within
+  those tolerances for 1 s (as a kidnap's recovery time, counted from t = 0); median and max over
+  the runs that got there;
+- **error while right**: mean |x|, |y| (cm), |theta| (rad) and the position RMSE over the valid
+  frames that are not wrong (below), pooled over the runs: the papers' table, on correct frames;
+- **wrong frames**: valid frames more than 0.5 m or 0.35 rad off (the `wrong_frames` definition of
+  harness/metrics.cpp), as a fraction of all frames, and the number of runs with any;
+- **mean over all**: mean position error over every valid frame, the statistic that hides both;
+- **beyond the walls**: frames whose estimate lies outside the floor (field.json beside the run),
+  valid ones and all (an invalid MCL estimate is still the set's mean, written to frames.csv).
+
+Usage: scripts/global_start.py FOLDER... [--markdown] [--json OUT]
+(folders: sweep folders or run folders, e.g. results/sweeps/global_tracking). Plain python3.
+"""
+import argparse
+import json
+import math
+import pathlib
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import omniloc_results as R  # noqa: E402
+
+POS_TOL, THETA_TOL, HOLD_S = 0.3, 0.2, 1.0      # harness/recovery.hpp RecoveryCriteria
+WRONG_POS, WRONG_THETA = 0.5, 0.35              # harness/metrics.cpp wrong_frames
+
+
+def wilson(k, n, z=1.959963984540054):
+    """Wilson score interval (lo, hi) for k successes out of n; (0, 1) for n = 0."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    den = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _frame(row):
+    return (float(row["t"]), row["valid"] == "1", abs(float(row["err_x"])), abs(float(row["err_y"])),
+            abs(float(row["err_theta"])), float(row["err_pos"]))
+
+
+def score_run(rows, half_floor=None):
+    """Per-run figures from frames.csv rows (robot 0): dict with ended_right, t_first (None when
+    never), the sums over right frames, the wrong and total frame counts, the mean over all, and
+    (with half_floor = (half x, half y) of the floor inside the walls, metres) the valid frames
+    whose estimate lies beyond the walls."""
+    rows = [r for r in rows if r.get("robot", "0") == "0"]
+    fr = [_frame(r) for r in rows]
+    outside = outside_any = 0
+    if half_floor:
+        beyond = [abs(float(r["est_x"])) > half_floor[0] or abs(float(r["est_y"])) > half_floor[1] for r in rows]
+        outside = sum(1 for r, b in zip(rows, beyond) if b and r["valid"] == "1")
+        outside_any = sum(beyond)
+    ok = [v and ep <= POS_TOL and et <= THETA_TOL for (_, v, _, _, et, ep) in fr]
+    t_end = fr[-1][0] if fr else 0.0
+    last = [o for (f, o) in zip(fr, ok) if f[0] > t_end - HOLD_S and f[1]]
+    ended_right = bool(last) and all(last)
+    # First t from which every frame for HOLD_S is ok (the run's end counts only if a full second fits).
+    t_first, start = None, None
+    for (f, o) in zip(fr, ok):
+        if not o:
+            start = None
+            continue
+        if start is None:
+            start = f[0]
+        if f[0] - start >= HOLD_S - 1e-9:
+            t_first = start
+            break
+    right = [f for f in fr if f[1] and not (f[5] > WRONG_POS or f[4] > WRONG_THETA)]
+    wrong = sum(1 for f in fr if f[1] and (f[5] > WRONG_POS or f[4] > WRONG_THETA))
+    valid = [f for f in fr if f[1]]
+    return {
+        "frames": len(fr), "ended_right": ended_right, "t_first": t_first, "wrong_frames": wrong,
+        "right_frames": len(right), "sum_x": sum(f[2] for f in right), "sum_y": sum(f[3] for f in right),
+        "sum_th": sum(f[4] for f in right), "sum_p2": sum(f[5] ** 2 for f in right),
+        "max_x": max((f[2] for f in right), default=0.0), "max_y": max((f[3] for f in right), default=0.0),
+        "valid_frames": len(valid), "sum_pos_all": sum(f[5] for f in valid),
+        "outside_walls_frames": outside, "outside_walls_any_frames": outside_any,
+    }
+
+
+def summarise(per_run):
+    """Aggregate of score_run results (one localizer)."""
+    n = len(per_run)
+    k = sum(r["ended_right"] for r in per_run)
+    lo, hi = wilson(k, n)
+    times = sorted(r["t_first"] for r in per_run if r["t_first"] is not None)
+    nr = sum(r["right_frames"] for r in per_run)
+    frames = sum(r["frames"] for r in per_run)
+    nv = sum(r["valid_frames"] for r in per_run)
+    med = None
+    if times:
+        m = len(times) // 2
+        med = times[m] if len(times) % 2 else 0.5 * (times[m - 1] + times[m])
+    return {
+        "runs": n, "ended_right": k, "ended_right_fraction": k / n if n else None, "wilson95": [lo, hi],
+        "converged_runs": len(times), "t_first_median_s": med, "t_first_max_s": times[-1] if times else None,
+        "right_frames": nr,
+        "right_mean_x_cm": 100 * sum(r["sum_x"] for r in per_run) / nr if nr else None,
+        "right_mean_y_cm": 100 * sum(r["sum_y"] for r in per_run) / nr if nr else None,
+        "right_mean_theta_rad": sum(r["sum_th"] for r in per_run) / nr if nr else None,
+        "right_pos_rmse_cm": 100 * math.sqrt(sum(r["sum_p2"] for r in per_run) / nr) if nr else None,
+        "right_max_x_cm": 100 * max((r["max_x"] for r in per_run), default=0.0),
+        "right_max_y_cm": 100 * max((r["max_y"] for r in per_run), default=0.0),
+        "wrong_frame_fraction": sum(r["wrong_frames"] for r in per_run) / frames if frames else None,
+        "runs_with_wrong_frames": sum(1 for r in per_run if r["wrong_frames"] > 0),
+        "all_mean_pos_cm": 100 * sum(r["sum_pos_all"] for r in per_run) / nv if nv else None,
+        "outside_walls_frames": sum(r["outside_walls_frames"] for r in per_run),
+        "outside_walls_any_frames": sum(r["outside_walls_any_frames"] for r in per_run),
+    }
+
+
+def collect(folders):
+    runs, _, _ = R.discover(folders)
+    by = {}
+    for run in runs:
+        f = run.folder / "field.json"
+        half = None
+        if f.exists():
+            j = json.loads(f.read_text())
+            half = (0.5 * j["length"] + j.get("margin", 1.0), 0.5 * j["width"] + j.get("margin", 1.0))
+        # In a sweep the folder is scenario__label__params__sN: the label tells variants of one type apart.
+        parts = run.folder.name.split("__")
+        key = parts[1] if len(parts) == 4 else run.localizer
+        by.setdefault(key, []).append((run.seed, score_run(run.frames(), half)))
+    return by
+
+
+def _f(v, fmt):
+    return "-" if v is None else fmt % v
+
+
+def markdown(table):
+    out = ["| localizer | runs | ended right | Wilson 95 % | first correct convergence median / max s | "
+           "error while right: mean x / y cm, th rad, pos RMSE cm | wrong frames (runs with any) | mean pos error over all valid frames cm | frames beyond the walls: valid / all |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for loc, s in table.items():
+        out.append(f"| {loc} | {s['runs']} | {s['ended_right']} ({_f(100 * s['ended_right_fraction'], '%.0f')} %) | "
+                   f"{100 * s['wilson95'][0]:.0f}-{100 * s['wilson95'][1]:.0f} % | "
+                   f"{_f(s['t_first_median_s'], '%.2f')} / {_f(s['t_first_max_s'], '%.2f')} ({s['converged_runs']} runs) | "
+                   f"{_f(s['right_mean_x_cm'], '%.2f')} / {_f(s['right_mean_y_cm'], '%.2f')}, {_f(s['right_mean_theta_rad'], '%.4f')}, "
+                   f"{_f(s['right_pos_rmse_cm'], '%.2f')} | {_f(100 * s['wrong_frame_fraction'], '%.2f')} % ({s['runs_with_wrong_frames']}) | "
+                   f"{_f(s['all_mean_pos_cm'], '%.1f')} | {s['outside_walls_frames']} / {s['outside_walls_any_frames']} |")
+    return "\n".join(out)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folders", nargs="+")
+    ap.add_argument("--json", help="write the table (and the per-run figures) as JSON here")
+    ap.add_argument("--markdown", action="store_true", help="print a Markdown table (default: JSON)")
+    a = ap.parse_args(argv)
+    by = collect(a.folders)
+    order = [loc for loc in ("mcl", "hybrid", "grid_global") if loc in by] + sorted(set(by) - {"mcl", "hybrid", "grid_global"})
+    table = {loc: summarise([r for _, r in by[loc]]) for loc in order}
+    per_run = {loc: [{"seed": seed, "ended_right": r["ended_right"], "t_first_s": r["t_first"], "wrong_frames": r["wrong_frames"],
+                      "outside_walls_frames": r["outside_walls_frames"],
+                      "outside_walls_any_frames": r["outside_walls_any_frames"], "frames": r["frames"]} for seed, r in sorted(by[loc], key=lambda x: x[0])] for loc in order}
+    if a.json:
+        pathlib.Path(a.json).write_text(json.dumps({"summary": table, "runs": per_run}, indent=1) + "\n")
+    if a.markdown:
+        print(markdown(table))
+        for loc in order:
+            bad = [p["seed"] for p in per_run[loc] if not p["ended_right"]]
+            print(f"\n{loc}: seeds not ending right: {bad if bad else 'none'}")
+    else:
+        print(json.dumps({"summary": table, "runs": per_run}, indent=1))
+
+
+if __name__ == "__main__":
+    main()
