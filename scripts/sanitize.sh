@@ -6,7 +6,8 @@
 # Usage: scripts/sanitize.sh [ctest arguments]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-targets=(omniloc)
+# olp_cpp_example: the one-header C++ client, whose stream tests (ctest olp_cpp_client) are unit tests.
+targets=(omniloc olp_cpp_example)
 for f in tests/*_test.cpp; do
   name=$(basename "$f" .cpp)
   case "$name" in scenario_*) continue ;; esac
