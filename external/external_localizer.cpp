@@ -196,9 +196,6 @@ void ExternalLocalizer::fail(const std::string& reason) {
   std::string msg = where + ": " + reason;
   if (proc_) {
     proc_->terminate();
-    if (const auto st = proc_->poll_exit(); st && reason.find("exited") == std::string::npos && reason.find("killed") == std::string::npos &&
-                                            reason.find("closed") != std::string::npos)
-      msg += " (" + describe_wait_status(*st) + ")";
     const std::string tail = proc_->stderr_tail(20);
     msg += tail.empty() ? "\n  (the client wrote nothing to stderr)" : "\n  last lines of the client's stderr:\n    " + std::regex_replace(tail, std::regex("\n"), "\n    ");
   }
