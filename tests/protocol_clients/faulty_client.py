@@ -24,11 +24,11 @@ pid_file = sys.argv[2] if len(sys.argv) > 2 else None
 kind, _, arg = mode.partition(":")
 n_at = int(arg) if arg and kind not in ("slow", "fail_once") else -1
 if kind == "fail_once":
-    if os.path.exists(arg):
-        kind = "ok"
-    else:
-        open(arg, "w").close()
+    try:  # atomic: of clients started together exactly one creates the flag and fails
+        os.close(os.open(arg, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
         kind, n_at = "exit_at", 2
+    except FileExistsError:
+        kind = "ok"
 inp, out = sys.stdin.buffer, sys.stdout.buffer
 
 
