@@ -20,6 +20,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "external/client_process.hpp"
 #include "external/external_config.hpp"
 #include "external/sha256.hpp"
 
@@ -42,14 +43,7 @@ std::string shq(const std::string& s) {
   return o + "'";
 }
 
-bool on_path(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "/usr/bin:/bin");
-  std::string d;
-  while (std::getline(ss, d, ':'))
-    if (!d.empty() && ::access((fs::path(d) / name).c_str(), X_OK) == 0) return true;
-  return false;
-}
+bool on_path(const std::string& name) { return external::resolve_program(name, fs::current_path().string()).has_value(); }
 
 struct Captured {
   int status = -1;  ///< wait status; -1 when the program could not be started
@@ -501,11 +495,15 @@ void describe_submission(Json& sub, const SweepSpec& spec, const SlurmOptions& o
   sub["time"] = o.time_limit;
   sub["sbatch_args"] = o.sbatch_args;
   // The external clients the runs start (docs/protocol.md): which program and script, by hash.
+  // Each distinct localizer object once: describing hashes its files.
+  std::set<std::string> seen;
   Json clients = Json::array();
-  for (const auto& r : spec.runs)
-    if (Json c = external::describe_client(r.scenario.value("localizer", Json())); !c.is_null() &&
-                                                                                     std::find(clients.begin(), clients.end(), c) == clients.end())
+  for (const auto& r : spec.runs) {
+    const Json loc = r.scenario.value("localizer", Json());
+    if (!seen.insert(loc.dump()).second) continue;
+    if (Json c = external::describe_client(loc); !c.is_null() && std::find(clients.begin(), clients.end(), c) == clients.end())
       clients.push_back(std::move(c));
+  }
   if (!clients.empty()) sub["external_clients"] = clients;
   if (!sub.contains("submissions")) sub["submissions"] = Json::array();
 }

@@ -54,7 +54,6 @@ Localizers parse_localizers(const Json& l, const std::string& at) {
     // An external localizer's row is named after its script unless labelled (docs/protocol.md).
     std::string label = lj.value("label", external ? external::default_label(lj) : lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
     lj.erase("label");
-    external::anchor_external_paths(lj);
     locs.emplace_back(sanitize(label), lj);
   }
   return locs;

@@ -27,15 +27,20 @@ if [ $# -ge 1 ] && [ "$1" != "--full" ]; then
 fi
 full=0; [ "${1:-}" = "--full" ] && full=1
 
+# A copy of sweep SPEC with COUNT seeds, written to OUT (scenario paths made relative to results/suites/).
+with_seeds() {
+  mkdir -p results/suites
+  "$PY" -c 'import json,sys; j=json.load(open(sys.argv[1])); j["seeds"]={"first":1,"count":int(sys.argv[3])}
+base="../../scenarios/sweeps/"
+j["scenarios"]=[({**s,"file":base+s["file"]} if isinstance(s,dict) else base+s) for s in j["scenarios"]]
+open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$1" "$3" "$2"
+}
+
 # The paper suite: scenarios/sweeps/paper_suite.json holds every paper scenario and the variants the
 # published tables need (three seeds per row); --full runs it with five seeds.
 spec=scenarios/sweeps/paper_suite.json
 if [ $full -eq 1 ]; then
-  mkdir -p results/suites
-  "$PY" -c 'import json,sys; j=json.load(open(sys.argv[1])); j["seeds"]={"first":1,"count":5}
-base="../../scenarios/sweeps/"
-j["scenarios"]=[({**s,"file":base+s["file"]} if isinstance(s,dict) else base+s) for s in j["scenarios"]]
-open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$spec" results/suites/paper_suite.json
+  with_seeds "$spec" 5 results/suites/paper_suite.json
   spec=results/suites/paper_suite.json
 fi
 phase "2/6 paper suite: $spec"
@@ -45,11 +50,7 @@ results=(results/sweeps/paper_suite)
 # one seed by default, three with --full (issue 29: a profile contradiction needs seed-to-seed spread).
 fr_spec=scenarios/sweeps/paper_suite_field_robot.json
 if [ $full -eq 1 ]; then
-  mkdir -p results/suites
-  "$PY" -c 'import json,sys; j=json.load(open(sys.argv[1])); j["seeds"]={"first":1,"count":3}
-base="../../scenarios/sweeps/"
-j["scenarios"]=[({**s,"file":base+s["file"]} if isinstance(s,dict) else base+s) for s in j["scenarios"]]
-open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$fr_spec" results/suites/paper_suite_field_robot.json
+  with_seeds "$fr_spec" 3 results/suites/paper_suite_field_robot.json
   fr_spec=results/suites/paper_suite_field_robot.json
 fi
 phase "3/6 paper suite under the field_robot profile"
