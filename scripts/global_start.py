@@ -83,6 +83,9 @@ def score_run(rows, half_floor=None):
             t_first = start
             break
     right = [f for f in fr if f[1] and not (f[5] > WRONG_POS or f[4] > WRONG_THETA)]
+    # A particle filter's spread (frames.csv spread_m, MCL) on the right frames: what sets its error there.
+    spreads = [float(r["spread_m"]) for r, f in zip(rows, fr) if r.get("spread_m") not in (None, "")
+               and f[1] and not (f[5] > WRONG_POS or f[4] > WRONG_THETA)]
     wrong = sum(1 for f in fr if f[1] and (f[5] > WRONG_POS or f[4] > WRONG_THETA))
     valid = [f for f in fr if f[1]]
     return {
@@ -92,6 +95,7 @@ def score_run(rows, half_floor=None):
         "max_x": max((f[2] for f in right), default=0.0), "max_y": max((f[3] for f in right), default=0.0),
         "valid_frames": len(valid), "sum_pos_all": sum(f[5] for f in valid),
         "outside_walls_frames": outside, "outside_walls_any_frames": outside_any,
+        "sum_spread": sum(spreads), "spread_frames": len(spreads),
     }
 
 
@@ -123,6 +127,8 @@ def summarise(per_run):
         "all_mean_pos_cm": 100 * sum(r["sum_pos_all"] for r in per_run) / nv if nv else None,
         "outside_walls_frames": sum(r["outside_walls_frames"] for r in per_run),
         "outside_walls_any_frames": sum(r["outside_walls_any_frames"] for r in per_run),
+        "right_mean_spread_cm": (100 * sum(r.get("sum_spread", 0.0) for r in per_run) / ns
+                                 if (ns := sum(r.get("spread_frames", 0) for r in per_run)) else None),
     }
 
 

@@ -42,7 +42,21 @@ TABLE_COLS = ["mean x cm", "mean y cm", "mean th rad", "std x cm", "std y cm", "
 
 
 def load_papers():
-    return json.loads(PAPERS.read_text())
+    """papers.json (the published figures and the rules that judge ours), with each claim's causes
+    from causes.json beside it (our explanations of the verdicts that do not hold: kept apart, so the
+    papers' record holds only what the papers say)."""
+    papers = json.loads(PAPERS.read_text())
+    causes_file = PAPERS.with_name("causes.json")
+    if causes_file.exists():
+        causes = json.loads(causes_file.read_text()).get("claims", {})
+        ids = {c["id"] for c in papers.get("claims", [])}
+        unknown = sorted(set(causes) - ids)
+        if unknown:
+            raise ValueError(f"{causes_file}: causes for unknown claim(s) {', '.join(unknown)} (claims: {', '.join(sorted(ids))})")
+        for c in papers.get("claims", []):
+            if c["id"] in causes:
+                c["causes"] = causes[c["id"]]
+    return papers
 
 
 def _skip_dir(d):

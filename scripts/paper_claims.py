@@ -13,6 +13,7 @@ import math
 import pathlib
 import statistics
 
+import global_start as G
 import omniloc_results as R
 
 
@@ -137,6 +138,18 @@ def quantity(q, ctx):
         if q.get("sum"):
             return sum(per_run), f"n={len(per_run)}"
         return sum(per_run) / len(per_run), f"n={len(per_run)}"
+    if "where" in q:
+        # A row of a list in an experiment's JSON picked by its fields, e.g. the error budget's
+        # {"source": "vibration", "localizer": "matching"}: robust to rows added or reordered.
+        j = ctx.experiment_json(q["experiment"], q["file"])
+        if j is None:
+            return None, f"not run: build/omniloc experiment {q['experiment']}"
+        found, rows = R.pointer(j, q.get("list", ""))
+        hit = [r for r in (rows if found and isinstance(rows, list) else []) if isinstance(r, dict) and all(r.get(k) == v for k, v in q["where"].items())]
+        v = hit[0].get(q["field"]) if hit else None
+        if not isinstance(v, (int, float)) or isinstance(v, bool):
+            return None, f"{q['file']}{q.get('list', '')} has no {q['field']} where {q['where']}"
+        return float(v), q["experiment"]
     if "experiment" in q:
         j = ctx.experiment_json(q["experiment"], q["file"])
         if j is None:
@@ -145,6 +158,40 @@ def quantity(q, ctx):
         if not found or not isinstance(v, (int, float)) or isinstance(v, bool):
             return None, f"{q['file']}{q['pointer']} absent"
         return float(v), q["experiment"]
+    if "global_start" in q:
+        # Per-run judgement of a global-start row (scripts/global_start.py): success rate, error
+        # while right, wrong frames; the statistic a mean over every frame hides (issue 29).
+        try:
+            key, defaults, command = row_key(ctx.papers, *q["global_start"])
+        except KeyError as e:
+            return None, str(e)
+        sel = R.select(ctx.runs, key, defaults)
+        if not sel:
+            return None, f"not run: {command}"
+        per_run = [G.score_run(r.frames()) for r in sel]
+        if not any(p["frames"] for p in per_run):
+            return None, f"no frames.csv in {len(sel)} run(s)"
+        v = G.summarise(per_run).get(q["stat"])
+        if not isinstance(v, (int, float)) or isinstance(v, bool):
+            return None, f"{q['stat']} undefined over {len(sel)} run(s)"
+        return float(v), f"n={len(sel)} runs, per run"
+    if "expr" in q:
+        # A formula over other quantities (names in "vars", math functions only), for evidence
+        # such as a quadrature gap: written out in papers.json next to what it argues.
+        vals, notes = {}, []
+        for name, sub in q["vars"].items():
+            v, note = (float(sub), "") if isinstance(sub, (int, float)) else quantity(sub, ctx)
+            if v is None:
+                return None, note
+            vals[name] = v
+            if note:
+                notes.append(note)
+        env = {k: getattr(math, k) for k in ("sqrt", "log", "exp", "pi", "atan2", "degrees", "radians", "hypot")}
+        env.update(max=max, min=min, abs=abs)
+        try:
+            return float(eval(q["expr"], {"__builtins__": {}}, dict(env, **vals))), "; ".join(dict.fromkeys(notes))  # noqa: S307 (our own data file)
+        except (ZeroDivisionError, ValueError) as e:
+            return None, f"{q['expr']}: {e}"
     if "timing" in q:
         med, frames, sel = timing_ms(ctx.papers, q["timing"][1], ctx.runs)
         if not sel:
@@ -183,9 +230,10 @@ def _has(q, key):
     """Whether a quantity selector (or any of its parts) uses `key` ("row", "timing", "experiment")."""
     if not isinstance(q, dict):
         return False
-    if key in q:
+    if key in q or (key == "row" and "global_start" in q):
         return True
-    return any(_has(x, key) for x in (q.get("ratio") or q.get("fraction") or []))
+    parts = list(q.get("ratio") or q.get("fraction") or []) + list((q.get("vars") or {}).values())
+    return any(_has(x, key) for x in parts)
 
 
 def claim_kind(c):
@@ -337,3 +385,68 @@ def totals_text(t):
         if d:
             parts.append(f"{kind}: " + ", ".join(f"{d[v]} {v}" for v in order if d.get(v)))
     return "; ".join(parts)
+
+
+# ---- causes: why a verdict is not "holds" (issue 29) ----------------------------------------------
+# A claim in papers.json may carry "causes": [{"verdicts": [...], "profiles": [...], "text": ...,
+# "doc": "docs/FILE.md#anchor", "evidence": [{"label", "ours": selector, "unit", "expect": [lo, hi]}]}].
+# A cause is an argument that rests on measurements: each evidence item is a quantity read from the
+# results given to the report, and "expect" is the range in which it supports the argument. So a cause
+# whose numbers change under a later model says so ("evidence contradicts") instead of standing as text.
+
+EXPLAINED, NOT_MEASURED, CONTRADICTED, UNEXPLAINED = "explained", "evidence not in these results", "evidence contradicts the cause", "no cause recorded"
+
+
+def _applies(cause, verdict, profile):
+    return verdict in cause.get("verdicts", ["partly", "does not"]) and profile in cause.get("profiles", ["robot", "field_robot"])
+
+
+def explain(claims, ctx, profile="robot"):
+    """One row per claim of `claims` (evaluate_claims' output for ctx) whose verdict is neither
+    "holds" nor "not run" / "n/a": {"id", "paper", "claim", "verdict", "profile", "status", "text",
+    "doc", "evidence": [{"label", "value", "unit", "expect", "ok", "note"}]}. status: explained (every
+    evidence item measured and inside its range), evidence not in these results, evidence contradicts
+    the cause, or no cause recorded."""
+    by_id = {c["id"]: c for c in ctx.papers.get("claims", [])}
+    out = []
+    for c in claims:
+        if c["verdict"] in ("holds", "not run", "n/a"):
+            continue
+        causes = [k for k in by_id.get(c["id"], {}).get("causes", []) if _applies(k, c["verdict"], profile)]
+        row = {"id": c["id"], "paper": c["paper"], "claim": c["claim"], "verdict": c["verdict"], "profile": profile,
+               "status": UNEXPLAINED, "text": "", "doc": "", "evidence": []}
+        if causes:
+            k = causes[0]
+            row["text"], row["doc"] = k["text"], k.get("doc", "")
+            for ev in k.get("evidence", []):
+                v, note = quantity(ev["ours"], ctx)
+                lo, hi = ev.get("expect", [-math.inf, math.inf])
+                ok = None if v is None else (lo - 1e-12 <= v <= hi + 1e-12)
+                row["evidence"].append({"label": ev["label"], "value": v, "unit": ev.get("unit", ""), "expect": ev.get("expect"), "ok": ok, "note": note})
+            oks = [e["ok"] for e in row["evidence"]]
+            row["status"] = CONTRADICTED if False in oks else NOT_MEASURED if (None in oks or not oks) else EXPLAINED
+        out.append(row)
+    return out
+
+
+def _sig(v):
+    """Three significant figures, no exponent for the magnitudes the causes use."""
+    if v is None or not math.isfinite(v):
+        return "-"
+    if v == 0:
+        return "0"
+    digits = max(0, 2 - int(math.floor(math.log10(abs(v)))))
+    return f"{v:.{digits}f}"
+
+
+def evidence_text(e):
+    """'label: 0.12 deg/cm (expected 0-0.2)' for the report and the terminal."""
+    if e["value"] is None:
+        return f"{e['label']}: not measured ({e['note']})"
+    rng = ""
+    if e["expect"]:
+        lo, hi = e["expect"]
+        rng = f" (argument needs {_sig(lo)} to {_sig(hi)})" if lo > -1e11 and hi < 1e11 else \
+              f" (argument needs at least {_sig(lo)})" if hi >= 1e11 else f" (argument needs at most {_sig(hi)})"
+    mark = "" if e["ok"] else " — CONTRADICTS"
+    return f"{e['label']}: {_sig(e['value'])}{(' ' + e['unit']) if e['unit'] else ''}{rng}{mark}"
