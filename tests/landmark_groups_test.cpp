@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "core/json_reader.hpp"
 #include "core/rng.hpp"
 #include "experiments/experiment.hpp"
+#include "experiments/landmark_maps.hpp"
 #include "localization/landmarks/landmark_groups.hpp"
 
 using namespace omniloc;
@@ -128,6 +130,7 @@ TEST(LandmarkGroups, VotingRejectsAnOutlier) {
   EXPECT_FALSE(r.forced);
   EXPECT_EQ(r.votes, 3);
   EXPECT_EQ(r.fix_votes, (std::vector<int>{1, 3, 3, 3}));  // the outlier has only its own vote
+  EXPECT_EQ(r.members, (std::vector<int>{1, 2, 3}));       // the average accepted last: the best-voted fix first
   EXPECT_NEAR(r.position.x, (1.0 + 1.1 + 0.95) / 3, 1e-12);
   EXPECT_NEAR(r.position.y, (1.0 + 0.9 + 1.1) / 3, 1e-12);
   EXPECT_NEAR(r.position.theta, 0.0966, 1e-3);
@@ -165,6 +168,7 @@ TEST(LandmarkGroups, DeadlockAcceptsAfterMoreThanThreeFrames) {
   for (int k = 1; k <= 4; ++k) {
     const VoteResult r = v.vote(outside, region);
     EXPECT_FALSE(r.accepted) << "frame " << k;
+    EXPECT_TRUE(r.members.empty());
     EXPECT_EQ(r.deadlock, k);
     EXPECT_EQ(r.position.x, 0.0);  // the last position is kept
   }
@@ -205,6 +209,7 @@ TEST(LandmarkGroups, BestVotedOutsideRegionKeepsThePlausibleOne) {
     EXPECT_TRUE(r.accepted);
     EXPECT_EQ(r.votes, 1);
     EXPECT_EQ(r.position.x, 1.0);
+    EXPECT_EQ(r.members, (std::vector<int>{fixes == &a ? 0 : 2}));
   }
 }
 
@@ -309,5 +314,83 @@ TEST(LandmarkMapsExperiment, QuickRunWritesItsFiles) {
     EXPECT_TRUE(std::isfinite(a["fixes_max_m"].get<double>())) << c;
   }
   EXPECT_NE(out.str().find("table 1"), std::string::npos);
+
+  // Paper 004 as printed (table1_004.json, /as_printed): the numbers that follow from the published table
+  // alone are exact; the Monte Carlo ones (2000 trials in quick mode) within their sampling spread.
+  const auto& ap = t["as_printed"];
+  ASSERT_TRUE(ap["computed"].get<bool>());
+  EXPECT_NEAR(ap["published_ratio"].get<double>(), (106.775 + 131.4) / 2 / ((38.601 + 19.647 + 11.045) / 3) /
+                                                       ((18.385 + 38.275) / 2 / ((30.0 + 13.601 + 7.211) / 3)), 1e-12);
+  for (const auto& row : ap["rows"]) EXPECT_TRUE(row["same_set"].get<bool>());
+  EXPECT_NEAR(ap["rows"][2]["implied_two_circle"]["diff_deg"][1].get<double>(), 45.92, 0.01);   // (75, 100): theta2 off by 46 deg
+  EXPECT_NEAR(ap["rows"][4]["implied_two_circle"]["diff_deg"][1].get<double>(), -53.94, 0.01);  // (410, 83)
+  EXPECT_NEAR(ap["sigma"]["ml_deg"].get<double>(), 5.014, 0.001);
+  const double s_match = ap["sigma"]["mean_match_deg"].get<double>();
+  EXPECT_GT(s_match, 1.4);
+  EXPECT_LT(s_match, 2.1);
+  // Same bearings, same point: with independent draws per method the two-circle error is above the
+  // three-point one at all five positions with probability 1/32 (0.031; 2000 trials: sd 0.004).
+  for (const char* m : {"mean_match", "ml"}) {
+    const auto& mc = ap["monte_carlo"][m];
+    EXPECT_NEAR(mc["p_two_circle_worse_at_all_five"].get<double>(), 1.0 / 32, 0.015) << m;
+    EXPECT_NEAR(mc["median_ratio"].get<double>(), 1.0, 0.15) << m;
+  }
+  EXPECT_EQ(ap["monte_carlo"]["mean_match"]["n_both_edges_ge_published_two_circle"].get<long>(), 0);
+
+  // Paper 003's voting bound (sim_003.json, /paper_memory/voting_cause).
+  const auto& vc = sim["paper_memory"]["voting_cause"];
+  const auto& dist = vc["error_distribution"];
+  EXPECT_EQ(dist["max_m"].get<double>(), sim["paper_memory"]["all_paths"]["voting_max_m"].get<double>());
+  EXPECT_LE(dist["p50_m"].get<double>(), dist["p95_m"].get<double>());
+  EXPECT_LE(dist["p95_m"].get<double>(), dist["p99_m"].get<double>());
+  EXPECT_LE(dist["p99_m"].get<double>(), dist["max_m"].get<double>());
+  EXPECT_EQ(dist["frames_over_1m"].get<long>(),
+            dist["over_1m_accepted"].get<long>() + dist["over_1m_kept_with_fixes"].get<long>() + dist["over_1m_kept_without_fix"].get<long>());
+  EXPECT_EQ(dist["frames"].get<long>(), sim["paper_memory"]["all_paths"]["frames"].get<long>());
+  for (const char* w : {"worst", "worst_accepted"}) {
+    const auto& f = vc[w];
+    ASSERT_TRUE(f.is_object()) << w;
+    // estimate - truth = (estimate - truth at the source) + (truth at the source - truth now)
+    EXPECT_LE(f["err_m"].get<double>(), f["source_err_m"].get<double>() + f["stale_m"].get<double>() + 1e-12) << w;
+    EXPECT_GE(f["err_m"].get<double>(), std::fabs(f["source_err_m"].get<double>() - f["stale_m"].get<double>()) - 1e-12) << w;
+    if (f["accepted"].get<bool>()) {
+      EXPECT_EQ(f["stale_m"].get<double>(), 0.0) << w;
+    }
+    EXPECT_GE(f["dilution_m_per_m"].get<double>(), 0.0) << w;
+  }
+  EXPECT_TRUE(vc["worst_accepted"]["accepted"].get<bool>());
+  EXPECT_FALSE(sim["paper_consecutive"].contains("voting_cause"));
+  // Paper 003's own real run (its table 1): waypoint 6, (-1000, 4000) mm measured at (447, 4412) mm.
+  EXPECT_NEAR(sim["paper_real_run"]["max_error_m"].get<double>(), std::hypot(1447.0, 412.0) / 1000, 1e-12);
+  EXPECT_EQ(sim["paper_real_run"]["max_at_waypoint"].get<int>(), 6);
   fs::remove_all(dir);
+}
+
+// Dilution of a group fix with respect to its landmarks' coordinates (landmark_maps.hpp, fix_dilution):
+// two exact identities of bearing-only positioning.
+TEST(LandmarkMapsExperiment, FixDilutionIdentities) {
+  const std::array<Eigen::Vector2d, 3> lm = {Eigen::Vector2d(-4, -4), Eigen::Vector2d(-4, 4), Eigen::Vector2d(4, -4)};
+  const Pose2 robot(0.7, -1.2, 0.4);
+  std::array<double, 3> b{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector2d rel = robot.inverse_transform(lm[k]);
+    b[k] = std::atan2(rel.y(), rel.x());
+  }
+  // Moving every landmark by the same vector moves the fix by that vector: with one common direction u,
+  // J0 + J1 + J2 = u, so distance errors of +1 m each give exactly a 1 m fix error.
+  const Eigen::Vector2d u = Eigen::Vector2d(0.6, 0.8);
+  const auto same = experiments::fix_dilution(lm, b, {u, u, u});
+  const Eigen::Vector2d sum = same.J[0] + same.J[1] + same.J[2];
+  EXPECT_NEAR(sum.x(), u.x(), 1e-6);
+  EXPECT_NEAR(sum.y(), u.y(), 1e-6);
+  EXPECT_GE(same.worst, 1.0 - 1e-6);
+  // Scaling the landmarks about the robot leaves every bearing from it unchanged, so the fix stays: along
+  // the lines of sight from the robot, sum |L_k - robot| J_k = 0.
+  std::array<Eigen::Vector2d, 3> dirs;
+  for (std::size_t k = 0; k < 3; ++k) dirs[k] = (lm[k] - robot.translation()).normalized();
+  const auto los = experiments::fix_dilution(lm, b, dirs);
+  Eigen::Vector2d z = Eigen::Vector2d::Zero();
+  for (std::size_t k = 0; k < 3; ++k) z += (lm[k] - robot.translation()).norm() * los.J[k];
+  EXPECT_NEAR(z.norm(), 0.0, 1e-6);
+  EXPECT_TRUE(std::isfinite(los.worst));
 }

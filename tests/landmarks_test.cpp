@@ -14,6 +14,7 @@
 
 #include "core/angles.hpp"
 #include "core/rng.hpp"
+#include "experiments/landmark_maps.hpp"
 #include "localization/landmarks/landmark_solvers.hpp"
 #include "testing/scenes.hpp"
 
@@ -444,4 +445,92 @@ TEST(Landmarks, NeverNaNNearTheSingularSetsOrOnInconsistentBearings) {
     for (auto& o : obs) o.bearing = rng.uniform(-10, 10);  // bearings of no consistent pose
     check(obs, "random bearings");
   }
+}
+
+// --- Paper 004 as printed (experiments/landmark_maps.hpp): landmark choice and implied bearing errors ------
+
+namespace {
+Eigen::Vector2d fix_position(const std::array<Eigen::Vector2d, 3>& L, const Eigen::Vector2d& p, const std::array<double, 3>& err_rad) {
+  std::array<BearingObs, 3> obs;
+  for (std::size_t k = 0; k < 3; ++k) obs[k] = {L[k], std::atan2(L[k].y() - p.y(), L[k].x() - p.x()) - 0.3 + err_rad[k]};  // heading 0.3
+  const Fix f = total_like(obs);
+  EXPECT_TRUE(f.ok) << f.reason;
+  return {f.pose.x, f.pose.y};
+}
+}  // namespace
+
+TEST(LandmarkMapsAsPrinted, ImpliedBearingsZeroAtTheTruth) {
+  const std::array<Eigen::Vector2d, 3> L = {Eigen::Vector2d(0, 1.5), Eigen::Vector2d(0, 2.5), Eigen::Vector2d(6, 1.5)};
+  const auto ib = experiments::implied_bearings(L, {0.75, 1.0}, {0.75, 1.0});
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(ib.diff_deg[k], 0.0);
+    EXPECT_EQ(ib.min_bearing_deg[k], 0.0);
+  }
+  EXPECT_EQ(ib.norm_deg, 0.0);
+}
+
+TEST(LandmarkMapsAsPrinted, ImpliedBearingsHandComputed) {
+  // Posts A (-1, 0), B (1, 0), C (0, 2). The truth (0, -1) sees A at 135, B at 45, C at 90 degrees:
+  // angles A-B, B-C, A-C = 90, -45, 45. The estimate (0, -2) sees A at 90 + a, B at 90 - a, C at 90, with
+  // a = atan(1/2) in degrees: angles 2a, -a, a. Changes: 2a - 90, 45 - a, a - 45; the smallest zero-sum
+  // bearing errors are (a - 45, 45 - a, 0) (by symmetry C's bearing need not move).
+  const std::array<Eigen::Vector2d, 3> L = {Eigen::Vector2d(-1, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(0, 2)};
+  const double a = rad2deg(std::atan(0.5));
+  const auto ib = experiments::implied_bearings(L, {0, -1}, {0, -2});
+  EXPECT_NEAR(ib.diff_deg[0], 2 * a - 90, 1e-12);
+  EXPECT_NEAR(ib.diff_deg[1], 45 - a, 1e-12);
+  EXPECT_NEAR(ib.diff_deg[2], a - 45, 1e-12);
+  EXPECT_NEAR(ib.min_bearing_deg[0], a - 45, 1e-12);
+  EXPECT_NEAR(ib.min_bearing_deg[1], 45 - a, 1e-12);
+  EXPECT_NEAR(ib.min_bearing_deg[2], 0.0, 1e-12);
+  EXPECT_NEAR(ib.norm_deg, std::sqrt(2.0) * (45 - a), 1e-12);
+  // They are what the camera would have to measure: an exact fix from the true bearings plus these
+  // errors lands on the estimate.
+  const Eigen::Vector2d q = fix_position(L, {0, -1}, {deg2rad(ib.min_bearing_deg[0]), deg2rad(ib.min_bearing_deg[1]), deg2rad(ib.min_bearing_deg[2])});
+  EXPECT_NEAR(q.x(), 0.0, 1e-9);
+  EXPECT_NEAR(q.y(), -2.0, 1e-9);
+}
+
+TEST(LandmarkMapsAsPrinted, SinglePostFit) {
+  const std::array<Eigen::Vector2d, 3> L = {Eigen::Vector2d(0, 1.5), Eigen::Vector2d(0, 2.5), Eigen::Vector2d(6, 1.5)};
+  const Eigen::Vector2d truth(0.75, 1.0);
+  // An estimate made by an error of post 2 alone is reproduced exactly by post 2 alone.
+  const Eigen::Vector2d e = fix_position(L, truth, {0, 0, deg2rad(3.0)});
+  const auto fit2 = experiments::single_post_fit(L, truth, e, 2);
+  EXPECT_NEAR(fit2.error_deg, 3.0, 1e-7);
+  EXPECT_NEAR(fit2.miss, 0.0, 1e-9);
+  // Post 0 alone cannot: its best point lies on the circle through posts 1, 2 and the truth, and the fix
+  // from its error is exactly that point.
+  const auto fit0 = experiments::single_post_fit(L, truth, e, 0);
+  EXPECT_GT(fit0.miss, 1e-3);
+  const Eigen::Vector2d q = fix_position(L, truth, {deg2rad(fit0.error_deg), 0, 0});
+  EXPECT_NEAR(q.x(), fit0.point.x(), 1e-9);
+  EXPECT_NEAR(q.y(), fit0.point.y(), 1e-9);
+  // No error: zero, wherever the estimate is the truth.
+  const auto none = experiments::single_post_fit(L, truth, truth, 1);
+  EXPECT_NEAR(none.error_deg, 0.0, 1e-12);
+  EXPECT_NEAR(none.miss, 0.0, 1e-12);
+  // Truth on the line through the other two posts: no circle, NaN.
+  EXPECT_TRUE(std::isnan(experiments::single_post_fit(L, {0, 4}, e, 2).error_deg));
+}
+
+TEST(LandmarkMapsAsPrinted, BothRulesPickTheSamePosts) {
+  // Paper 004 sec. 2.2 (the nearer goal's two posts and the other goal's nearer post) and sec. 2.3 (the
+  // three nearest posts) choose the same three posts: at the five table positions ...
+  const experiments::Field004 f;
+  const std::array<std::array<int, 3>, 5> two_circle = {{{0, 1, 3}, {0, 1, 2}, {0, 1, 2}, {3, 2, 0}, {3, 2, 0}}};
+  for (std::size_t k = 0; k < 5; ++k) {
+    const auto c = experiments::choose_posts_004(f, experiments::kTable1True[k] / 100.0);
+    EXPECT_EQ(c.two_circle, two_circle[k]) << k;
+    EXPECT_TRUE(c.same_set) << k;
+    EXPECT_EQ(c.d1_tie, k == 0) << k;             // (300, 315): on the centre line
+    EXPECT_EQ(c.third_tie, k == 0 || k == 1 || k == 3) << k;  // and y = 200 cm: the far goal's posts equally near
+    const auto alt = experiments::choose_posts_004(f, experiments::kTable1True[k] / 100.0, true);
+    EXPECT_TRUE(alt.same_set) << k;
+  }
+  const auto alt = experiments::choose_posts_004(f, experiments::kTable1True[0] / 100.0, true);
+  EXPECT_EQ(alt.two_circle, (std::array<int, 3>{3, 2, 1}));  // the tie the other way: the blue goal is D1
+  // ... and everywhere on the field (the farthest post is always the far goal's farther post).
+  for (double x = 0.025; x < 6.0; x += 0.05)
+    for (double y = 0.025; y < 4.0; y += 0.05) ASSERT_TRUE(experiments::choose_posts_004(f, {x, y}).same_set) << x << " " << y;
 }

@@ -114,10 +114,15 @@ VoteResult FixVoter::vote(std::span<const Pose2> fixes, const PlausibleRegion& r
     return std::hypot(a.x - b.x, a.y - b.y) < params_.position_tol && std::fabs(angle_diff(a.theta, b.theta)) < params_.heading_tol;
   };
   std::vector<Pose2> cluster;
+  std::vector<int> members;
   for (std::size_t i = 0; i < n; ++i) {
     cluster.assign(1, fixes[i]);
+    members.assign(1, static_cast<int>(i));
     for (std::size_t j = params_.later_only ? i + 1 : 0; j < n; ++j)
-      if (j != i && agree(fixes[i], fixes[j])) cluster.push_back(fixes[j]);
+      if (j != i && agree(fixes[i], fixes[j])) {
+        cluster.push_back(fixes[j]);
+        members.push_back(static_cast<int>(j));
+      }
     const int vote = static_cast<int>(cluster.size());
     r.fix_votes[i] = vote;
     if (vote > maxvote || !visflag) {
@@ -128,6 +133,7 @@ VoteResult FixVoter::vote(std::span<const Pose2> fixes, const PlausibleRegion& r
         visflag = true;
         r.forced = !inside;
         r.votes = vote;
+        r.members = members;
         position_ = average;
       }
     }

@@ -131,6 +131,10 @@ struct VoteResult {
   int votes = 0;               ///< votes of the accepted average; 0 when !accepted
   int deadlock = 0;            ///< the deadlock count after the frame
   std::vector<int> fix_votes;  ///< votes of each fix (itself included)
+  /// Indices (into the frame's fixes) of the fixes averaged into the accepted position, the best-voted
+  /// fix first; empty when !accepted. Lets a caller split an accepted position's error into the
+  /// errors of the fixes it came from (experiments/landmark_maps.cpp, paper 003's voting bound).
+  std::vector<int> members;
 };
 
 /// Paper 003's voting over the fixes of one frame, with the state it keeps between frames (the last
