@@ -14,6 +14,8 @@ const ParamList<ScanLineParams>& ScanLineParams::params() {
       positive_param("line_width", &P::line_width, 1.0, "m", "the field's painted line width"),
       number_param("width_factor", &P::width_factor, 1.0, 20.0, "", "a white run may be this many times the expected width (oblique crossings)"),
       number_param("width_slack_px", &P::width_slack_px, 0.0, 20.0, "px", "... plus this many pixels (blur)"),
+      number_param("min_width_factor", &P::min_width_factor, 0.0, 1.0, "",
+                   "a white run must be at least this many times the expected width, less width_slack_px (a ray crosses a line over at least its width)"),
       integer_param("max_gap", &P::max_gap, 0, 10, "unknown pixels allowed between green and white (anti-aliasing)"),
       number_param("dark_mean", &P::dark_mean, 0.0, 255.0, "grey level", "mean grey below this: the camera is covered, no observation"),
   };
@@ -26,6 +28,10 @@ ScanLineParams ScanLineParams::from_json(JsonReader& r) {
   return p;
 }
 
+namespace {
+constexpr double kStep = 0.5;  ///< px between the radii a scan line samples (each pixel taken once)
+}  // namespace
+
 LineDetector::LineDetector(const ScanLineParams& p, const CalibrationMap& map, const ColourTable& table) : p_(p), map_(map), table_(table) {
   const Eigen::Vector2d c = map.centre();
   for (int k = 0; k < p.rays; ++k) {
@@ -33,7 +39,7 @@ LineDetector::LineDetector(const ScanLineParams& p, const CalibrationMap& map, c
     const Eigen::Vector2d dir(-std::sin(b), -std::cos(b));
     std::vector<Sample> ray;
     int last_u = -1, last_v = -1;
-    for (double r = map.min_radius() + 1.0; r <= map.max_radius(); r += 0.5) {
+    for (double r = map.min_radius() + 1.0; r <= map.max_radius(); r += kStep) {
       const auto d = map.ground_distance(r, b);
       if (!d) continue;
       if (*d > p.max_distance) break;
@@ -74,10 +80,17 @@ ScanResult LineDetector::detect(const Image& img) const {
           int white_end = i - 1;
           while (white_end > white_start && table_.classify(img.row(ray[white_end].v) + 3 * ray[white_end].u) != kLineWhite) --white_end;
           if (i - white_end - 1 <= p_.max_gap) {
-            const double len = ray[white_end].r - ray[white_start].r + 0.5;
+            // The run spans from where the ray enters its first white pixel to where it enters the
+            // next one (ray[white_end + 1] exists: the green sample i lies beyond). Each sample's r is
+            // the first 0.5 px step inside its pixel, on average kStep / 2 past the pixel's edge, so the
+            // run's centre is the mean of the two entries less that. (Taking the last white pixel's
+            // entry as the far end put every line point half a pixel, about 1.2 cm at 3 m, short of
+            // the line's centre: issue 29, tests/vision_test.cpp.)
+            const double r_in = ray[white_start].r, r_out = ray[white_end + 1].r;
+            const double len = r_out - r_in;
             const Sample& mid = ray[(white_start + white_end) / 2];
-            if (len <= p_.width_factor * mid.expected_px + p_.width_slack_px) {
-              const double rmid = 0.5 * (ray[white_start].r + ray[white_end].r);
+            if (len <= p_.width_factor * mid.expected_px + p_.width_slack_px && len >= p_.min_width_factor * mid.expected_px - p_.width_slack_px) {
+              const double rmid = 0.5 * (r_in + r_out) - 0.5 * kStep;
               const Eigen::Vector2d dir = (Eigen::Vector2d(mid.u + 0.5, mid.v + 0.5) - map_.centre()).normalized();
               const Eigen::Vector2d pix = map_.centre() + rmid * dir;
               if (auto p = map_.to_robot(pix.x(), pix.y())) {
