@@ -87,6 +87,17 @@ PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int rob
   if (exposure_.enabled && !cond.covered && out.obs.camera_ok) {
     auto ct = controllers_.find(robot_id);
     if (ct == controllers_.end()) ct = controllers_.emplace(robot_id, ExposureController(exposure_, st->second)).first;
+    // A frame taken while a search is running was taken at a trial setting: it is for the entropy
+    // only. Paper 002 sec. 5 stops the robot "till the optimization is finished" so that it need not
+    // localise on such frames; fed to the tracker, an over-exposed trial frame (up to 2000 false line
+    // points under the sun) pulled the pose up to 0.9 m off while the robot stood still (issue 29).
+    // The localizer coasts on odometry instead, which is exact for a robot standing still.
+    const bool trial_frame = ct->second.searching();
+    if (trial_frame) {
+      out.obs.camera_ok = false;
+      out.obs.line_points.clear();
+      out.obs.blobs.clear();
+    }
     const double body = centre_brightness(*img, map_.centre(), 0.8 * map_.min_radius());
     if (ct->second.wants_entropy()) out.entropy = image_entropy(*img, map_.centre(), map_.max_radius());
     ExposureDecision d = ct->second.update(t, body, out.entropy);

@@ -9,7 +9,9 @@
 #include "core/atomic_file.hpp"
 #include "harness/render_frame.hpp"
 #include "harness/runner.hpp"
+#include "harness/camera_perception.hpp"
 #include "harness/scenario.hpp"
+#include "testing/scenes.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;
@@ -48,4 +50,38 @@ TEST(RenderFrame, ShowsTheFrameTheRunSaw) {
   render_to_png(s, 75 / 30.0, 0, 6, false, other);
   EXPECT_NE(read_file(other), read_file((tmp / "frames" / "r0_000075.png").string()));
   fs::remove_all(tmp);
+}
+
+// Issue 29: a frame taken at one of the entropy search's trial settings is for the entropy only. Fed
+// to the tracker, over-exposed trial frames under the sun (up to 2000 false line points) pulled the
+// pose up to 0.9 m off while the robot stood still; paper 002 sec. 5 stops the robot during the search
+// so that it need not localise on them.
+TEST(CameraPerceptionExposure, FramesAtTrialSettingsCarryNoObservations) {
+  const Scenario s = load_scenario(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/lighting_002_sun.json");
+  CameraPerception p(s, 1);
+  ASSERT_TRUE(p.exposure_params().enabled);
+  sim::WorldState w = scenes::one_robot(s.robots.at(0).spec.start);
+  w.lighting = s.lighting_at(0.0);  // the sun
+  int trial = 0, after = 0;
+  bool searching = false, ended = false;
+  for (int k = 0; k < 60 && !ended; ++k) {
+    const PerceptionOutput o = p.observe(w, 0, k / 30.0, {});
+    if (k == 0) {
+      // The first frame is taken at the initial setting: usable, and it starts the search.
+      EXPECT_TRUE(o.obs.camera_ok);
+      EXPECT_GT(o.obs.line_points.size(), 30u);
+      EXPECT_TRUE(o.stop_robot);
+    } else if (searching) {
+      EXPECT_FALSE(o.obs.camera_ok) << "frame " << k << " was taken at a trial setting";
+      EXPECT_TRUE(o.obs.line_points.empty());
+      ++trial;
+    } else {
+      EXPECT_TRUE(o.obs.camera_ok) << "frame " << k;
+      EXPECT_GT(o.obs.line_points.size(), 30u);
+      ended = ++after >= 3;
+    }
+    searching = o.stop_robot;
+  }
+  EXPECT_GE(trial, 4);  // the search tried several settings, two frames each
+  EXPECT_TRUE(ended);
 }

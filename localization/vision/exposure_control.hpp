@@ -48,6 +48,8 @@ class ExposureController {
   ExposureController(const ExposureParams& p, const CameraSettings& initial);
   /// Whether the next update needs the frame's entropy (computing it costs about a millisecond).
   bool wants_entropy() const { return state_ != State::Idle || (first_ && p_.search_at_start); }
+  /// Whether a search is running, i.e. the next frame is taken at one of its trial settings.
+  bool searching() const { return state_ == State::Searching; }
   /// One frame taken with `current()` at time t (s): its body brightness (0..255) and, if
   /// wants_entropy(), its entropy (nats).
   ExposureDecision update(double t, double body_brightness, double entropy);
