@@ -165,7 +165,7 @@ Json growth_report(const CoopGrowth& g, const Paper001& p, std::ostream& md) {
     growth_json[to_string(f.kind)] = {{"mean", f.mean}, {"std", f.sd}, {"median", f.median}};
   }
   auto paired = [&](const CoopGrowth::Paired& d) {
-    growth_json[std::string(to_string(d.a)) + "_minus_" + to_string(d.b)] = {{"mean", d.mean}, {"se", d.se}, {"a_lower", d.a_lower}};
+    growth_json[std::string(to_string(d.a)) + "_minus_" + to_string(d.b)] = {{"mean", d.mean}, {"se", d.se}, {"a_lower", d.a_lower}, {"runs", g.runs}};
     return strprintf("%.3f +- %.3f (", d.mean, d.se) + to_string(d.a) + strprintf(" lower in %d of %d runs)", d.a_lower, g.runs);
   };
   const std::string d_mf = paired(g.mfbpf_minus_fbpf), d_fp = paired(g.fbpf_minus_pf);

@@ -182,13 +182,17 @@ void collect_cells(const BudgetSweep& b, const std::string& sweep_dir, ErrorBudg
     const Json sj = read_json_strict(summary.string(), summary.string());
     const Json& rob = sj["robots"][0];
     ++cell.runs;
-    cell.rmse_cm += 100.0 * rob["position_m"]["rmse"].get<double>();
-    cell.p50_cm += 100.0 * rob["position_m"]["p50"].get<double>();
-    cell.theta_rmse_deg += rob.value("theta_rmse_rad", 0.0) * 180.0 / 3.141592653589793;
-    cell.wrong_frames += rob.value("wrong_frames", 0L);
+    const ErrorBudgetSeed s{run.seed, 100.0 * rob["position_m"]["rmse"].get<double>(), 100.0 * rob["position_m"]["p50"].get<double>(),
+                            rob.value("theta_rmse_rad", 0.0) * 180.0 / 3.141592653589793, rob.value("wrong_frames", 0L)};
+    cell.rmse_cm += s.rmse_cm;
+    cell.p50_cm += s.p50_cm;
+    cell.theta_rmse_deg += s.theta_rmse_deg;
+    cell.wrong_frames += s.wrong_frames;
+    cell.per_seed.push_back(s);
   }
   for (auto& [key, cell] : r.cells)
     if (cell.runs > 0) {
+      std::sort(cell.per_seed.begin(), cell.per_seed.end(), [](const ErrorBudgetSeed& a, const ErrorBudgetSeed& b) { return a.seed < b.seed; });
       cell.rmse_cm /= cell.runs;
       cell.p50_cm /= cell.runs;
       cell.theta_rmse_deg /= cell.runs;
@@ -274,6 +278,11 @@ Json budget_json(const ErrorBudgetResult& r) {
         row["position_rmse_cm"] = cell.rmse_cm;
         row["position_p50_cm"] = cell.p50_cm;
         row["heading_rmse_deg"] = cell.theta_rmse_deg;
+        Json seeds = Json::array();
+        for (const auto& s : cell.per_seed)
+          seeds.push_back({{"seed", s.seed}, {"position_rmse_cm", s.rmse_cm}, {"position_p50_cm", s.p50_cm},
+                           {"heading_rmse_deg", s.theta_rmse_deg}, {"wrong_frames", s.wrong_frames}});
+        row["per_seed"] = seeds;
       }
       table.push_back(row);
     }

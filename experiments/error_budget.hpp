@@ -44,10 +44,19 @@ ErrorBudgetConfig load_error_budget(const std::string& file);
 void validate_error_budget(const std::string& file);
 
 /// One cell of the table: one row (error source) and one localizer.
+/// One finished run (seed) of a cell: what the means are taken over, kept so that the report can
+/// give each row an interval over the seeds (issue 29) and a reader can see whether a seed matters.
+struct ErrorBudgetSeed {
+  std::uint64_t seed = 0;
+  double rmse_cm = 0, p50_cm = 0, theta_rmse_deg = 0;
+  long wrong_frames = 0;
+};
+
 struct ErrorBudgetCell {
   int runs = 0, failed = 0;
   double rmse_cm = 0, p50_cm = 0, theta_rmse_deg = 0;  ///< means over the runs that finished
   long wrong_frames = 0;                                ///< summed over them
+  std::vector<ErrorBudgetSeed> per_seed;                ///< the finished runs, by seed
 };
 
 struct ErrorBudgetResult {

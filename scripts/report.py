@@ -506,7 +506,10 @@ def scorecard(rep, ctx):
         if kind == "timing":
             cap += f" Ours: median wall time on {machine_text()}."
         rep.table(header + ["rule"], rows, cap)
-    causes = C.explain(claims, ctx, "robot") + (C.explain([field_claims[c["id"]] for c in claims if c["uses_runs"]], fctx, "field_robot") if field_claims else [])
+    causes = C.explain(claims, ctx, "robot")
+    if field_claims:
+        with R.pairing_profile("field_robot"):  # the evidence of the field_robot verdicts is read from its own runs
+            causes += C.explain([field_claims[c["id"]] for c in claims if c["uses_runs"]], fctx, "field_robot")
     causes_section(rep, causes)
     ctext = causes_totals(causes)
     return claims, field_claims, totals + (f" | field_robot: {ftotals}" if ftotals else "") + (f" | {ctext}" if ctext else "")
