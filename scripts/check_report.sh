@@ -2,7 +2,8 @@
 # Opens a report in headless Chromium (Debian's package, installed when missing) and saves a
 # screenshot of the whole page, to check that every table and picture renders in a browser; then
 # checks that every published table of results/reference/papers.json (each top-level key but
-# "comment" and "claims") and the scorecard appear in the report, then runs check_report_html.py
+# "comment" and "claims") and the scorecard appear in the report, that no verdict other than holds is
+# without a cause or with a cause its evidence contradicts, then runs check_report_html.py
 # (size, rendering, raw markdown, absolute paths, scorecard first). Exit 1 when one fails.
 # Usage: scripts/check_report.sh [results/report/report.html] [screenshot.png]
 set -euo pipefail
@@ -28,6 +29,10 @@ keys = [k for k in papers if k not in ("comment", "claims")]
 missing = [k for k in keys if k not in doc]
 if 'id="scorecard"' not in doc:
     missing.append("the reproduction scorecard")
+# Issue 29: every verdict other than holds carries a cause whose evidence these results support.
+for status in ("no cause recorded", "evidence contradicts the cause"):
+    if f">{status}<" in doc:
+        missing.append(f"a cause (the scorecard's 'Why a claim does not hold' table has '{status}')")
 if missing:
     print("check_report: missing from the report: " + ", ".join(missing), file=sys.stderr)
     sys.exit(1)
