@@ -224,6 +224,15 @@ class Report:
                 para.clear()
         while i < len(lines):
             ln = lines[i].rstrip()
+            if ln.startswith("```"):  # a fenced block (an experiment's fixed-width table): kept as it is
+                flush()
+                j = i + 1
+                while j < len(lines) and not lines[j].startswith("```"):
+                    j += 1
+                self.html.append("<pre>" + html.escape("\n".join(lines[i + 1:j])) + "</pre>")
+                kept += lines[i:j + 1]
+                i = j + 1
+                continue
             if ln.startswith("#"):
                 current = ln
                 flush()

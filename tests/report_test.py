@@ -476,6 +476,13 @@ class ReaderReport(unittest.TestCase):
             self.assertIn("href='#error_budget'", doc)
             self.assertIn("<code>scenarios/experiments/error_budget.json</code>", doc)  # path made relative, markdown rendered
             self.assertIn("<b>bold</b>", doc)
+            # A fenced block (landmark_maps' fixed-width table) is kept as preformatted text, not
+            # shown as raw backticks (check_report_html.py flagged it).
+            rep.markdown("## Set-up\n\n```\nposts | d(1,2) <x>\n(75, 100) | 6.35\n```\n\nAfter.\n")
+            doc = "\n".join(rep.html)
+            self.assertIn("<pre>posts | d(1,2) &lt;x&gt;\n(75, 100) | 6.35</pre>", doc)
+            self.assertNotIn("```", doc)
+            self.assertIn("<p>After.</p>", doc)
 
     def test_layout_paths_and_history_page(self):
         with tempfile.TemporaryDirectory() as tmp:
