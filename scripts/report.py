@@ -939,7 +939,7 @@ def error_budget_section(rep, ctx):
         if len(seeds) < 2:
             return fnum(r[key], 2)
         st = R.stats(seeds)
-        if st["sd"] == 0:
+        if max(seeds) - min(seeds) <= 1e-9 * max(1.0, abs(st["mean"])):
             return f"{fnum(st['mean'], 2)} (= every seed)"
         return f"{fnum(st['mean'], 2)} [{fnum(st['lo'], 2)}, {fnum(st['hi'], 2)}]"
     table = []
@@ -996,14 +996,14 @@ def reference_error_text(rep, rows_by_source, ctx):
         wt = math.degrees(math.sqrt(max(0.0, pub_th ** 2 - th ** 2) * math.pi / 2))
         gap = (f" Our tracking row (robot profile, {len(sel)} seed(s)) has mean x {fnum(x, 2)} cm and heading {fnum(math.degrees(th), 2)} deg "
                f"against the papers' {pub_x} cm and {fnum(math.degrees(pub_th), 2)} deg; in quadrature (Gaussian errors, sigma = mean x sqrt(pi/2)) "
-               f"the difference needs a reference that wanders by about {fnum(wx, 1)} cm and yaws by about {fnum(wt, 1)} deg per axis.")
+               f"the difference needs a reference that wanders by about {fnum(wx, 1)} cm and yaws by about {fnum(wt, 1)} deg per axis. "
+               "Those are the magnitudes of a person pushing a 0.5 m robot along a painted line (argued, not measured: no real robot here).")
     rep.para("**Which real-robot error is missing** (issue 29). The papers scored a robot pushed by hand along straight tracks against "
              "those tracks (paper 002 sec. 6), so their reference itself errs; ours is exact. The papers' table has "
              f"{fnum(math.degrees(pub_th) / pub_x, 2)} deg of heading error per cm of position error; the most any row above gives with "
              f"matching is {fnum(top, 2)} deg/cm (`{top_src}`). Every simulated source moves heading and position together, so none of them, "
              "scaled up to the papers' position error, reaches the papers' heading error: an error of the reference, which has no such "
-             f"link, is the missing one.{gap} Those are the magnitudes of a person pushing a 0.5 m robot along a painted line (argued, not "
-             "measured: no real robot here); docs/error_budget.md.")
+             f"link, is the missing one.{gap} See docs/error_budget.md.")
 
 
 def published_tables(rep, papers, ctx):

@@ -742,3 +742,29 @@ class Causes(unittest.TestCase):
             self.assertIn("Why a claim does not hold", md)
             self.assertIn("pushed by hand", md)
             self.assertIn("not measured (not run: build/omniloc experiment error_budget)", md)
+
+
+class ErrorBudgetSeeds(unittest.TestCase):
+    """Issue 29, item 5: the error budget's cells carry an interval over the seeds."""
+
+    def test_cells_show_an_interval_or_that_every_seed_agrees(self):
+        import report
+        seeds = lambda vals: [{"seed": k + 1, "position_rmse_cm": v, "position_p50_cm": v / 2, "heading_rmse_deg": 0.1} for k, v in enumerate(vals)]
+        rows = [{"source": "none (baseline)", "localizer": "matching", "runs": 3, "failed": 0, "position_rmse_cm": 0.6, "position_p50_cm": 0.3,
+                 "heading_rmse_deg": 0.1, "per_seed": seeds([0.6, 0.6, 0.6])},
+                {"source": "vibration", "localizer": "matching", "runs": 3, "failed": 0, "position_rmse_cm": 4.5, "position_p50_cm": 2.25,
+                 "heading_rmse_deg": 0.1, "per_seed": seeds([4.0, 4.5, 5.0])}]
+        with tempfile.TemporaryDirectory() as tmp:
+            e = pathlib.Path(tmp) / "error_budget"
+            e.mkdir()
+            (e / "error_budget.json").write_text(json.dumps({"experiment": "error_budget", "config_file": "x.json", "quick": False, "duration_s": 60.0,
+                                                               "seeds": 3, "first_seed": 1, "sweep": "s", "rows": rows}))
+            ctx = C.Context(R.load_papers(), [], [str(e)])
+            rep = report.Report(pathlib.Path(tmp) / "out", "t")
+            report.error_budget_section(rep, ctx)
+            rep.write()
+            md = (pathlib.Path(tmp) / "out" / "report.md").read_text()
+            self.assertIn("| none (baseline) | 0.60 (= every seed) | 0.30 (= every seed) | 0.10 (= every seed) |", md)
+            self.assertIn("| vibration | 4.50 [4.11, 4.89] |", md)  # exact bootstrap enumeration over the three seeds
+            self.assertIn("Mean over 3 seeds with a 95 % bootstrap interval", md)
+            self.assertIn("Which real-robot error is missing", md)
