@@ -181,18 +181,20 @@ void collect_cells(const BudgetSweep& b, const std::string& sweep_dir, ErrorBudg
     }
     const Json sj = read_json_strict(summary.string(), summary.string());
     const Json& rob = sj["robots"][0];
-    ++cell.runs;
-    const ErrorBudgetSeed s{run.seed, 100.0 * rob["position_m"]["rmse"].get<double>(), 100.0 * rob["position_m"]["p50"].get<double>(),
-                            rob.value("theta_rmse_rad", 0.0) * 180.0 / 3.141592653589793, rob.value("wrong_frames", 0L)};
-    cell.rmse_cm += s.rmse_cm;
-    cell.p50_cm += s.p50_cm;
-    cell.theta_rmse_deg += s.theta_rmse_deg;
-    cell.wrong_frames += s.wrong_frames;
-    cell.per_seed.push_back(s);
+    cell.per_seed.push_back({run.seed, 100.0 * rob["position_m"]["rmse"].get<double>(), 100.0 * rob["position_m"]["p50"].get<double>(),
+                             rob.value("theta_rmse_rad", 0.0) * 180.0 / 3.141592653589793, rob.value("wrong_frames", 0L)});
   }
+  // The cell's figures from its seeds: means of the errors, the wrong frames summed.
   for (auto& [key, cell] : r.cells)
-    if (cell.runs > 0) {
+    if (!cell.per_seed.empty()) {
       std::sort(cell.per_seed.begin(), cell.per_seed.end(), [](const ErrorBudgetSeed& a, const ErrorBudgetSeed& b) { return a.seed < b.seed; });
+      cell.runs = static_cast<int>(cell.per_seed.size());
+      for (const auto& s : cell.per_seed) {
+        cell.rmse_cm += s.rmse_cm;
+        cell.p50_cm += s.p50_cm;
+        cell.theta_rmse_deg += s.theta_rmse_deg;
+        cell.wrong_frames += s.wrong_frames;
+      }
       cell.rmse_cm /= cell.runs;
       cell.p50_cm /= cell.runs;
       cell.theta_rmse_deg /= cell.runs;

@@ -107,6 +107,21 @@ class Context:
         return self._json[k]
 
 
+def _row_runs(ctx, row):
+    """(runs reproducing a published row [table, label], note): the note says why there are none."""
+    try:
+        key, defaults, command = row_key(ctx.papers, *row)
+    except KeyError as e:
+        return [], str(e)
+    sel = R.select(ctx.runs, key, defaults)
+    return sel, ("" if sel else f"not run: {command}")
+
+
+def _number(v):
+    """v as a float when it is a JSON number (not a bool), else None."""
+    return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else None
+
+
 def quantity(q, ctx):
     """(value or None, note) of a quantity selector of papers.json's claims."""
     if q is None:
@@ -120,13 +135,9 @@ def quantity(q, ctx):
             return (math.inf if a > 0 else None), f"{R.fnum(a)} / 0"
         return a / b, f"{R.fnum(a)} / {R.fnum(b)}" + (f" ({na})" if na == nb and na else "")
     if "row" in q:
-        try:
-            key, defaults, command = row_key(ctx.papers, *q["row"])
-        except KeyError as e:
-            return None, str(e)
-        sel = R.select(ctx.runs, key, defaults)
+        sel, note = _row_runs(ctx, q["row"])
         if not sel:
-            return None, f"not run: {command}"
+            return None, note
         metrics = q["metric"] if isinstance(q["metric"], list) else [q["metric"]]
         per_run = []
         for r in sel:
@@ -146,35 +157,26 @@ def quantity(q, ctx):
             return None, f"not run: build/omniloc experiment {q['experiment']}"
         found, rows = R.pointer(j, q.get("list", ""))
         hit = [r for r in (rows if found and isinstance(rows, list) else []) if isinstance(r, dict) and all(r.get(k) == v for k, v in q["where"].items())]
-        v = hit[0].get(q["field"]) if hit else None
-        if not isinstance(v, (int, float)) or isinstance(v, bool):
-            return None, f"{q['file']}{q.get('list', '')} has no {q['field']} where {q['where']}"
-        return float(v), q["experiment"]
+        v = _number(hit[0].get(q["field"]) if hit else None)
+        return (v, q["experiment"]) if v is not None else (None, f"{q['file']}{q.get('list', '')} has no {q['field']} where {q['where']}")
     if "experiment" in q:
         j = ctx.experiment_json(q["experiment"], q["file"])
         if j is None:
             return None, f"not run: build/omniloc experiment {q['experiment']}"
         found, v = R.pointer(j, q["pointer"])
-        if not found or not isinstance(v, (int, float)) or isinstance(v, bool):
-            return None, f"{q['file']}{q['pointer']} absent"
-        return float(v), q["experiment"]
+        v = _number(v) if found else None
+        return (v, q["experiment"]) if v is not None else (None, f"{q['file']}{q['pointer']} absent")
     if "global_start" in q:
         # Per-run judgement of a global-start row (scripts/global_start.py): success rate, error
         # while right, wrong frames; the statistic a mean over every frame hides (issue 29).
-        try:
-            key, defaults, command = row_key(ctx.papers, *q["global_start"])
-        except KeyError as e:
-            return None, str(e)
-        sel = R.select(ctx.runs, key, defaults)
+        sel, note = _row_runs(ctx, q["global_start"])
         if not sel:
-            return None, f"not run: {command}"
+            return None, note
         per_run = [G.score_run(r.frames()) for r in sel]
         if not any(p["frames"] for p in per_run):
             return None, f"no frames.csv in {len(sel)} run(s)"
-        v = G.summarise(per_run).get(q["stat"])
-        if not isinstance(v, (int, float)) or isinstance(v, bool):
-            return None, f"{q['stat']} undefined over {len(sel)} run(s)"
-        return float(v), f"n={len(sel)} runs, per run"
+        v = _number(G.summarise(per_run).get(q["stat"]))
+        return (v, f"n={len(sel)} runs, per run") if v is not None else (None, f"{q['stat']} undefined over {len(sel)} run(s)")
     if "expr" in q:
         # A formula over other quantities (names in "vars", math functions only), for evidence
         # such as a quadrature gap: written out in papers.json next to what it argues.

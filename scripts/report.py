@@ -984,17 +984,16 @@ def reference_error_text(rep, rows_by_source, ctx):
     if not ratios:
         return
     top, top_src = max(ratios)
-    pub_x, pub_th = 5.907, 0.044  # paper 000 / 002 tracking table: mean x cm, mean heading rad
-    key = {"scenario": "tracking", "localizer": "matching", "config": {"/occlusion/fraction": 0.0}}
-    sel = R.select([r for r in ctx.runs if profile_of(r) != "field_robot"], key, {"/occlusion/fraction": 0.0})
-    xs = [r.metric("x_cm/mean") for r in sel if r.metric("x_cm/mean") is not None]
-    ths = [r.metric("theta_rad/mean") for r in sel if r.metric("theta_rad/mean") is not None]
+    # The paper 000 / 002 tracking row, ours (robot profile: the pairing default) and published.
+    row = ["000_tracking", "tracking"]
+    pub_x, pub_th = (C._published_cell(ctx.papers, row, m) for m in ("x_cm/mean", "theta_rad/mean"))
+    x, n_note = C.quantity({"row": row, "metric": "x_cm/mean"}, ctx)
+    th, _ = C.quantity({"row": row, "metric": "theta_rad/mean"}, ctx)
     gap = ""
-    if xs and ths:
-        x, th = sum(xs) / len(xs), sum(ths) / len(ths)
+    if x is not None and th is not None:
         wx = math.sqrt(max(0.0, pub_x ** 2 - x ** 2) * math.pi / 2)
         wt = math.degrees(math.sqrt(max(0.0, pub_th ** 2 - th ** 2) * math.pi / 2))
-        gap = (f" Our tracking row (robot profile, {len(sel)} seed(s)) has mean x {fnum(x, 2)} cm and heading {fnum(math.degrees(th), 2)} deg "
+        gap = (f" Our tracking row (robot profile, {n_note}) has mean x {fnum(x, 2)} cm and heading {fnum(math.degrees(th), 2)} deg "
                f"against the papers' {pub_x} cm and {fnum(math.degrees(pub_th), 2)} deg; in quadrature (Gaussian errors, sigma = mean x sqrt(pi/2)) "
                f"the difference needs a reference that wanders by about {fnum(wx, 1)} cm and yaws by about {fnum(wt, 1)} deg per axis. "
                "Those are the magnitudes of a person pushing a 0.5 m robot along a painted line (argued, not measured: no real robot here).")
