@@ -5,7 +5,7 @@
 namespace omniloc::harness {
 
 Simulation::Simulation(const Scenario& s, std::uint64_t seed, EventLog* log)
-    : sc_(s), log_(log), world_(s.field, 1.0 / s.physics_rate), event_rng_(Rng::stream(seed, "events")) {
+    : sc_(s), log_(log), world_(s.field, s.physics_rate), event_rng_(Rng::stream(seed, "events")) {
   for (const auto& rc : s.robots) {
     world_.add_robot(rc.spec);
     const std::string id = std::to_string(rc.spec.id);
@@ -29,7 +29,9 @@ double Simulation::time() const { return world_.time(); }
 
 void Simulation::advance_to(double t) {
   const double dt = world_.dt();
-  while (world_.time() < t - 1e-9) {
+  // No tolerance: time() is exact in steps, so the loop stops at the first step at or after t
+  // (docs/protocol.md: a frame's t is never before k / camera_rate).
+  while (world_.time() < t) {
     while (next_event_ < sc_.events.size() && sc_.events[next_event_].t <= world_.time() + 1e-9) {
       const Json record = apply_event(sc_.events[next_event_++], *this);
       if (log_) log_->add(record);

@@ -32,8 +32,9 @@ Eigen::Vector2d approach(const Eigen::Vector2d& current, const Eigen::Vector2d& 
 }
 }  // namespace
 
-World::World(const Field& field, double dt) : field_(field), dt_(dt), world_(std::make_unique<b2World>(b2Vec2(0, 0))) {
-  if (!(dt > 0.0 && dt <= 0.1)) throw ConfigError("/physics_rate", std::to_string(1.0 / dt), "a physics step in (0, 0.1] s");
+World::World(const Field& field, double rate_hz)
+    : field_(field), rate_(rate_hz), dt_(1.0 / rate_hz), world_(std::make_unique<b2World>(b2Vec2(0, 0))) {
+  if (!(rate_hz >= 10.0 && rate_hz < 1e9)) throw ConfigError("/physics_rate", std::to_string(rate_hz), "a physics rate of at least 10 Hz (a step of at most 0.1 s)");
   build_static_geometry();
 }
 
@@ -161,7 +162,7 @@ void World::step() {
     r->last_wheel_motion = Pose2(local_start.x(), local_start.y(), r->wheel_omega * dt_);
   }
   world_->Step(static_cast<float>(dt_), 8, 3);
-  t_ += dt_;
+  ++steps_;
   for (auto& r : robots_) {
     bool touching = false;
     for (b2ContactEdge* ce = r->body->GetContactList(); ce; ce = ce->next)
@@ -180,7 +181,7 @@ bool World::in_contact(int robot_id) const { return robot(robot_id).contact; }
 
 WorldState World::state() const {
   WorldState s;
-  s.t = t_;
+  s.t = time();
   for (const auto& r : robots_) {
     RobotState rs;
     rs.id = r->spec.id;

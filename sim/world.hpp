@@ -38,8 +38,10 @@ struct DriveCommand {
 
 class World {
  public:
-  /// dt: fixed physics step, seconds.
-  World(const Field& field, double dt);
+  /// rate_hz: physics steps per second; the fixed step is 1 / rate_hz seconds. Time is kept as a
+  /// step count, so time() after n steps is n / rate_hz exactly rounded (never a sum of rounded
+  /// steps): a frame due at k / camera_rate is taken at the first step whose time() is >= it.
+  World(const Field& field, double rate_hz);
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;
@@ -55,7 +57,8 @@ class World {
   /// Advances one fixed step.
   void step();
 
-  double time() const { return t_; }
+  /// Seconds since the start: steps taken / rate, correctly rounded.
+  double time() const { return static_cast<double>(steps_) / rate_; }
   double dt() const { return dt_; }
   const Field& field() const { return field_; }
   WorldState state() const;
@@ -74,8 +77,9 @@ class World {
   void build_static_geometry();
 
   Field field_;
-  double dt_;
-  double t_ = 0.0;
+  double rate_;  ///< steps per second
+  double dt_;    ///< 1 / rate_, seconds
+  long long steps_ = 0;
   std::unique_ptr<b2World> world_;
   std::vector<RobotSpec> specs_;
   std::vector<std::unique_ptr<Robot>> robots_;

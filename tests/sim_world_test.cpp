@@ -22,7 +22,7 @@ RobotSpec robot_at(int id, double x, double y, double th = 0.0) {
 
 TEST(World, RobotsStayInsideTheWallsUnderRandomPushes) {
   const Field f = Field::preset("msl2012");
-  World w(f, 0.005);
+  World w(f, 200.0);
   for (int i = 0; i < 4; ++i) w.add_robot(robot_at(i, -6.0 + 4.0 * i, 0.5 * i));
   w.set_ball({0, 0}, {3, 1});
   Rng rng(123);
@@ -45,7 +45,7 @@ TEST(World, RobotsStayInsideTheWallsUnderRandomPushes) {
 
 TEST(World, DriveRespectsSpeedAndAccelerationLimits) {
   const Field f = Field::preset("msl2012");
-  World w(f, 0.005);
+  World w(f, 200.0);
   w.add_robot(robot_at(0, -5, 0));
   w.command(0, {{10.0, 0.0}, 0.0});
   // After 0.5 s at 3 m/s^2 the speed is 1.5 m/s; after 3 s it is capped at 4 m/s.
@@ -57,7 +57,7 @@ TEST(World, DriveRespectsSpeedAndAccelerationLimits) {
 
 TEST(World, WheelMotionMatchesTrueMotionWithoutContact) {
   const Field f = Field::preset("msl2012");
-  World w(f, 0.005);
+  World w(f, 200.0);
   w.add_robot(robot_at(0, 0, 0, 0.3));
   OdometrySensor odo(OdometryNoise{}, Rng(1));
   w.command(0, {{1.0, 0.5}, 0.4});
@@ -74,7 +74,7 @@ TEST(World, WheelMotionMatchesTrueMotionWithoutContact) {
 
 TEST(World, CollisionMakesOdometryWrong) {
   const Field f = Field::preset("msl2012");
-  World w(f, 0.005);
+  World w(f, 200.0);
   // Drive into the wall at x = +10: the wheels keep turning, the body stops.
   w.add_robot(robot_at(0, 8.5, 3.0));
   OdometrySensor odo(OdometryNoise{}, Rng(1));
@@ -99,7 +99,7 @@ TEST(World, CollisionMakesOdometryWrong) {
 
 TEST(World, TeleportLeavesNoWheelMotion) {
   const Field f = Field::preset("msl2012");
-  World w(f, 0.005);
+  World w(f, 200.0);
   w.add_robot(robot_at(0, 0, 0));
   w.teleport(0, Pose2(3, 2, 1));
   w.step();
@@ -109,7 +109,7 @@ TEST(World, TeleportLeavesNoWheelMotion) {
 
 TEST(Motion, WaypointsAreReachedInOrder) {
   const Field f = Field::preset("msl2012");
-  World w(f, 0.005);
+  World w(f, 200.0);
   w.add_robot(robot_at(0, 0, 0));
   auto script = MotionScript::from_json(Json::parse(R"({"type": "waypoints", "speed": 2.0, "points": [[2, 0], [2, 2]]})"), "/m", 0);
   for (int k = 0; k < 1200; ++k) {
