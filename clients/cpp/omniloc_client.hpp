@@ -27,6 +27,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -94,7 +95,9 @@ struct Field {
   std::vector<std::string> goal_colours;
   Json raw;  ///< the object as sent (landmarks and any later fields)
 
-  /// Exact distance (metres) from the world point (x, y) to the nearest line centre.
+  /// Exact distance (metres) from the world point (x, y) to the nearest marking: a line's or an
+  /// arc's centre line, or a spot's rim (0 inside a spot). The same distance as omniloc's own
+  /// distance map (core/field.hpp Field::distance_to_marking; tests/field_distance_test.cpp).
   double distance_to_lines(double x, double y) const {
     double best = HUGE_VAL;
     for (const auto& s : segments) {
@@ -115,6 +118,8 @@ struct Field {
           best = std::min(best, std::hypot(x - (a[0] + a[2] * std::cos(e)), y - (a[1] + a[2] * std::sin(e))));
       }
     }
+    // Spots (centre and penalty marks) are filled discs: a point inside is on paint.
+    for (const auto& s : spots) best = std::min(best, std::max(0.0, std::hypot(x - s[0], y - s[1]) - s[2]));
     return best;
   }
 };
@@ -251,6 +256,9 @@ struct Estimate {
   std::optional<std::array<double, 9>> covariance;
   std::string mode;                    ///< empty: not sent
   std::map<std::string, double> extra; ///< empty: not sent (sorted keys: deterministic bytes); not kReservedExtra
+  /// Your own computation time for this frame (ms), written to timing.csv beside the round trip.
+  /// run() fills it with the time update() took when you leave it empty.
+  std::optional<double> compute_ms;
 };
 
 /// Derive from this. Set name/version/needs_start_pose/wants_image in the constructor or ready().
@@ -321,6 +329,10 @@ inline std::string estimate_line(const Estimate& e, long long k) {
       x[key] = check(v, "an extra value");
     }
     m["extra"] = x;
+  }
+  if (e.compute_ms) {
+    if (!(*e.compute_ms >= 0.0) || !std::isfinite(*e.compute_ms)) throw ProtocolError("estimate: compute_ms must be a finite number >= 0");
+    m["compute_ms"] = *e.compute_ms;
   }
   return m.dump() + "\n";
 }
@@ -491,7 +503,9 @@ inline int run(Localizer& loc, std::istream& in, const std::function<void(const 
         const Frame f = detail::parse_frame(msg, image, shape);
         last_k = f.k;
         stage = "in update() of frame " + std::to_string(f.k);
-        const Estimate e = loc.update(f);
+        const auto t0 = std::chrono::steady_clock::now();
+        Estimate e = loc.update(f);
+        if (!e.compute_ms) e.compute_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         send(detail::estimate_line(e, f.k));
       } else if (type == "end") {
         stage = "in end()";

@@ -42,6 +42,7 @@ import math
 import os
 import re
 import sys
+import time
 import traceback
 from dataclasses import dataclass, field as dataclass_field
 from typing import Any, BinaryIO, Dict, List, Optional, Sequence, Tuple
@@ -154,7 +155,9 @@ class Field:
         return pts
 
     def distance_to_lines(self, x: float, y: float) -> float:
-        """Exact distance (metres) from the world point (x, y) to the nearest line centre."""
+        """Exact distance (metres) from the world point (x, y) to the nearest marking: a line's or an
+        arc's centre line, or a spot's rim (0 inside a spot): the distance omniloc's own distance map
+        holds (core/field.hpp, Field::distance_to_marking)."""
         best = math.inf
         for x1, y1, x2, y2 in self.segments:
             ex, ey = x2 - x1, y2 - y1
@@ -169,6 +172,8 @@ class Field:
             else:  # nearest end of the arc
                 for e in (start, start + sweep):
                     best = min(best, math.hypot(x - (cx + r * math.cos(e)), y - (cy + r * math.sin(e))))
+        for cx, cy, r in self.spots:  # centre and penalty marks: filled discs
+            best = min(best, max(0.0, math.hypot(x - cx, y - cy) - r))
         return best
 
 
@@ -367,13 +372,16 @@ class Estimate:
     """The answer to a frame. pose: (x, y, theta) in the world frame (any finite theta).
     valid: False while you have no pose you stand behind (such frames are not scored as localized).
     covariance: 9 numbers, row-major 3x3 over (x, y, theta), m^2/rad^2. mode: a short word
-    ([a-z0-9_], <= 32) written to frames.csv. extra: up to 32 named numbers, columns of frames.csv."""
+    ([a-z0-9_], <= 32) written to frames.csv. extra: up to 32 named numbers, columns of frames.csv.
+    compute_ms: your own computation time for this frame in milliseconds (timing.csv, beside the round
+    trip); run() fills in the time update() took when you leave it None."""
 
     pose: Sequence[float]
     valid: bool = True
     covariance: Optional[Sequence[float]] = None
     mode: Optional[str] = None
     extra: Optional[Dict[str, float]] = None
+    compute_ms: Optional[float] = None
 
     def to_message(self, k: int) -> Dict[str, Any]:
         """The `estimate` message for frame k; ProtocolError when a field would be rejected."""
@@ -402,6 +410,11 @@ class Estimate:
                     raise ProtocolError(f"estimate for frame {k}: extra {key!r} is a column of frames.csv already; choose another name")
                 extra[key] = value
             m["extra"] = extra
+        if self.compute_ms is not None:
+            ms = float(self.compute_ms)
+            if not math.isfinite(ms) or ms < 0:
+                raise ProtocolError(f"estimate for frame {k}: compute_ms must be a finite number >= 0, got {self.compute_ms!r}")
+            m["compute_ms"] = ms
         return m
 
 
@@ -599,9 +612,12 @@ def _run(localizer: Localizer, inp: BinaryIO, writer: _Writer, err: Any) -> int:
                 frame = _parse_frame(msg, parts, shapes)
                 k = frame.k
                 stage = f"in update() of frame {k}"
+                t0 = time.perf_counter()
                 est = localizer.update(frame)
                 if not isinstance(est, Estimate):
                     raise ProtocolError(f"update() of frame {k} returned {type(est).__name__}, not an Estimate")
+                if est.compute_ms is None:  # the time update() took: the client's own compute time
+                    est.compute_ms = (time.perf_counter() - t0) * 1e3
                 writer.send(est.to_message(k))
             elif kind == "end":
                 stage = "in end()"

@@ -236,6 +236,7 @@ class ServeTest(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         out = [json.loads(x) for x in p.stdout.splitlines()]
         self.assertEqual([m["type"] for m in out], ["ready", "estimate", "estimate"])
+        self.assertGreaterEqual(out[2].pop("compute_ms"), 0.0)  # run() reports the time update() took
         self.assertEqual(out[2], {"type": "estimate", "k": 1, "pose": [1.0, 0.0, 0.0], "valid": False})
         self.assertIn(b"frame 1", p.stderr)
         self.assertIn(b"raw fd 1 write", p.stderr)
@@ -288,6 +289,9 @@ class HelperTest(unittest.TestCase):
     def test_estimate_message(self):
         m = olp.Estimate((1, 2, 3), valid=False).to_message(5)
         self.assertEqual(m, {"type": "estimate", "k": 5, "pose": [1.0, 2.0, 3.0], "valid": False})
+        self.assertEqual(olp.Estimate((1, 2, 3), compute_ms=0.25).to_message(5)["compute_ms"], 0.25)
+        with self.assertRaises(olp.ProtocolError):
+            olp.Estimate((0, 0, 0), compute_ms=-1).to_message(0)
         with self.assertRaises(olp.ProtocolError):
             olp.Estimate((0, 0, 0), mode="Bad Mode").to_message(0)
         with self.assertRaises(olp.ProtocolError):
