@@ -28,6 +28,7 @@
 #include "harness/scenario.hpp"
 #include "batch/slurm.hpp"
 #include "batch/sweep.hpp"
+#include "batch/sweep_spec.hpp"
 #include "harness/vision_setup.hpp"
 #include "sim/render/camera_config.hpp"
 #include "sim/render/gl_context.hpp"
@@ -121,8 +122,9 @@ const cli::Command kGlDevices{"gl-devices", "", 0, 0,
                                "renders on under the current OMNILOC_EGL_DEVICE; exit 1 when \"egl\" cannot render.",
                                {}};
 const cli::Command kList{"list", "", 0, 0, "Field presets, motion scripts, event kinds, localizers, noise profiles, experiments.", {}};
-const cli::Command kSchema{"schema", "", 0, 0, "The JSON Schema of scenario files, or (--markdown) the parameter reference docs/localizers.md.",
+const cli::Command kSchema{"schema", "", 0, 0, "The JSON Schema of scenario files (or of sweep files), or (--markdown) the parameter reference docs/localizers.md.",
                            {{"--markdown", "", "the parameter reference instead of the schema"},
+                            {"--sweep", "", "the JSON Schema of sweep files instead"},
                             {"-o", "FILE", "write to FILE (atomically) instead of standard output"}}};
 const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                           "Scenarios x localizers x parameters x seeds, in parallel; aggregate with mean and 95 % interval\n"
@@ -391,7 +393,10 @@ int cmd_colour_calibrate(const cli::Args& a) {
 }
 
 int cmd_schema(const cli::Args& a) {
-  const std::string text = a.has("--markdown") ? harness::parameter_reference() : harness::scenario_schema().dump(2) + "\n";
+  if (a.has("--markdown") && a.has("--sweep")) throw UsageError("--markdown and --sweep: choose one");
+  const std::string text = a.has("--markdown") ? harness::parameter_reference()
+                           : a.has("--sweep")  ? batch::sweep_schema().dump(2) + "\n"
+                                               : harness::scenario_schema().dump(2) + "\n";
   const std::string out = a.value("-o");
   if (out.empty()) {
     std::cout << text;

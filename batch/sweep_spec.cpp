@@ -1,11 +1,13 @@
 #include "batch/sweep_spec.hpp"
 
 #include <filesystem>
+#include <regex>
 #include <set>
 
 #include "core/json_parse.hpp"
 #include "external/external_config.hpp"
 #include "harness/scenario.hpp"
+#include "harness/scenario_schema.hpp"
 
 namespace omniloc::batch {
 
@@ -33,7 +35,14 @@ Json read_json_file(const std::string& path, const std::string& what_path) { ret
 namespace {
 
 using Combo = std::vector<std::pair<std::string, Json>>;       // JSON pointer -> value
-using Localizers = std::vector<std::pair<std::string, Json>>;  // label, localizer JSON (null = scenario's own)
+// One entry of a "localizers" list: its row label, the localizer JSON (null = the scenario's own) and
+// where it stands in the sweep file, so an error in its keys names the sweep's JSON path.
+struct LocalizerEntry {
+  std::string label;
+  Json json;
+  std::string at;
+};
+using Localizers = std::vector<LocalizerEntry>;
 
 // One entry of "scenarios": the scenario file read, with the localizers and parameter combinations it runs with.
 struct ScenarioEntry {
@@ -43,6 +52,21 @@ struct ScenarioEntry {
   std::vector<Combo> combos;
 };
 
+// The row name of localizer entry `lj` at JSON path `at`: its "label" (checked here, before anything
+// reads it as a string), else an external client's script stem (docs/protocol.md), else the type.
+std::string row_label(const Json& lj, const std::string& at) {
+  if (const auto it = lj.find("label"); it != lj.end()) {
+    static const std::regex re("[A-Za-z0-9_.-]{1,64}");
+    if (!it->is_string() || !std::regex_match(it->get<std::string>(), re))
+      throw ConfigError(json_child(at, "label"), json_brief(*it), "a row name: 1-64 characters of [A-Za-z0-9_.-]");
+    return it->get<std::string>();
+  }
+  const auto type = lj.find("type");
+  if (type == lj.end()) return "odometry_only";
+  if (*type == "external") return external::default_label(lj);
+  return type->is_string() ? type->get<std::string>() : std::string("?");
+}
+
 // "localizers": [{"type": ...}, ...] at `at`.
 Localizers parse_localizers(const Json& l, const std::string& at) {
   if (!l.is_array() || l.empty()) throw ConfigError(at, json_brief(l), "a non-empty array of {\"type\": ...} objects");
@@ -50,11 +74,11 @@ Localizers parse_localizers(const Json& l, const std::string& at) {
   for (std::size_t i = 0; i < l.size(); ++i) {
     Json lj = l[i];
     if (!lj.is_object() || !lj.contains("type")) throw ConfigError(json_child(at, i), json_brief(lj), "an object {\"type\": ...}");
-    const bool external = lj["type"] == "external";
-    // An external localizer's row is named after its script unless labelled (docs/protocol.md).
-    std::string label = lj.value("label", external ? external::default_label(lj) : lj["type"].is_string() ? lj["type"].get<std::string>() : std::string("?"));
-    lj.erase("label");
-    locs.emplace_back(sanitize(label), lj);
+    const std::string lp = json_child(at, i);
+    if (!lj["type"].is_string()) throw ConfigError(json_child(lp, "type"), json_brief(lj["type"]), "a localizer type name (omniloc list)");
+    std::string label = row_label(lj, lp);
+    lj.erase("label");  // it names the sweep's row; the localizer's reader never sees it
+    locs.push_back({sanitize(label), lj, lp});
   }
   return locs;
 }
@@ -106,6 +130,7 @@ ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, cons
   if (p.is_relative()) p = base / p;
   if (!fs::exists(p)) throw ConfigError(fp, json_brief(*file), "an existing scenario file (looked for " + p.string() + ")");
   sc.json = read_json_file(p.string(), fp);
+  if (!sc.json.is_object()) throw ConfigError(fp, json_brief(*file), "a scenario file holding a JSON object (" + p.string() + " holds " + json_brief(sc.json) + ")");
   sc.name = sc.json.is_object() && sc.json.contains("name") && sc.json["name"].is_string() ? sc.json["name"].get<std::string>() : p.stem().string();
   return sc;
 }
@@ -174,23 +199,28 @@ void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenari
               SweepSpec& spec) {
   std::set<std::string> ids;
   for (const auto& sc : scenarios)
-    for (const auto& [llabel, lj] : sc.locs)
+    for (const auto& [llabel, lj, lat] : sc.locs)
       for (const auto& combo : sc.combos) {
         std::string plabel;
         Json patched = apply_combo(sc.json, combo, plabel);
         if (!lj.is_null()) patched["localizer"] = lj;
         if (patched.contains("localizer")) external::anchor_external_paths(patched["localizer"]);
-        const Json own = patched.value("localizer", Json::object());
-        const std::string loc_label = !lj.is_null() ? llabel
-                                      : own.value("type", Json()) == "external"
-                                          ? own.value("label", external::default_label(own))
-                                          : sanitize(own.value("type", std::string("odometry_only")));
+        std::string loc_label = llabel;
         try {
+          // The scenario's own localizer names the row; its label is checked before it is read.
+          if (lj.is_null()) {
+            const Json own = patched.is_object() ? patched.value("localizer", Json::object()) : Json::object();
+            loc_label = sanitize(own.is_object() ? row_label(own, "/localizer") : std::string("?"));
+          }
           parse_scenario(patched, sc.name);
         } catch (const ConfigError& e) {
-          throw ConfigError("sweep " + path + ", scenario \"" + sc.name + "\", localizer \"" + loc_label + "\"" +
-                                (plabel.empty() ? "" : ", " + plabel) + ": " + (e.path().empty() ? "/" : e.path()),
-                            e.value(), e.expected());
+          const std::string context = "sweep " + path + ", scenario \"" + sc.name + "\", localizer \"" + loc_label + "\"" +
+                                      (plabel.empty() ? "" : ", " + plabel);
+          // A key of one of the sweep's own localizer entries: named by its path in the sweep file.
+          const std::string& ep = e.path();
+          if (!lj.is_null() && ep.rfind("/localizer", 0) == 0 && (ep.size() == 10 || ep[10] == '/'))
+            throw ConfigError(lat + ep.substr(10) + " (" + context + ")", e.value(), e.expected());
+          throw ConfigError(context + ": " + (ep.empty() ? "/" : ep), e.value(), e.expected());
         }
         for (std::uint64_t seed : seeds) {
           SweepRun run;
@@ -223,7 +253,7 @@ SweepSpec load_sweep(const std::string& path) {
   // Sweep-wide localizers and parameters apply to every scenario entry; an entry written as
   // {"file": ..., "parameters": {...}, "localizers": [...]} adds its own parameters to the sweep's and
   // replaces the sweep's localizers, so one file can hold rows that vary different things (the paper suite).
-  Localizers locs = {{"", Json()}};
+  Localizers locs = {{"", Json(), ""}};
   if (const Json* l = r.raw("localizers")) locs = parse_localizers(*l, "/localizers");
   std::vector<Combo> combos = {{}};
   if (const Json* pj = r.raw("parameters")) combos = parse_combos(*pj, "/parameters", combos);
@@ -234,6 +264,46 @@ SweepSpec load_sweep(const std::string& path) {
   check_sweep_size(scenarios, seeds.size());
   add_runs(path, scenarios, seeds, spec);
   return spec;
+}
+
+Json sweep_schema() {
+  const Json localizer = harness::scenario_schema()["properties"]["localizer"];
+  Json entry = localizer;  // a sweep's localizer entry: a scenario's localizer with a row name
+  entry["required"] = Json::array({"type"});
+  const Json label = {{"type", "string"}, {"pattern", "^[A-Za-z0-9_.-]{1,64}$"},
+                      {"description", "the sweep's row name (default: the type, or an external client's script name)"}};
+  const Json localizers = {{"type", "array"}, {"minItems", 1}, {"items", {{"allOf", Json::array({entry, {{"properties", {{"label", label}}}}})}}},
+                           {"description", "localizers each scenario runs with (default: the scenario's own)"}};
+  const Json parameters = {{"type", "object"},
+                           {"propertyNames", {{"pattern", "^/"}}},
+                           {"additionalProperties", {{"type", "array"}, {"minItems", 1}}},
+                           {"description", "JSON pointer into the scenario -> the values to sweep (cross product)"}};
+  const Json file = {{"type", "string"}, {"minLength", 1}, {"description", "a scenario file, relative to the sweep file"}};
+  const Json scenario_entry = {
+      {"oneOf", Json::array({file,
+                             {{"type", "object"},
+                              {"required", {"file"}},
+                              {"additionalProperties", false},
+                              {"properties", {{"file", file}, {"comment", {{"type", "string"}}}, {"parameters", parameters}, {"localizers", localizers}}}}})}};
+  const Json seed = {{"type", "integer"}, {"minimum", 0}, {"maximum", 9007199254740992LL}};
+  return {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
+          {"title", "omniloc sweep file"},
+          {"type", "object"},
+          {"required", {"scenarios"}},
+          {"additionalProperties", false},
+          {"properties",
+           {{"name", {{"type", "string"}, {"description", "results/sweeps/<name>/ (default: the file's name)"}}},
+            {"comment", {{"type", "string"}}},
+            {"scenarios", {{"type", "array"}, {"minItems", 1}, {"items", scenario_entry}}},
+            {"localizers", localizers},
+            {"parameters", parameters},
+            {"seeds", {{"oneOf", Json::array({{{"type", "array"}, {"minItems", 1}, {"items", seed}},
+                                               {{"type", "object"},
+                                                {"required", {"count"}},
+                                                {"additionalProperties", false},
+                                                {"properties",
+                                                 {{"first", {{"type", "integer"}, {"minimum", 0}, {"maximum", 4503599627370496LL}}},
+                                                  {"count", {{"type", "integer"}, {"minimum", 1}, {"maximum", 100000}}}}}}})}}}}}};
 }
 
 }  // namespace omniloc::batch

@@ -29,4 +29,8 @@ struct SweepSpec {
 /// Reads a sweep file; every scenario/localizer/override combination is validated here, before any run.
 SweepSpec load_sweep(const std::string& path);
 
+/// JSON Schema (draft 2020-12) of sweep files (`omniloc schema --sweep`): every key load_sweep reads,
+/// a localizer entry as in a scenario (docs/localizers.md) plus its row "label".
+Json sweep_schema();
+
 }  // namespace omniloc::batch

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Mutation test of `omniloc validate` (issue 19): deterministic mutants of the shipped scenario and
-experiment files, each run through `omniloc validate`, which must exit 0 or 2 - never a signal,
-never another code, never hang.
+"""Mutation test of `omniloc validate` (issue 19): deterministic mutants of the shipped scenario,
+experiment and sweep files (sweeps since issue 40), each run through `omniloc validate`, which must
+exit 0 or 2 - never a signal, never another code, never hang.
 
 Usage: mutation_validate.py OMNILOC [--count N] [--seed S] [--jobs J] [--keep DIR]
 Exit 1 (listing the first bad inputs, saved under --keep) when any mutant misbehaves.
@@ -33,9 +33,32 @@ EXTREME_JSON = [1e39, -1e39, 1e308, -1e308, 0, -1, 1, 2**63, 2**64, 0.5, 1e6, -1
 
 
 def corpus():
+    """Every shipped input file: scenarios, experiments and sweeps. A sweep names its scenario files
+    relative to itself and its external clients relative to the working directory, so its mutants are
+    written into a copy of the scenarios/ tree (see `place`) and run where clients/ and build/ resolve."""
     files = sorted((ROOT / "scenarios").rglob("*.json"))
-    # Sweep files name other files relatively; their mutants are scenario-shaped text anyway.
-    return [(f.name, f.read_bytes()) for f in files if "sweeps" not in f.parts]
+    return [(str(f.relative_to(ROOT / "scenarios")), f.read_bytes()) for f in files]
+
+
+def is_sweep(name):
+    return name.startswith("sweeps" + os.sep)
+
+
+def prepare(work, omniloc):
+    """The mutants' folder: scenarios/ copied (sweeps' relative paths), clients/ and tests/ linked, and
+    build/ linked to the tested binary's folder (a sweep's C++ client is build/olp_cpp_example)."""
+    shutil.copytree(ROOT / "scenarios", work / "scenarios")
+    for name in ("clients", "tests", "data"):
+        (work / name).symlink_to(ROOT / name)
+    (work / "build").symlink_to(pathlib.Path(omniloc).resolve().parent if os.sep in omniloc else ROOT / "build")
+
+
+def place(work, k, name):
+    """Where mutant k of `name` is written: sweeps beside the shipped sweeps, the rest in work/."""
+    base = os.path.basename(name)
+    if is_sweep(name):
+        return work / "scenarios" / "sweeps" / f"m{k:06d}_{base}"
+    return work / f"m{k:06d}_{base}"
 
 
 def json_paths(j, prefix=()):
@@ -139,6 +162,7 @@ def main():
     rng = random.Random(a.seed)
     seeds = corpus()
     work = pathlib.Path(tempfile.mkdtemp(prefix="omniloc_mutation_"))
+    prepare(work, a.omniloc)
     # Inputs are generated up front from one seeded generator, so a run is reproducible whatever the
     # scheduling of the workers.
     inputs = []
@@ -157,7 +181,7 @@ def main():
     def one(chunk):
         files = []
         for k, name, text in chunk:
-            f = work / f"m{k:06d}_{name}"
+            f = place(work, k, name)
             f.write_bytes(text)
             files.append((k, name, f))
         verdict = {}
@@ -189,7 +213,10 @@ def main():
     secs = time.monotonic() - t0
     summary = ", ".join(f"exit {c}: {n}" if isinstance(c, int) and c >= 0 else f"{'signal ' + str(-c) if isinstance(c, int) else c}: {n}"
                         for c, n in sorted(codes.items(), key=lambda x: str(x[0])))
-    print(f"mutation_validate: {a.count} mutants (seed {a.seed}) in {secs:.1f} s with {a.jobs} jobs: {summary}")
+    sweeps = sum(1 for _, name, _ in inputs if is_sweep(name))
+    print(f"mutation_validate: {a.count} mutants (seed {a.seed}; {sweeps} of them of the {sum(1 for n, _ in seeds if is_sweep(n))} "
+          f"shipped sweeps, the rest of {sum(1 for n, _ in seeds if not is_sweep(n))} scenario and experiment files) "
+          f"in {secs:.1f} s with {a.jobs} jobs: {summary}")
     if bad:
         keep = pathlib.Path(a.keep) if a.keep else work
         keep.mkdir(parents=True, exist_ok=True)

@@ -129,7 +129,9 @@ TEST(Sweep, BadSweepFailsBeforeAnyRun) {
     load_sweep(bad2);
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(e.path().find("/localizer/type"), std::string::npos) << e.what();
+    // Named by its place in the sweep file (issue 40), with the run it was checked for.
+    EXPECT_EQ(e.path().rfind("/localizers/0/type (sweep ", 0), 0u) << e.what();
+    EXPECT_NE(e.path().find("localizer \"no_such_localizer\""), std::string::npos) << e.what();
   }
   const std::string bad3 = (test_dir() / "bad3.json").string();
   write_file_atomic(bad3, R"({"scenarios": ["short.json"], "parameters": {"/robots/0/motion/speed": [-3]}})");
