@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 extern char** environ;
 
@@ -24,91 +25,15 @@ namespace omniloc::external {
 
 namespace {
 
-// ---- Process groups to end when omniloc is interrupted -------------------------------------------
-// A fixed table of atomics, because the signal handler may only touch async-signal-safe state.
-constexpr int kMaxGroups = 256;
-std::atomic<int> g_groups[kMaxGroups];
-struct sigaction g_previous[65];
-std::once_flag g_handlers_installed;
-
-void register_group(int pid) {
-  for (auto& g : g_groups) {
-    int expected = 0;
-    if (g.compare_exchange_strong(expected, pid)) return;
-  }
-}
-
-void unregister_group(int pid) {
-  for (auto& g : g_groups) {
-    int expected = pid;
-    if (g.compare_exchange_strong(expected, 0)) return;
-  }
+bool is_executable_file(const std::string& p) {
+  struct stat st{};
+  return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && access(p.c_str(), X_OK) == 0;
 }
 
 void sleep_ms(long ms) {
   timespec ts{ms / 1000, (ms % 1000) * 1000000L};
   while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
   }
-}
-
-// SIGINT / SIGTERM / SIGHUP: end every client group (TERM, up to 2 s, KILL), then let the signal do
-// what it did before (by default: end omniloc with it, so the exit status still says "signal").
-void on_fatal_signal(int sig) {
-  const int saved_errno = errno;
-  bool any = false;
-  for (auto& g : g_groups)
-    if (const int pid = g.load(); pid > 0) {
-      kill(-pid, SIGTERM);
-      any = true;
-    }
-  for (int waited = 0; any && waited < 2000; waited += 20) {
-    bool alive = false;
-    for (auto& g : g_groups)
-      if (const int pid = g.load(); pid > 0) {
-        siginfo_t info{};
-        // WNOWAIT: leave the zombie, so its pid (the group id) cannot be reused before the KILL below.
-        if (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == 0) alive = true;
-      }
-    if (!alive) break;
-    sleep_ms(20);
-  }
-  for (auto& g : g_groups)
-    if (const int pid = g.load(); pid > 0) kill(-pid, SIGKILL);
-  const struct sigaction& prev = g_previous[sig];
-  if (prev.sa_handler == SIG_IGN) {
-    errno = saved_errno;
-    return;
-  }
-  if (!(prev.sa_flags & SA_SIGINFO) && prev.sa_handler != SIG_DFL) {
-    prev.sa_handler(sig);
-    errno = saved_errno;
-    return;
-  }
-  signal(sig, SIG_DFL);
-  raise(sig);
-}
-
-void install_handlers() {
-  std::call_once(g_handlers_installed, [] {
-    // A client that died closes its stdin pipe: writing then must fail with EPIPE, not kill omniloc.
-    signal(SIGPIPE, SIG_IGN);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
-      struct sigaction prev{};
-      sigaction(sig, nullptr, &prev);
-      g_previous[sig] = prev;
-      if (prev.sa_handler == SIG_IGN) continue;  // e.g. nohup: keep ignoring
-      struct sigaction sa{};
-      sa.sa_handler = on_fatal_signal;
-      sigemptyset(&sa.sa_mask);
-      sa.sa_flags = 0;
-      sigaction(sig, &sa, nullptr);
-    }
-  });
-}
-
-bool is_executable_file(const std::string& p) {
-  struct stat st{};
-  return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && access(p.c_str(), X_OK) == 0;
 }
 
 int ms_until(Clock::time_point deadline) {
@@ -145,7 +70,7 @@ std::string describe_wait_status(int status) {
 }
 
 ClientProcess::ClientProcess(const ProcessSpec& spec) : stderr_path_(spec.stderr_path) {
-  install_handlers();
+  interrupt::install();
   // Everything the child needs is prepared before fork: after it only async-signal-safe calls.
   std::vector<std::string> env_strings;
   for (char** e = environ; *e; ++e) {
@@ -204,7 +129,7 @@ ClientProcess::ClientProcess(const ProcessSpec& spec) : stderr_path_(spec.stderr
   }
   pid_ = pid;
   setpgid(pid, pid);  // also from this side: no race with a signal sent right after fork
-  register_group(pid);
+  interrupt::watch_group(pid);
   close(in[0]);
   close(out[1]);
   close(err_fd);
@@ -292,7 +217,7 @@ std::optional<int> ClientProcess::poll_exit() {
   while (waitpid(pid_, &st, 0) < 0 && errno == EINTR) {
   }
   status_ = st;
-  unregister_group(pid_);
+  interrupt::unwatch_group(pid_);
   return status_;
 }
 

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace omniloc::harness {
 
@@ -64,11 +65,14 @@ RunDirectory::RunDirectory(std::string final_dir) : final_(std::move(final_dir))
   staging_ = (parent / ("." + f.filename().string() + ".partial-" + staging_tag())).string();
   std::error_code ec;
   fs::remove_all(staging_, ec);
+  // Watched before it exists: an interruption between the two leaves nothing behind.
+  watch_slot_ = interrupt::watch_folder(staging_.c_str());
   fs::create_directories(staging_, ec);
   if (ec) throw RuntimeFailure("cannot create " + staging_ + ": " + ec.message());
 }
 
 RunDirectory::~RunDirectory() {
+  interrupt::unwatch_folder(watch_slot_);
   if (!committed_) {
     std::error_code ec;
     fs::remove_all(staging_, ec);
@@ -84,6 +88,10 @@ void RunDirectory::commit() {
   // Files were fsynced one by one (write_file_atomic); frames written by other writers and the
   // folder entries themselves are made durable before the folder becomes visible.
   fsync_dir(staging_);
+  // From here on the staging folder is the whole result: an interruption must not remove it (nor
+  // leave the previous results moved aside with nothing in their place).
+  interrupt::unwatch_folder(watch_slot_);
+  watch_slot_ = -1;
   const std::string old = staging_ + ".old";
   fs::remove_all(old, ec);
   if (fs::exists(final_)) {

@@ -1,7 +1,8 @@
 #pragma once
 // A results folder written all at once: files are collected in memory-backed staging under a
 // temporary sibling folder and the folder is renamed into place at commit(), so a killed run never
-// leaves a folder that looks complete.
+// leaves a folder that looks complete. SIGINT, SIGTERM and SIGHUP remove the staging folder
+// (core/interrupt.hpp); after kill -9 it stays until the next run into the same parent clears it.
 #include <string>
 #include <string_view>
 
@@ -32,6 +33,7 @@ class RunDirectory {
  private:
   std::string final_, staging_;
   bool committed_ = false;
+  int watch_slot_ = -1;  ///< core/interrupt's slot: SIGINT / SIGTERM / SIGHUP remove the staging folder
 };
 
 }  // namespace omniloc::harness
