@@ -69,6 +69,17 @@ ExternalConfig ExternalConfig::from_json(JsonReader& r) {
   if (!c.label.empty() && !std::regex_match(c.label, std::regex("[A-Za-z0-9_.-]{1,64}")))
     throw ConfigError(r.child_path("label"), "\"" + c.label + "\"", "1-64 characters of [A-Za-z0-9_.-]");
 
+  // Files the command does not name but the client runs (modules it imports, a model it loads).
+  const std::vector<std::string> hash = r.strings("hash", std::vector<std::string>{});
+  if (hash.size() > 256) throw ConfigError(r.child_path("hash"), std::to_string(hash.size()) + " files", "at most 256 files");
+  for (std::size_t i = 0; i < hash.size(); ++i) {
+    const std::string p = hash[i].empty() || hash[i].find('\0') != std::string::npos ? std::string() : absolute_from(hash[i], c.cwd);
+    if (p.empty() || !fs::is_regular_file(p, ec))
+      throw ConfigError(json_child(r.child_path("hash"), i), json_brief(Json(hash[i])),
+                        "an existing file to record in provenance (relative paths are taken against " + c.cwd + ")");
+    c.hash.push_back(p);
+  }
+
   const auto program = resolve_program(c.command[0], c.cwd);
   if (!program)
     throw ConfigError(json_child(cmd_path, std::size_t{0}), "\"" + c.command[0] + "\"",
@@ -99,6 +110,8 @@ Json ExternalConfig::schema() {
       {"frame_timeout_s", num("seconds from sending a frame to its estimate", 10, 3600)},
       {"exit_timeout_s", num("seconds from end to the client's exit", 5, 600)},
       {"label", {{"type", "string"}, {"pattern", "^[A-Za-z0-9_.-]{1,64}$"}, {"description", "sweeps: the row name (default: the script's file name)"}}},
+      {"hash", {{"type", "array"}, {"items", {{"type", "string"}, {"minLength", 1}}}, {"maxItems", 256},
+                {"description", "more files whose SHA-256 summary.json records beside the command's (the client's modules, models); relative to cwd"}}},
   };
 }
 
@@ -131,6 +144,7 @@ Json client_files(const ExternalConfig& cfg) {
     const std::string p = absolute_from(cfg.command[i], cfg.cwd);
     if (cfg.command[i][0] != '-' && fs::is_regular_file(p, ec)) files.push_back({{"path", p}, {"sha256", sha256_file(p)}});
   }
+  for (const auto& p : cfg.hash) files.push_back({{"path", p}, {"sha256", sha256_file(p)}});
   return files;
 }
 

@@ -19,6 +19,7 @@ struct ExternalConfig {
   double frame_timeout_s = 10.0;             ///< seconds from sending a frame to its estimate
   double exit_timeout_s = 5.0;               ///< seconds from end to the client's exit
   std::string label;                         ///< sweeps: row name (default: the script's stem)
+  std::vector<std::string> hash;             ///< more files whose SHA-256 provenance records (the client's modules), absolute
   std::string program;                       ///< command[0] resolved (PATH or cwd), absolute
 
   /// Reads the keys at `r` ("type" already read) and checks that the program can be started:
@@ -39,8 +40,9 @@ void anchor_external_paths(Json& localizer);
 /// command[0]), restricted to [A-Za-z0-9_.-].
 std::string default_label(const Json& localizer);
 
-/// {"path", "sha256"} for the program and for every later command element that names an existing
-/// regular file (relative ones against cwd): what identifies the client that made a result.
+/// {"path", "sha256"} for the program, for every later command element that names an existing
+/// regular file (relative ones against cwd) and for every file of "hash": what identifies the
+/// client that made a result.
 Json client_files(const ExternalConfig& cfg);
 
 /// {"command", "cwd", "files"} of an external localizer object as a scenario holds it (checked

@@ -101,6 +101,11 @@ Estimate ExternalLocalizer::parse_estimate(const Json& msg, long long expected_k
     e.mode_label = mode->get<std::string>();
     e.mode = mode_of(e.mode_label);
   }
+  if (const auto c = msg.find("compute_ms"); c != msg.end() && !c->is_null()) {
+    const double ms = finite_number(*c, "estimate: /compute_ms");
+    if (ms < 0) throw ProtocolError("estimate: /compute_ms: expected the client's own milliseconds for this frame (>= 0), got " + json_brief(*c));
+    e.compute_ms = ms;
+  }
   if (const auto extra = msg.find("extra"); extra != msg.end() && !extra->is_null()) {
     if (!extra->is_object() || extra->size() > 32) throw ProtocolError("estimate: /extra: expected an object of at most 32 numbers, got " + json_brief(*extra));
     static const std::regex key_re("[A-Za-z0-9_]{1,32}");

@@ -4,6 +4,7 @@
 // (harness/metrics) and the result files (harness/run_writer) are computed from these records alone.
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ struct FrameRecord {
   double match_error = 0.0;
   std::map<std::string, double> extra;  ///< localizer extras and the camera settings (frames.csv columns)
   double render_ms = 0.0, vision_ms = 0.0, localize_ms = 0.0;  ///< wall time: timing.csv only
+  std::optional<double> compute_ms;  ///< an external client's own time for the frame (ms): timing.csv only
 };
 
 struct RobotRecord {

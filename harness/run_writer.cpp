@@ -48,11 +48,19 @@ std::string frames_csv(const std::vector<RobotRecord>& robots) {
 }
 
 std::string timing_csv(const std::vector<RobotRecord>& robots) {
-  std::string timing = "t,robot,render_ms,vision_ms,localize_ms\n";
+  // compute_ms only when a localizer reported its own time (an external client, docs/protocol.md);
+  // an empty cell is a frame it did not report.
+  bool compute = false;
   for (const auto& robot : robots)
-    for (const auto& r : robot.frames)
+    for (const auto& r : robot.frames) compute = compute || r.compute_ms.has_value();
+  std::string timing = compute ? "t,robot,render_ms,vision_ms,localize_ms,compute_ms\n" : "t,robot,render_ms,vision_ms,localize_ms\n";
+  for (const auto& robot : robots)
+    for (const auto& r : robot.frames) {
       timing += fmt("%.4f", r.t) + "," + std::to_string(robot.id) + "," + fmt("%.4f", r.render_ms) + "," + fmt("%.4f", r.vision_ms) + "," +
-                fmt("%.4f", r.localize_ms) + "\n";
+                fmt("%.4f", r.localize_ms);
+      if (compute) timing += "," + (r.compute_ms ? fmt("%.4f", *r.compute_ms) : std::string());
+      timing += "\n";
+    }
   return timing;
 }
 

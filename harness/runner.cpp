@@ -84,7 +84,7 @@ void robot_frame(Tracked& tr, Simulation& sim, Perception& perception, const sim
   const double loc_ms = ms_since(t0);
 
   FrameRecord row{now.t, now.robot(id)->pose, est.pose, est.valid, po.obs.camera_ok, sim.in_contact(id), est.mode, est.mode_label,
-                  po.obs.line_points.size(), est.match_error, est.extra, po.render_ms, po.vision_ms, loc_ms};
+                  po.obs.line_points.size(), est.match_error, est.extra, po.render_ms, po.vision_ms, loc_ms, est.compute_ms};
   if (po.image) {  // the camera settings the frame was taken with (exposure control, paper 002)
     row.extra["exposure_ms"] = po.settings.exposure_ms;
     row.extra["gain"] = po.settings.gain;

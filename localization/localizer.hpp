@@ -106,6 +106,9 @@ struct Estimate {
   /// A mode word from an external localizer (docs/protocol.md); written instead of mode_name(mode)
   /// when not empty. `mode` is set too when the word is one of ours.
   std::string mode_label;
+  /// An external localizer's own computation time for this frame (milliseconds, olp/1 estimate
+  /// "compute_ms"), when it reports one; timing.csv writes it beside the round trip.
+  std::optional<double> compute_ms;
 };
 
 class Localizer {

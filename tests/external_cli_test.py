@@ -94,6 +94,32 @@ class ExternalCli(unittest.TestCase):
                 timing = (out / "timing.csv").read_text().splitlines()
                 self.assertGreater(len(timing), 10)
 
+    def test_client_compute_time_and_extra_hashed_files(self):
+        # The Python client library reports the time update() took (estimate.compute_ms): timing.csv
+        # carries it beside the round trip; a built-in run has no such column.
+        helper = self.tmp / "helper_module.py"
+        helper.write_text("# a module the client imports\n")
+        py = self.run_scenario({"type": "external", "command": [PY, str(ROOT / "clients" / "python" / "examples" / "dead_reckoning.py")],
+                                "hash": [str(helper)]}, "py_compute", duration=1.0)
+        rows = (py / "timing.csv").read_text().splitlines()
+        head = rows[0].split(",")
+        self.assertEqual(head[-2:], ["localize_ms", "compute_ms"])
+        pairs = [(float(r.split(",")[head.index("localize_ms")]), float(r.split(",")[head.index("compute_ms")])) for r in rows[1:]]
+        self.assertEqual(len(pairs), 31)
+        self.assertTrue(all(0 <= c for _, c in pairs), pairs)
+        # The client's own time is part of the round trip (median: single frames may straddle clock reads).
+        self.assertLess(sorted(c for _, c in pairs)[15], sorted(l for l, _ in pairs)[15])
+        s = json.loads((py / "summary.json").read_text())
+        digest = subprocess.run(["sha256sum", str(helper)], capture_output=True, text=True).stdout.split()[0]
+        self.assertIn({"path": str(helper), "sha256": digest}, s["external"]["files"])
+        ref = self.run_scenario({"type": "odometry_only"}, "builtin_timing", duration=1.0)
+        self.assertEqual((ref / "timing.csv").read_text().splitlines()[0], "t,robot,render_ms,vision_ms,localize_ms")
+        # A file to hash that is not there is an input error naming its path, before any work.
+        bad = self.write("bad_hash.json", scenario({"type": "external", "command": [PY, FAULTY, "ok"], "hash": ["no_such_module.py"]}))
+        r = self.omniloc("validate", bad, check=False)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("/localizer/hash/0", r.stderr)
+
     def test_perl_client_reads_images(self):
         out = self.run_scenario({"type": "external", "command": ["perl", PERL], "env": {"OLP_WANTS_IMAGE": "1"}}, "perl_img",
                                 duration=0.5)
@@ -160,20 +186,36 @@ class ExternalCli(unittest.TestCase):
         pids = self.tmp / f"pids_{sig}"
         f = self.write(f"slow_{sig}.json", scenario({"type": "external", "command": [PY, FAULTY, "slow:0.05", str(pids)]}, duration=30))
         out = self.tmp / f"out_{sig}"
-        p = subprocess.Popen([BIN, "run", f, "-o", str(out)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        p = subprocess.Popen([BIN, "run", f, "-o", str(out)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         deadline = time.time() + 60
         while time.time() < deadline and not (pids.exists() and pids.read_text().strip()):
             time.sleep(0.1)
         time.sleep(1.0)  # in the middle of the frames
         client = int(pids.read_text().split()[0])
         self.assertTrue(alive(client))
+        staging = [x for x in os.listdir(self.tmp) if x.startswith(f".out_{sig}.partial-")]
+        self.assertEqual(len(staging), 1, "the run stages its folder (with the client's stderr log) beside -o")
         p.send_signal(sig)
-        p.wait(timeout=30)
+        _, err = p.communicate(timeout=30)
         deadline = time.time() + 5
         while time.time() < deadline and alive(client):
             time.sleep(0.05)
         self.assertFalse(alive(client), f"client {client} outlived omniloc after signal {sig}")
         self.assertFalse(out.exists())
+        left = [x for x in os.listdir(self.tmp) if x.startswith(f".out_{sig}")]
+        if sig == signal.SIGKILL:
+            # kill -9 cannot be caught: the staging folder stays until the next run there clears it.
+            self.assertEqual(left, staging)
+            self.run_scenario({"type": "odometry_only"}, f"out_{sig}", name=f"again_{sig}", duration=0.5)
+            self.assertEqual([x for x in os.listdir(self.tmp) if x.startswith(f".out_{sig}")], [])
+            return
+        # Dies of the signal itself, as shells expect (they print 130 / 143 / 129), after one line.
+        self.assertEqual(p.returncode, -sig)
+        self.assertEqual(left, [], "the staging folder must go with an interrupted run")
+        lines = [x for x in err.splitlines() if x.startswith("omniloc: ")]
+        self.assertEqual(len(lines), 1, err)
+        self.assertIn({signal.SIGINT: "interrupted", signal.SIGTERM: "terminated", signal.SIGHUP: "hung up"}[sig], lines[0])
+        self.assertIn("staging folder was removed", lines[0])
 
     def test_ctrl_c_ends_the_client(self):
         self.interrupt(signal.SIGINT)
@@ -183,6 +225,24 @@ class ExternalCli(unittest.TestCase):
 
     def test_sigterm_ends_the_client(self):  # what scancel and kill send first
         self.interrupt(signal.SIGTERM)
+
+    def test_sighup_ends_the_client(self):  # a closed terminal or ssh session
+        self.interrupt(signal.SIGHUP)
+
+    def test_ctrl_c_removes_a_built_in_run_staging_folder(self):
+        f = self.write("long.json", scenario({"type": "matching"}, duration=60))
+        out = self.tmp / "out_builtin"
+        p = subprocess.Popen([BIN, "run", f, "-o", str(out)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        deadline = time.time() + 60
+        while time.time() < deadline and not any(x.startswith(".out_builtin.partial-") for x in os.listdir(self.tmp)):
+            time.sleep(0.05)
+        time.sleep(0.5)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+        self.assertEqual(p.returncode, -signal.SIGINT, err)
+        self.assertEqual([x for x in os.listdir(self.tmp) if x.startswith(".out_builtin")], [])
+        self.assertFalse(out.exists())
+        self.assertIn("omniloc: interrupted (SIGINT)", err)
 
 
 if __name__ == "__main__":
