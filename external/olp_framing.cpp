@@ -103,7 +103,11 @@ std::optional<Message> MessageReader::next() {
     try {
       header = parse_json_strict(line, "message");
     } catch (const std::exception& e) {
-      throw ProtocolError("not a JSON object: " + printable_prefix(line) + " (" + e.what() + ")");
+      // NaN and Infinity are what a client most often writes by accident (Python's json.dumps does
+      // by default): say so, rather than leave the parser's offset to be puzzled over.
+      const bool non_finite = line.find("NaN") != std::string_view::npos || line.find("Infinity") != std::string_view::npos;
+      throw ProtocolError("not a JSON object: " + printable_prefix(line) + " (" + e.what() + ")" +
+                          (non_finite ? "; NaN and Infinity are not JSON numbers: send finite numbers (docs/protocol.md section 3)" : ""));
     }
     if (!header.is_object()) throw ProtocolError("not a JSON object: " + printable_prefix(line));
     part_sizes_ = announced_parts(header);

@@ -29,7 +29,7 @@ TEST(LinePointAccuracy, DistanceToTheNearestLineCentreByRange) {
   const auto perception = harness::make_perception(sc, true, seed);
   const int id = sc.localized_robots().front();
   // Range bands (metres from the robot): where the mirror's resolution halves and halves again.
-  const std::vector<double> edges = {0.0, 1.5, 3.0, 5.0, 9.0};
+  const std::vector<double> edges = {0.0, 1.5, 3.0, 5.0, 7.5};  // the scan lines stop at 7.5 m
   std::vector<std::vector<double>> off(edges.size() - 1);
   // Every 3rd frame of the first 20 s (200 frames): the whole first lap of the tracking path.
   for (long long k = 0; k <= 600; ++k) {
