@@ -24,6 +24,8 @@
 #include "core/atomic_file.hpp"
 #include "harness/render_frame.hpp"
 #include "harness/scenario_schema.hpp"
+#include "external/external_config.hpp"
+#include "harness/recording.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "batch/slurm.hpp"
@@ -46,6 +48,11 @@ const char* kUsage = R"(usage: omniloc <command> [options]
 commands:
   run FILE [--seed N] [-o DIR [--overwrite]] [--frames DIR] [--frames-every N] [--quiet]
                          run a scenario; results in results/runs/<scenario>/<seed>/
+  record FILE [--seed N] [--images] [-o DIR [--overwrite]] [--quiet]
+                         simulate and perceive a scenario once, no localizer: a recording of every
+                         frame a localizer is given (docs/recording.md), in results/recordings/<scenario>/<seed>/
+  replay RECORDING --localizer JSON|FILE [--seed N] [-o DIR [--overwrite]] [--quiet]
+                         run any localizer on a recording: the same run folder as `run` gives
   render FILE --t SECONDS [--robot ID] [--seed N] [--labels | --points] -o frame.png
                          the panorama robot ID (default: the first localized) sees at time t
   calibrate FILE [-o map.json] [--seed N]
@@ -58,7 +65,7 @@ commands:
   gl-devices             the EGL devices of this machine and the device each GL back-end renders on
                          (OMNILOC_GL_BACKEND, OMNILOC_EGL_DEVICE: docs/camera.md "GPUs")
   list                   field presets, motion scripts, event kinds, localizers, noise profiles, experiments
-  schema [--markdown] [-o FILE]
+  schema [--sweep | --markdown] [-o FILE]
                          the JSON Schema of scenario files (for editors), or the parameter
                          reference docs/localizers.md generated from the same lists
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
@@ -93,6 +100,22 @@ const cli::Command kRun{"run", "FILE", 1, 1, "Run a scenario; results in results
                          {"--frames", "DIR", "write the camera frames as PNG into DIR"},
                          {"--frames-every", "N", "with --frames: every N-th frame (integer in [1, 1000000])"},
                          {"--quiet", "", "no progress log on stderr"}}};
+const cli::Command kRecord{"record", "FILE", 1, 1,
+                           "Simulate and perceive a scenario once, without a localizer, and write a recording of everything\n"
+                           "a localizer is given (docs/recording.md); results/recordings/<scenario>/<seed>/ (or -o DIR).",
+                           {{"--seed", "N", "seed (integer >= 0; default: the scenario's)"},
+                            {"--images", "", "also keep every frame's image (lossless PNG, for clients that read pixels)"},
+                            {"-o", "DIR", "recording folder; must not exist or be empty unless --overwrite"},
+                            {"--overwrite", "", "replace what is at -o DIR"},
+                            {"--quiet", "", "no progress log on stderr"}}};
+const cli::Command kReplay{"replay", "RECORDING", 1, 1,
+                           "Run a localizer on a recording's frames: the run folder `omniloc run` writes for the recorded\n"
+                           "scenario and seed with that localizer, without simulating or rendering (docs/recording.md).",
+                           {{"--localizer", "JSON|FILE", "the localizer, as a scenario's \"localizer\" object: inline JSON or a file holding it (required)"},
+                            {"--seed", "N", "seed of the localizer's random stream (default: the recording's seed)"},
+                            {"-o", "DIR", "results folder; must not exist or be empty unless --overwrite"},
+                            {"--overwrite", "", "replace what is at -o DIR"},
+                            {"--quiet", "", "no progress log on stderr"}}};
 const cli::Command kRender{"render", "FILE", 1, 1, "Render the panorama robot ID sees at time t.",
                            {{"--t", "SECONDS", "time in [0, the scenario's duration] (default 0)"},
                             {"--robot", "ID", "robot id (default: the first localized robot)"},
@@ -274,6 +297,57 @@ int cmd_run(const cli::Args& a) {
   const auto r = harness::run_scenario(s, o);
   std::cout << "scenario " << s.name << ", seed " << r.seed << ", localizer " << r.summary["localizer"].get<std::string>()
             << ", noise " << s.noise.name << "\n"
+            << r.table << "results: " << r.out_dir << "\n";
+  return 0;
+}
+
+int cmd_record(const cli::Args& a) {
+  const auto s = harness::load_scenario(a.positional[0]);
+  harness::RecordOptions o;
+  if (a.has("--seed")) o.seed = a.unsigned_integer("--seed", 0, kMaxSeed);
+  o.out_dir = a.value("-o");
+  check_output_target(a);
+  o.images = a.has("--images");
+  if (!a.has("--quiet")) o.log = &std::cerr;
+  const auto r = harness::record_scenario(s, o);
+  const double minutes = std::max(1e-9, s.duration / 60.0);
+  std::cout << "scenario " << s.name << ", seed " << r.seed << ": " << r.frames << " frames, frames.jsonl "
+            << r.frames_bytes / 1024 << " KiB (" << static_cast<long long>(r.frames_bytes / minutes / 1024) << " KiB per minute)";
+  if (o.images) std::cout << ", images " << r.image_bytes / (1024 * 1024) << " MiB (" << static_cast<long long>(r.image_bytes / minutes / (1024 * 1024)) << " MiB per minute)";
+  std::cout << "\nrecording: " << r.out_dir << "\n";
+  return 0;
+}
+
+// --localizer: inline JSON (starting with '{') or a file holding the localizer object.
+Json localizer_argument(const std::string& v) {
+  if (v.empty()) throw UsageError("replay needs --localizer JSON|FILE (e.g. --localizer '{\"type\": \"matching\"}')");
+  const auto first = v.find_first_not_of(" \t\n");
+  Json j = first != std::string::npos && v[first] == '{' ? parse_json_strict(v, "--localizer") : read_json_strict(v, "--localizer");
+  if (!j.is_object()) throw ConfigError("--localizer", json_brief(j), "a localizer object {\"type\": ...}");
+  external::anchor_external_paths(j);
+  return j;
+}
+
+int cmd_replay(const cli::Args& a) {
+  const Json localizer = localizer_argument(a.value("--localizer"));
+  check_output_target(a);
+  harness::RecordingHeader header = harness::RecordingHeader::read(a.positional[0]);
+  const harness::Scenario s = harness::replay_scenario(header, localizer);
+  harness::RecordingSource source(std::move(header));  // reads and checks every frame before any work
+  harness::RunOptions o;
+  o.seed = a.has("--seed") ? a.unsigned_integer("--seed", 0, kMaxSeed) : source.header().seed;
+  o.out_dir = a.value("-o");
+  o.replay = true;
+  if (!a.has("--quiet")) o.log = &std::cerr;
+  Json provenance = Json::object();
+  if (!source.header().render.is_null()) provenance["render"] = source.header().render;
+  provenance["replay"] = {{"recording", std::filesystem::absolute(a.positional[0]).lexically_normal().string()},
+                          {"format", source.header().format},
+                          {"recorded_seed", source.header().seed},
+                          {"recorded_with", source.header().omniloc.value("version", std::string("unknown"))}};
+  const auto r = harness::run_frames(s, *o.seed, source, o, provenance);
+  std::cout << "replay of " << a.positional[0] << " (scenario " << s.name << ", seed " << r.seed << "), localizer "
+            << r.summary["localizer"].get<std::string>() << "\n"
             << r.table << "results: " << r.out_dir << "\n";
   return 0;
 }
@@ -469,6 +543,8 @@ int main(int argc, char** argv) {
   };
   const Entry commands[] = {{&kValidate, cmd_validate},
                             {&kRun, cmd_run},
+                            {&kRecord, cmd_record},
+                            {&kReplay, cmd_replay},
                             {&kGlDevices, cmd_gl_devices},
                             {&kList, [](const cli::Args&) { return cmd_list(); }},
                             {&kSchema, cmd_schema},

@@ -33,7 +33,7 @@ Json camera_for_client(const CalibrationMap* map) {
             {"max_radius_px", map->max_radius()}}}};
 }
 
-external::Session make_session(const Scenario& sc, int robot, const Perception& perception, std::uint64_t localizer_seed,
+external::Session make_session(const Scenario& sc, int robot, const Json& camera, bool blobs, std::uint64_t localizer_seed,
                                const std::string& log_dir) {
   external::Session s;
   s.robot = robot;
@@ -42,8 +42,8 @@ external::Session make_session(const Scenario& sc, int robot, const Perception& 
   s.camera_rate_hz = sc.camera_rate;
   s.duration_s = sc.duration;
   s.field = field_for_client(sc.field);
-  s.camera = camera_for_client(perception.calibration_map());
-  s.blobs = perception.detects_blobs();
+  s.camera = camera;
+  s.blobs = blobs;
   s.log_dir = log_dir;
   s.seed = localizer_seed;
   for (const auto& l : localizers())

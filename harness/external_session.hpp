@@ -17,7 +17,9 @@ Json field_for_client(const Field& field);
 /// `map` is null: nothing is rendered).
 Json camera_for_client(const CalibrationMap* map);
 
-external::Session make_session(const Scenario& sc, int robot, const Perception& perception, std::uint64_t localizer_seed,
+/// The session of robot `robot`'s client: `camera` is hello.camera (camera_for_client), `blobs`
+/// whether frames can carry blobs.
+external::Session make_session(const Scenario& sc, int robot, const Json& camera, bool blobs, std::uint64_t localizer_seed,
                                const std::string& log_dir);
 
 }  // namespace omniloc::harness

@@ -6,7 +6,9 @@
 #include <ostream>
 
 #include "core/version.hpp"
+#include "external/external_localizer.hpp"
 #include "harness/external_session.hpp"
+#include "harness/frame_source.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/perception.hpp"
 #include "harness/render_frame.hpp"
@@ -31,8 +33,8 @@ struct Tracked {
 // One localizer per localized robot, each with its own random stream; tracking localizers start at
 // the true start pose (the papers' set-up), and so do external ones that ask for it. `effective`
 // gets the localizer's effective parameters. An external localizer's client is started here (its
-// stderr log goes to `log_dir`, the run's staging folder) and told the camera `perception` uses.
-std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const LocalizerInfo& info, const Perception& perception,
+// stderr log goes to `log_dir`, the run's staging folder) and told the camera the frames come from.
+std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const LocalizerInfo& info, const FrameSource& source,
                                   const std::string& log_dir, Json& effective) {
   std::vector<Tracked> tracked;
   for (int id : sc.localized_robots()) {
@@ -44,7 +46,7 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
     ctx.cache_dir = "results/cache";
     external::Session session;
     if (info.type == "external") {
-      session = make_session(sc, id, perception, ctx.seed, log_dir);
+      session = make_session(sc, id, source.client_camera(id), source.detects_blobs(), ctx.seed, log_dir);
       ctx.session = &session;
     }
     Json eff;
@@ -57,42 +59,42 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
   return tracked;
 }
 
-// What perception reported beside the observations: warnings, camera control and pauses.
-void log_perception(const PerceptionOutput& po, int robot, double t, bool was_paused, EventLog& log) {
-  for (const auto& w : po.warnings) log.add(Json{{"t", t}, {"type", "warning"}, {"robot", robot}, {"message", w}});
-  for (const auto& n : po.notes)
-    log.add(Json{{"t", t}, {"type", "camera"}, {"robot", robot}, {"message", n}, {"exposure_ms", po.settings.exposure_ms}, {"gain", po.settings.gain}});
-  if (po.stop_robot != was_paused) log.add(Json{{"t", t}, {"type", po.stop_robot ? "pause" : "resume"}, {"robot", robot}});
+// What a localizer without vision sees of a frame that was perceived with a camera (a recording):
+// what NoPerception gives a live run of it, so the replay writes the live run's files.
+void without_vision(RobotFrame& r) {
+  Observations o;
+  o.t = r.obs.t;
+  o.camera_ok = !r.covered;
+  r.obs = std::move(o);
+  r.settings.reset();
+  r.events.clear();
+  r.render_ms = r.vision_ms = 0.0;
 }
 
-// One camera frame of one localized robot: perceive, localize, record.
-void robot_frame(Tracked& tr, Simulation& sim, Perception& perception, const sim::WorldState& now, long long k, const RunOptions& opt,
-                 EventLog& log) {
+// One camera frame of one localized robot: localize, record.
+void robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOptions& opt, EventLog& log) {
   const int id = tr.record.id;
-  const FrameConditions cond = sim.conditions(id, now);
-  const SensorReadings sensors = sim.read_sensors(id, now);
-  const PerceptionOutput po = perception.observe(sim.camera_view(now), id, now.t, cond);
-  if (!opt.frames_dir.empty() && po.image && k % opt.frames_every == 0) {
+  const double t = rf.obs.t;
+  if (!opt.frames_dir.empty() && rf.obs.image && k % opt.frames_every == 0) {
     char name[64];
     std::snprintf(name, sizeof name, "/r%d_%06lld.png", id, k);
-    write_png(*po.image, opt.frames_dir + name);
+    write_png(*rf.obs.image, opt.frames_dir + name);
   }
-  log_perception(po, id, now.t, sim.paused(id), log);
-  sim.set_paused(id, po.stop_robot);
+  for (const auto& line : rf.events) log.add_line(line);
   const auto t0 = Clock::now();
-  const Estimate est = tr.localizer->update(po.obs, sensors.odometry, sensors.heading);
+  const Estimate est = tr.localizer->update(rf.obs, rf.odometry, rf.heading);
   const double loc_ms = ms_since(t0);
 
-  FrameRecord row{now.t, now.robot(id)->pose, est.pose, est.valid, po.obs.camera_ok, sim.in_contact(id), est.mode, est.mode_label,
-                  po.obs.line_points.size(), est.match_error, est.extra, po.render_ms, po.vision_ms, loc_ms, est.compute_ms};
-  if (po.image) {  // the camera settings the frame was taken with (exposure control, paper 002)
-    row.extra["exposure_ms"] = po.settings.exposure_ms;
-    row.extra["gain"] = po.settings.gain;
+  FrameRecord row{t, rf.truth.value_or(Pose2()), est.pose, est.valid, rf.obs.camera_ok, rf.contact, est.mode, est.mode_label,
+                  rf.obs.line_points.size(), est.match_error, est.extra, rf.render_ms, rf.vision_ms, loc_ms, est.compute_ms};
+  if (rf.settings) {  // the camera settings the frame was taken with (exposure control, paper 002)
+    row.extra["exposure_ms"] = rf.settings->exposure_ms;
+    row.extra["gain"] = rf.settings->gain;
   }
   tr.record.frames.push_back(std::move(row));
   const std::string mode = est.mode_label.empty() ? mode_name(est.mode) : est.mode_label;
   if (mode != tr.last_mode) {
-    log.add(Json{{"t", now.t}, {"type", "mode"}, {"robot", id}, {"mode", mode}});
+    log.add(Json{{"t", t}, {"type", "mode"}, {"robot", id}, {"mode", mode}});
     tr.last_mode = mode;
   }
 }
@@ -100,7 +102,7 @@ void robot_frame(Tracked& tr, Simulation& sim, Perception& perception, const sim
 // Scores every robot and writes the result files; the table rows go to `result`.
 // `localizer`: the name results carry; `external`: an external client's provenance (else null).
 void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const Json& external,
-                   const std::vector<RobotRecord>& records, const EventLog& log, const Json& effective, const Perception& perception,
+                   const std::vector<RobotRecord>& records, const EventLog& log, const Json& effective, const Json& provenance,
                    RunDirectory& dir, RunResult& result) {
   Json summary;
   summary["scenario"] = sc.name;
@@ -115,8 +117,9 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   summary["camera_rate_hz"] = sc.camera_rate;
   summary["omniloc"] = build_info_json();  // provenance; the regression gates compare everything else
   summary["omniloc"]["host"] = host_info_json();  // the machine the run ran on (reports quote it)
-  // The renderer is provenance too: OSMesa and a GPU draw slightly different pixels (docs/camera.md "GPUs").
-  if (const auto dev = perception.render_device()) summary["omniloc"]["render"] = dev->to_json();
+  // The renderer (OSMesa and a GPU draw slightly different pixels, docs/camera.md "GPUs") and, for a
+  // replay, the recording the frames came from.
+  for (auto it = provenance.begin(); it != provenance.end(); ++it) summary["omniloc"][it.key()] = it.value();
   std::vector<TableRow> rows;
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RobotRecord& rec = records[i];
@@ -143,38 +146,55 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
 
 }  // namespace
 
-RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
-  const std::uint64_t seed = opt.seed.value_or(sc.seed);
+RunResult run_frames(const Scenario& sc, std::uint64_t seed, FrameSource& source, const RunOptions& opt, const Json& provenance) {
   RunResult result;
   result.seed = seed;
   RunDirectory dir(opt.out_dir.empty() ? "results/runs/" + sc.name + "/" + std::to_string(seed) : opt.out_dir);
 
   EventLog log;
-  Simulation sim(sc, seed, &log);
   Json effective = sc.effective;
   effective["seed"] = seed;
   const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
-  const auto perception = make_perception(sc, info.needs_vision || !opt.frames_dir.empty(), seed);
-  if (opt.log)
-    if (const auto dev = perception->render_device()) *opt.log << "  rendering on " << dev->line() << "\n";
-  std::vector<Tracked> tracked = make_tracked(sc, seed, info, *perception, dir.staging(), effective);
+  std::vector<Tracked> tracked = make_tracked(sc, seed, info, source, dir.staging(), effective);
+  for (const auto& tr : tracked)
+    if (const auto* ext = dynamic_cast<const external::ExternalLocalizer*>(tr.localizer.get()); ext && ext->wants_image() && !source.has_images())
+      throw ConfigError("/localizer", "a client that asked for images (ready.wants_image)",
+                        "frames with images: this recording was made without them (omniloc record --images)");
+  const bool strip = opt.replay && !info.needs_vision;
 
-  // simulate -> perceive -> localize -> record, at every camera frame (the first at t = 0 before any motion).
-  const long long n_frames = static_cast<long long>(std::floor(sc.duration * sc.camera_rate + 1e-9)) + 1;
-  for (long long k = 0; k < n_frames; ++k) {
-    sim.advance_to(static_cast<double>(k) / sc.camera_rate);
-    const sim::WorldState now = sim.state();
-    for (auto& tr : tracked) robot_frame(tr, sim, *perception, now, k, opt, log);
-    if (opt.log && k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && k > 0) *opt.log << "  t = " << now.t << " s\n";
+  // perceive (the source) -> localize -> record, at every camera frame (the first at t = 0 before any motion).
+  while (auto frame = source.next()) {
+    for (const auto& line : frame->events) log.add_line(line);
+    if (frame->robots.size() != tracked.size())
+      throw RuntimeFailure("frame " + std::to_string(frame->k) + " has " + std::to_string(frame->robots.size()) + " robots, the run localizes " +
+                           std::to_string(tracked.size()));
+    for (std::size_t i = 0; i < tracked.size(); ++i) {
+      if (strip) without_vision(frame->robots[i]);
+      robot_frame(tracked[i], frame->robots[i], frame->k, opt, log);
+    }
+    if (opt.log && frame->k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && frame->k > 0)
+      *opt.log << "  t = " << frame->t << " s\n";
   }
   for (auto& tr : tracked) tr.localizer->finish();  // an external client must end cleanly, or the run fails
   const std::string name = tracked.empty() ? info.type : tracked.front().localizer->name();
   const Json external = tracked.empty() ? Json(nullptr) : tracked.front().localizer->provenance();
   std::vector<RobotRecord> records;
   for (auto& tr : tracked) records.push_back(std::move(tr.record));
-  write_results(sc, seed, name, external, records, log, effective, *perception, dir, result);
+  write_results(sc, seed, name, external, records, log, effective, provenance, dir, result);
   result.out_dir = dir.final_dir();
   return result;
+}
+
+RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
+  const std::uint64_t seed = opt.seed.value_or(sc.seed);
+  const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
+  LiveSource source(sc, seed, info.needs_vision || !opt.frames_dir.empty());
+  Json provenance = Json::object();
+  if (const auto dev = source.perception().render_device()) {
+    provenance["render"] = dev->to_json();
+    if (opt.log) *opt.log << "  rendering on " << dev->line() << "\n";
+  }
+  return run_frames(sc, seed, source, opt, provenance);
 }
 
 }  // namespace omniloc::harness

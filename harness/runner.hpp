@@ -20,6 +20,9 @@ struct RunOptions {
   std::string frames_dir;             ///< when set, every `frames_every`-th frame is saved as PNG
   int frames_every = 30;
   std::ostream* log = nullptr;        ///< progress and warnings (null: silent)
+  /// The frames come from a recording: a localizer without vision gets what a live run without a
+  /// camera would give it (no line points, no camera settings, no perception events).
+  bool replay = false;
 };
 
 struct RobotResult {
@@ -37,6 +40,12 @@ struct RunResult {
   std::string table;  ///< paper-format table, printed by the CLI
 };
 
+/// A live run: simulation and perception (harness/frame_source.hpp LiveSource) into the localizer.
 RunResult run_scenario(const Scenario& scenario, const RunOptions& options);
+
+class FrameSource;
+/// The run loop over any frame source: `scenario` gives the localizer, the scoring events and the
+/// effective configuration; `provenance` is added to summary.json's "omniloc" block.
+RunResult run_frames(const Scenario& scenario, std::uint64_t seed, FrameSource& source, const RunOptions& options, const Json& provenance);
 
 }  // namespace omniloc::harness

@@ -315,6 +315,7 @@ void read_camera_and_vision(JsonReader& r, Scenario& s) {
 Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source) {
   Scenario s;
   s.source = source;
+  s.input = j;
   JsonReader r(j, "", &s.effective);
   r.allow("comment");
   s.name = r.string("name", name_from_stem(name));

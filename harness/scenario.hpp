@@ -62,6 +62,7 @@ struct Scenario {
   Json camera;               ///< camera configuration (profile defaults merged)
   Json vision;               ///< vision front-end configuration (calibration, colour table, scan lines)
   Json effective;            ///< every value read, defaults filled in: saved as config.json
+  Json input;                ///< the JSON as given (a recording keeps it, so a replay parses the same scenario)
 
   const RobotConfig* robot(int id) const;
   /// Lighting at time t: lamp events applied with their transitions, sun patches moved.

@@ -27,6 +27,8 @@ namespace omniloc::harness {
 class EventLog {
  public:
   void add(const Json& record) { text_ += record.dump() + "\n"; }
+  /// A record already serialised (one JSON object, no newline).
+  void add_line(const std::string& line) { text_ += line + "\n"; }
   const std::string& text() const { return text_; }
 
  private:

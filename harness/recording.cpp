@@ -1,0 +1,424 @@
+#include "harness/recording.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <ostream>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.hpp"
+#include "core/json_parse.hpp"
+#include "core/version.hpp"
+#include "external/sha256.hpp"
+#include "harness/external_session.hpp"
+#include "harness/localizer_registry.hpp"
+#include "harness/render_frame.hpp"
+
+namespace omniloc::harness {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Frames a recording may hold (an hour at 200 Hz), and the largest frames.jsonl read (a frame with
+// thousands of line points is about 100 kB).
+constexpr long long kMaxFrames = 720000;
+constexpr std::uintmax_t kMaxFramesBytes = 8ULL << 30;
+
+const char* colour_name(ColourClass c) { return c == kYellow ? "yellow" : c == kBlue ? "blue" : c == kRed ? "red" : "unknown"; }
+const char* kind_name(Blob::Kind k) { return k == Blob::Kind::kLeftEdge ? "left_edge" : k == Blob::Kind::kRightEdge ? "right_edge" : "region"; }
+
+std::string image_name(int robot, long long k) {
+  char name[64];
+  std::snprintf(name, sizeof name, "images/r%d_%06lld.png", robot, k);
+  return name;
+}
+
+Json pose_json(const Pose2& p) { return Json::array({p.x, p.y, p.theta}); }
+
+Json robot_to_json(const RobotFrame& r) {
+  Json pts = Json::array();
+  pts.get_ref<Json::array_t&>().reserve(r.obs.line_points.size());
+  for (const auto& p : r.obs.line_points) pts.push_back(Json::array({p.x(), p.y()}));
+  Json blobs = Json::array();
+  for (const auto& b : r.obs.blobs)
+    blobs.push_back({{"colour", colour_name(b.colour)}, {"kind", kind_name(b.kind)}, {"bearing", b.bearing}, {"left_bearing", b.left_bearing},
+                     {"right_bearing", b.right_bearing}, {"distance", b.has_distance ? Json(b.distance) : Json(nullptr)},
+                     {"area_px", b.area_px}, {"left_occluded", b.left_occluded}, {"right_occluded", b.right_occluded}});
+  Json events = Json::array();
+  for (const auto& e : r.events) events.push_back(Json::parse(e));
+  Json j = {{"robot", r.id},
+            {"odometry", pose_json(r.odometry.delta)},
+            {"heading", r.heading ? Json(*r.heading) : Json(nullptr)},
+            {"camera_ok", r.obs.camera_ok},
+            {"line_points", std::move(pts)},
+            {"blobs", std::move(blobs)},
+            {"covered", r.covered},
+            {"camera", r.settings ? Json{{"exposure_ms", r.settings->exposure_ms}, {"gain", r.settings->gain}} : Json(nullptr)},
+            {"stop_robot", r.stop_robot},
+            {"events", std::move(events)},
+            {"render_ms", r.render_ms},
+            {"vision_ms", r.vision_ms},
+            {"contact", r.contact}};
+  if (r.truth) j["truth"] = pose_json(*r.truth);
+  return j;
+}
+
+// Strict readers of frames.jsonl values: `at` names the file, line and JSON path.
+[[noreturn]] void bad(const std::string& at, const Json& v, const std::string& expected) { throw ConfigError(at, json_brief(v), expected); }
+
+const Json& member(const Json& o, const char* key, const std::string& at) {
+  const auto it = o.find(key);
+  if (it == o.end()) throw ConfigError(json_child(at, key), "nothing", "a value (docs/recording.md)");
+  return *it;
+}
+
+double finite(const Json& v, const std::string& at) {
+  if (!v.is_number() || !std::isfinite(v.get<double>())) bad(at, v, "a finite number");
+  return v.get<double>();
+}
+
+bool boolean(const Json& v, const std::string& at) {
+  if (!v.is_boolean()) bad(at, v, "true or false");
+  return v.get<bool>();
+}
+
+Pose2 pose(const Json& v, const std::string& at) {
+  if (!v.is_array() || v.size() != 3) bad(at, v, "[x, y, theta]");
+  return Pose2(finite(v[0], json_child(at, std::size_t{0})), finite(v[1], json_child(at, std::size_t{1})), finite(v[2], json_child(at, std::size_t{2})));
+}
+
+ColourClass colour_of(const Json& v, const std::string& at) {
+  if (v == "yellow") return kYellow;
+  if (v == "blue") return kBlue;
+  if (v == "red") return kRed;
+  bad(at, v, "\"yellow\", \"blue\" or \"red\"");
+}
+
+Blob::Kind kind_of(const Json& v, const std::string& at) {
+  if (v == "region") return Blob::Kind::kRegion;
+  if (v == "left_edge") return Blob::Kind::kLeftEdge;
+  if (v == "right_edge") return Blob::Kind::kRightEdge;
+  bad(at, v, "\"region\", \"left_edge\" or \"right_edge\"");
+}
+
+Blob blob_from_json(const Json& j, const std::string& at) {
+  if (!j.is_object()) bad(at, j, "a blob object (docs/protocol.md, frame.blobs)");
+  Blob b;
+  b.colour = colour_of(member(j, "colour", at), json_child(at, "colour"));
+  b.kind = kind_of(member(j, "kind", at), json_child(at, "kind"));
+  b.bearing = finite(member(j, "bearing", at), json_child(at, "bearing"));
+  b.left_bearing = finite(member(j, "left_bearing", at), json_child(at, "left_bearing"));
+  b.right_bearing = finite(member(j, "right_bearing", at), json_child(at, "right_bearing"));
+  const Json& d = member(j, "distance", at);
+  if (!d.is_null()) {
+    b.distance = finite(d, json_child(at, "distance"));
+    b.has_distance = true;
+  }
+  const Json& area = member(j, "area_px", at);
+  if (!area.is_number_integer() || area.get<long long>() < 0 || area.get<long long>() > (1LL << 31) - 1)
+    bad(json_child(at, "area_px"), area, "a pixel count");
+  b.area_px = area.get<int>();
+  b.left_occluded = boolean(member(j, "left_occluded", at), json_child(at, "left_occluded"));
+  b.right_occluded = boolean(member(j, "right_occluded", at), json_child(at, "right_occluded"));
+  return b;
+}
+
+RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const RecordedRobot& expected, bool truth) {
+  if (!j.is_object()) bad(at, j, "an object for robot " + std::to_string(expected.id));
+  RobotFrame r;
+  const Json& id = member(j, "robot", at);
+  if (!id.is_number_integer() || id.get<long long>() != expected.id) bad(json_child(at, "robot"), id, "robot " + std::to_string(expected.id) + " (recording.json's order)");
+  r.id = expected.id;
+  r.odometry.t = t;
+  r.odometry.delta = pose(member(j, "odometry", at), json_child(at, "odometry"));
+  const Json& h = member(j, "heading", at);
+  if (!h.is_null()) r.heading = finite(h, json_child(at, "heading"));
+  r.obs.t = t;
+  r.obs.camera_ok = boolean(member(j, "camera_ok", at), json_child(at, "camera_ok"));
+  const std::string lp_at = json_child(at, "line_points");
+  const Json& lp = member(j, "line_points", at);
+  if (!lp.is_array()) bad(lp_at, lp, "an array of [x, y]");
+  r.obs.line_points.reserve(lp.size());
+  for (std::size_t i = 0; i < lp.size(); ++i) {
+    const Json& p = lp[i];
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number() || !std::isfinite(p[0].get<double>()) ||
+        !std::isfinite(p[1].get<double>()))
+      bad(json_child(lp_at, i), p, "[x, y]: two finite numbers, metres, robot frame");
+    r.obs.line_points.emplace_back(p[0].get<double>(), p[1].get<double>());
+  }
+  if (const auto b = j.find("blobs"); b != j.end()) {
+    if (!b->is_array()) bad(json_child(at, "blobs"), *b, "an array of blobs");
+    for (std::size_t i = 0; i < b->size(); ++i) r.obs.blobs.push_back(blob_from_json((*b)[i], json_child(json_child(at, "blobs"), i)));
+  }
+  if (const auto c = j.find("covered"); c != j.end()) r.covered = boolean(*c, json_child(at, "covered"));
+  if (const auto c = j.find("camera"); c != j.end() && !c->is_null()) {
+    if (!c->is_object()) bad(json_child(at, "camera"), *c, "{\"exposure_ms\", \"gain\"} or null");
+    r.settings = CameraSettings{finite(member(*c, "exposure_ms", json_child(at, "camera")), json_child(json_child(at, "camera"), "exposure_ms")),
+                                finite(member(*c, "gain", json_child(at, "camera")), json_child(json_child(at, "camera"), "gain"))};
+  }
+  if (const auto s = j.find("stop_robot"); s != j.end()) r.stop_robot = boolean(*s, json_child(at, "stop_robot"));
+  if (const auto e = j.find("events"); e != j.end()) {
+    if (!e->is_array()) bad(json_child(at, "events"), *e, "an array of event objects");
+    for (std::size_t i = 0; i < e->size(); ++i) {
+      if (!(*e)[i].is_object()) bad(json_child(json_child(at, "events"), i), (*e)[i], "an event object");
+      r.events.push_back((*e)[i].dump());
+    }
+  }
+  if (const auto m = j.find("render_ms"); m != j.end()) r.render_ms = finite(*m, json_child(at, "render_ms"));
+  if (const auto m = j.find("vision_ms"); m != j.end()) r.vision_ms = finite(*m, json_child(at, "vision_ms"));
+  if (const auto c = j.find("contact"); c != j.end()) r.contact = boolean(*c, json_child(at, "contact"));
+  if (truth) r.truth = pose(member(j, "truth", at), json_child(at, "truth"));
+  return r;
+}
+
+std::string read_text(const std::string& path, std::uintmax_t max_bytes) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) throw ConfigError(path, "missing", "a readable file of the recording (docs/recording.md)");
+  if (size > max_bytes) throw ConfigError(path, std::to_string(size) + " bytes", "at most " + std::to_string(max_bytes) + " bytes");
+  std::ifstream in(path, std::ios::binary);
+  std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) throw ConfigError(path, "unreadable", "a readable file");
+  return s;
+}
+
+std::shared_ptr<const Image> read_png(const std::string& path) {
+  const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
+  if (bgr.empty()) throw RuntimeFailure("cannot read image " + path);
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  auto img = std::make_shared<Image>();
+  img->width = rgb.cols;
+  img->height = rgb.rows;
+  img->rgb.assign(rgb.data, rgb.data + static_cast<std::size_t>(rgb.cols) * rgb.rows * 3);
+  return img;
+}
+
+}  // namespace
+
+Json frame_to_json(const FrameData& f) {
+  Json events = Json::array();
+  for (const auto& e : f.events) events.push_back(Json::parse(e));
+  Json robots = Json::array();
+  for (const auto& r : f.robots) robots.push_back(robot_to_json(r));
+  return {{"k", f.k}, {"t", f.t}, {"events", std::move(events)}, {"robots", std::move(robots)}};
+}
+
+FrameData frame_from_json(const Json& j, const std::string& at, const std::vector<RecordedRobot>& robots, bool truth) {
+  if (!j.is_object()) bad(at, j, "a frame object {\"k\", \"t\", \"events\", \"robots\"}");
+  FrameData f;
+  const Json& k = member(j, "k", at);
+  if (!k.is_number_integer() || k.get<long long>() < 0) bad(json_child(at, "k"), k, "the frame number");
+  f.k = k.get<long long>();
+  f.t = finite(member(j, "t", at), json_child(at, "t"));
+  if (const auto e = j.find("events"); e != j.end()) {
+    if (!e->is_array()) bad(json_child(at, "events"), *e, "an array of event objects");
+    for (std::size_t i = 0; i < e->size(); ++i) {
+      if (!(*e)[i].is_object()) bad(json_child(json_child(at, "events"), i), (*e)[i], "an event object");
+      f.events.push_back((*e)[i].dump());
+    }
+  }
+  const Json& rs = member(j, "robots", at);
+  if (!rs.is_array() || rs.size() != robots.size())
+    bad(json_child(at, "robots"), rs, "one object per recorded robot (" + std::to_string(robots.size()) + ")");
+  for (std::size_t i = 0; i < robots.size(); ++i)
+    f.robots.push_back(robot_from_json(rs[i], json_child(json_child(at, "robots"), i), f.t, robots[i], truth));
+  return f;
+}
+
+RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
+  RecordResult result;
+  result.seed = opt.seed.value_or(sc.seed);
+  RunDirectory dir(opt.out_dir.empty() ? "results/recordings/" + sc.name + "/" + std::to_string(result.seed) : opt.out_dir);
+  LiveSource source(sc, result.seed, true);
+  if (opt.images) fs::create_directories(fs::path(dir.staging()) / "images");
+  std::string frames;
+  while (auto f = source.next()) {
+    frames += frame_to_json(*f).dump() + "\n";
+    if (opt.images)
+      for (const auto& r : f->robots)
+        if (r.obs.image) {
+          const std::string path = (fs::path(dir.staging()) / image_name(r.id, f->k)).string();
+          write_png(*r.obs.image, path);
+          result.image_bytes += fs::file_size(path);
+        }
+    ++result.frames;
+    if (opt.log && f->k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && f->k > 0) *opt.log << "  t = " << f->t << " s\n";
+  }
+  Json scenario = sc.input;
+  scenario["name"] = sc.name;
+  scenario["seed"] = result.seed;
+  Json robots = Json::array();
+  for (int id : sc.localized_robots())
+    robots.push_back({{"id", id}, {"start", pose_json(sc.robot(id)->spec.start)}, {"camera", source.client_camera(id)}, {"blobs", source.detects_blobs()}});
+  const Json header = {{"format", kRecordingFormat},
+                       {"omniloc", build_info_json()},
+                       {"name", sc.name},
+                       {"seed", result.seed},
+                       {"scenario", scenario},
+                       {"scenario_source", sc.source},
+                       {"field", field_for_client(sc.field)},
+                       {"field_fingerprint", sc.field.fingerprint()},
+                       {"camera_rate_hz", sc.camera_rate},
+                       {"duration_s", sc.duration},
+                       {"frames", result.frames},
+                       {"robots", robots},
+                       {"ground_truth", true},
+                       {"images", opt.images},
+                       {"render", source.render_device()},
+                       {"frames_sha256", external::sha256_hex(frames)}};
+  result.frames_bytes = frames.size();
+  dir.write("frames.jsonl", frames);
+  dir.write("recording.json", header.dump(2) + "\n");
+  dir.commit();
+  result.out_dir = dir.final_dir();
+  return result;
+}
+
+RecordingHeader RecordingHeader::read(const std::string& dir) {
+  RecordingHeader h;
+  h.dir = dir;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw ConfigError(dir, "not a folder", "a recording folder (recording.json, frames.jsonl; docs/recording.md)");
+  const std::string file = (fs::path(dir) / "recording.json").string();
+  if (!fs::exists(file, ec)) throw ConfigError(dir, "no recording.json", "a recording folder (docs/recording.md)");
+  const Json j = read_json_strict(file, file);
+  if (!j.is_object()) throw ConfigError(file, json_brief(j), "a recording header object (docs/recording.md)");
+  // The format first: a later version's other keys must not be judged by this version's rules.
+  const auto fmt = j.find("format");
+  if (fmt == j.end() || !fmt->is_string() || fmt->get<std::string>().rfind("omniloc-recording/", 0) != 0)
+    throw ConfigError(file + " /format", fmt == j.end() ? "nothing" : json_brief(*fmt), std::string("\"") + kRecordingFormat + "\" (docs/recording.md)");
+  if (*fmt != kRecordingFormat)
+    throw ConfigError(file + " /format", json_brief(*fmt),
+                      std::string("\"") + kRecordingFormat + "\": this omniloc reads version 1 only (a later omniloc wrote this recording)");
+  h.format = fmt->get<std::string>();
+  JsonReader r(j, file);
+  r.allow("format");
+  r.allow("comment");
+  if (const Json* o = r.raw("omniloc")) h.omniloc = *o;
+  h.name = r.string("name", std::string("recording"));
+  h.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, 1LL << 53));
+  if (const Json* s = r.raw("scenario"); s && !s->is_null()) {
+    if (!s->is_object()) throw ConfigError(r.child_path("scenario"), json_brief(*s), "the scenario object, or null");
+    h.scenario = *s;
+  }
+  h.scenario_source = r.string("scenario_source", std::string());
+  const Json* field = r.raw("field", true);
+  if (!field->is_object() && !field->is_string()) throw ConfigError(r.child_path("field"), json_brief(*field), "hello.field's object, or a field preset name");
+  h.field = *field;
+  h.field_fingerprint = r.string("field_fingerprint", std::string());
+  h.camera_rate_hz = r.positive("camera_rate_hz", std::nullopt, 1000.0);
+  h.duration_s = r.number("duration_s", std::nullopt, 0.0, 1e6);
+  h.frames = r.integer("frames", std::nullopt, 1, kMaxFrames);
+  const Json* robots = r.raw("robots", true);
+  if (!robots->is_array() || robots->empty()) throw ConfigError(r.child_path("robots"), json_brief(*robots), "a non-empty array of robots");
+  for (std::size_t i = 0; i < robots->size(); ++i) {
+    JsonReader rr((*robots)[i], json_child(r.child_path("robots"), i));
+    RecordedRobot rob;
+    rob.id = static_cast<int>(rr.integer("id", std::nullopt, 0, 1000000));
+    if (const Json* st = rr.raw("start"); st && !st->is_null()) rob.start = pose(*st, rr.child_path("start"));
+    if (const Json* cam = rr.raw("camera")) {
+      if (!cam->is_object()) throw ConfigError(rr.child_path("camera"), json_brief(*cam), "hello.camera's object ({} without a camera)");
+      rob.camera = *cam;
+    } else {
+      rob.camera = Json::object();
+    }
+    rob.blobs = rr.boolean("blobs", false);
+    rr.finish();
+    for (const auto& other : h.robots)
+      if (other.id == rob.id) throw ConfigError(rr.child_path("id"), std::to_string(rob.id), "distinct robot ids");
+    h.robots.push_back(std::move(rob));
+  }
+  h.ground_truth = r.boolean("ground_truth", true);
+  h.images = r.boolean("images", false);
+  if (const Json* rd = r.raw("render")) h.render = *rd;
+  h.frames_sha256 = r.string("frames_sha256", std::string());
+  r.finish();
+  return h;
+}
+
+RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(header)) {
+  const std::string file = (fs::path(header_.dir) / "frames.jsonl").string();
+  const std::string text = read_text(file, kMaxFramesBytes);
+  if (!header_.frames_sha256.empty() && external::sha256_hex(text) != header_.frames_sha256)
+    throw ConfigError(file, "SHA-256 " + external::sha256_hex(text),
+                      "the SHA-256 recording.json gives (" + header_.frames_sha256 + "): the file was changed or cut short");
+  frames_.reserve(static_cast<std::size_t>(header_.frames));
+  long long line_no = 0;
+  for (std::size_t a = 0; a < text.size();) {
+    std::size_t b = text.find('\n', a);
+    if (b == std::string::npos) throw ConfigError(file + " line " + std::to_string(line_no + 1), "a line without its newline", "whole lines (the file is cut short)");
+    ++line_no;
+    const std::string at = file + " line " + std::to_string(line_no);
+    if (line_no > header_.frames) throw ConfigError(at, "another frame", std::to_string(header_.frames) + " frames (recording.json)");
+    const Json j = parse_json_strict(std::string_view(text).substr(a, b - a), at);
+    FrameData f = frame_from_json(j, at, header_.robots, header_.ground_truth);
+    if (f.k != line_no - 1) throw ConfigError(at + " /k", std::to_string(f.k), "frame " + std::to_string(line_no - 1) + " (frames in order from 0)");
+    if (!frames_.empty() && !(f.t > frames_.back().t)) throw ConfigError(at + " /t", std::to_string(f.t), "a time after the previous frame's");
+    frames_.push_back(std::move(f));
+    a = b + 1;
+  }
+  if (line_no != header_.frames)
+    throw ConfigError(file, std::to_string(line_no) + " frames", std::to_string(header_.frames) + " frames (recording.json): the file is cut short");
+  if (header_.images) {
+    std::error_code ec;
+    for (const auto& f : frames_)
+      for (const auto& r : f.robots) {
+        const fs::path p = fs::path(header_.dir) / image_name(r.id, f.k);
+        if (!fs::is_regular_file(p, ec)) throw ConfigError(p.string(), "missing", "an image for every frame (recording.json says \"images\": true)");
+      }
+  }
+}
+
+std::optional<FrameData> RecordingSource::next() {
+  if (next_ >= frames_.size()) return std::nullopt;
+  FrameData f = std::move(frames_[next_++]);
+  if (header_.images)
+    for (auto& r : f.robots) r.obs.image = read_png((fs::path(header_.dir) / image_name(r.id, f.k)).string());
+  return f;
+}
+
+Json RecordingSource::client_camera(int robot) const {
+  for (const auto& r : header_.robots)
+    if (r.id == robot) return r.camera;
+  return Json::object();
+}
+
+bool RecordingSource::detects_blobs() const {
+  for (const auto& r : header_.robots)
+    if (r.blobs) return true;
+  return false;
+}
+
+Scenario replay_scenario(const RecordingHeader& h, const Json& localizer) {
+  if (h.scenario.is_null()) throw ConfigError(h.dir + "/recording.json /scenario", "null", "a recording made by omniloc record (logs without a scenario: docs/recording.md)");
+  Json j = h.scenario;
+  j["localizer"] = localizer;
+  j["name"] = h.name;
+  j["seed"] = h.seed;
+  Scenario sc;
+  try {
+    sc = parse_scenario(j, h.name, h.scenario_source);
+  } catch (const ConfigError& e) {
+    // The localizer is the replay's own input; everything else was the recording's.
+    if (e.path().rfind("/localizer", 0) == 0) throw ConfigError("--localizer" + e.path().substr(10), e.value(), e.expected());
+    throw ConfigError(h.dir + "/recording.json /scenario" + e.path(), e.value(), e.expected());
+  }
+  const std::vector<int> ids = sc.localized_robots();
+  bool same = ids.size() == h.robots.size();
+  for (std::size_t i = 0; same && i < ids.size(); ++i) same = ids[i] == h.robots[i].id;
+  if (!same) throw ConfigError(h.dir + "/recording.json /robots", json_brief(Json(ids)), "the scenario's localized robots, in order");
+  if (!h.field_fingerprint.empty() && sc.field.fingerprint() != h.field_fingerprint)
+    throw ConfigError(h.dir + "/recording.json /field", "a field whose geometry differs from the recorded one",
+                      "the recorded field (the preset or field file changed since it was recorded)");
+  return sc;
+}
+
+}  // namespace omniloc::harness

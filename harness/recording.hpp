@@ -1,0 +1,112 @@
+#pragma once
+// Recordings (docs/recording.md, format "omniloc-recording/1"): everything the localizers of a
+// scenario's localized robots are given, frame by frame, with the truth and events scoring needs,
+// so any localizer can be run on the same frames later without simulating or rendering them again.
+//
+// A recording is a folder: recording.json (what was recorded: scenario, field, camera per robot,
+// frame count, the SHA-256 of frames.jsonl), frames.jsonl (one JSON object a camera frame) and, when
+// recorded with images, images/r<robot>_<k>.png (lossless). It is written like a run folder: staged
+// and renamed into place at the end, so an interrupted recording leaves nothing that looks whole.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/json_reader.hpp"
+#include "harness/frame_source.hpp"
+#include "harness/run_directory.hpp"
+#include "harness/scenario.hpp"
+
+namespace omniloc::harness {
+
+/// The format this build writes and reads.
+inline constexpr const char* kRecordingFormat = "omniloc-recording/1";
+
+struct RecordOptions {
+  std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed
+  std::string out_dir;                ///< default: results/recordings/<scenario>/<seed>
+  bool images = false;                ///< also write every frame's image (PNG, lossless)
+  std::ostream* log = nullptr;        ///< progress (null: silent)
+};
+
+struct RecordResult {
+  std::string out_dir;
+  std::uint64_t seed = 0;
+  long long frames = 0;
+  std::size_t frames_bytes = 0;  ///< size of frames.jsonl
+  std::size_t image_bytes = 0;   ///< size of all images
+};
+
+/// Simulates and perceives `sc` (camera and vision always on, as for a localizer that needs vision)
+/// and writes the recording. No localizer runs.
+RecordResult record_scenario(const Scenario& sc, const RecordOptions& options);
+
+/// One robot of a recording's header.
+struct RecordedRobot {
+  int id = 0;
+  std::optional<Pose2> start;  ///< the true start pose (tracking localizers get it), when known
+  Json camera;                 ///< olp/1 hello.camera of this robot ({} without a camera)
+  bool blobs = false;
+};
+
+/// What recording.json says. Read strictly: a file that is not a recording, a future format, a
+/// missing or wrong key is a ConfigError naming the file and the JSON path.
+struct RecordingHeader {
+  std::string dir;          ///< the recording folder
+  std::string format;
+  Json omniloc;             ///< the build that wrote it
+  std::string name;         ///< scenario name
+  std::uint64_t seed = 0;
+  Json scenario;            ///< the scenario as given (localizer included), null in a log not made by omniloc
+  std::string scenario_source;
+  Json field;               ///< olp/1 hello.field
+  std::string field_fingerprint;  ///< omniloc's Field::fingerprint(), empty when not known
+  double camera_rate_hz = 30.0;
+  double duration_s = 0.0;
+  long long frames = 0;
+  std::vector<RecordedRobot> robots;
+  bool ground_truth = true;
+  bool images = false;
+  Json render;              ///< the renderer, null when none
+  std::string frames_sha256;
+
+  static RecordingHeader read(const std::string& dir);
+};
+
+/// Frames read back from a recording: every line of frames.jsonl is parsed and checked (and the
+/// image files of a recording with images found) in the constructor, so a truncated or corrupted
+/// recording fails before any localizer starts. Images are read one frame at a time.
+class RecordingSource : public FrameSource {
+ public:
+  explicit RecordingSource(RecordingHeader header);
+  std::optional<FrameData> next() override;
+  Json client_camera(int robot) const override;
+  bool detects_blobs() const override;
+  bool has_images() const override { return header_.images; }
+  Json render_device() const override { return header_.render; }
+  const RecordingHeader& header() const { return header_; }
+
+ private:
+  RecordingHeader header_;
+  std::vector<FrameData> frames_;
+  std::size_t next_ = 0;
+};
+
+/// JSON of one frame as frames.jsonl holds it, and back (`at`: where, for errors).
+Json frame_to_json(const FrameData& f);
+/// `truth`: the frames carry the true pose ("truth"; recording.json "ground_truth").
+FrameData frame_from_json(const Json& j, const std::string& at, const std::vector<RecordedRobot>& robots, bool truth = true);
+
+struct ReplayOptions {
+  Json localizer;                     ///< the localizer to run ({"type": ...}), as in a scenario
+  std::optional<std::uint64_t> seed;  ///< the localizer's random stream; default the recording's seed
+  std::string out_dir;                ///< default: results/runs/<scenario>/<seed>
+  std::ostream* log = nullptr;
+};
+
+/// The scenario a replay runs: the recorded one with `localizer` in place of its own (or, for a log
+/// not made by omniloc, one built from the header). Checks that the robots and field agree.
+Scenario replay_scenario(const RecordingHeader& header, const Json& localizer);
+
+}  // namespace omniloc::harness

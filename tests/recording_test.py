@@ -1,0 +1,215 @@
+"""Recordings (docs/recording.md): `omniloc replay` of a recording equals `omniloc run` of the recorded
+scenario and seed, file by file, for every built-in localizer and for external clients (their frame
+messages byte for byte); a recording reads in plain Python without omniloc; bad recordings exit 2
+before any work and leave nothing behind.
+
+Run by ctest as `recording_py` with OMNILOC_BIN set (Debian's python3)."""
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = os.environ.get("OMNILOC_BIN", str(ROOT / "build" / "omniloc"))
+PY = "/usr/bin/python3" if Path("/usr/bin/python3").exists() else sys.executable
+EXAMPLES = ROOT / "clients" / "python" / "examples"
+# Every file of a run folder but timing.csv (wall-clock) and summary.json's provenance block.
+SAME = ["est.tum", "gt.tum", "frames.csv", "events.jsonl", "config.json", "field.json"]
+
+
+def scenario(base, duration, seed=2, **extra):
+    s = json.loads((ROOT / "scenarios" / base).read_text())
+    s.update(duration=duration, seed=seed, **extra)
+    return s
+
+
+def summary_without_provenance(folder):
+    s = json.loads((folder / "summary.json").read_text())
+    s.pop("omniloc", None)
+    return s
+
+
+class Recording(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = Path(tempfile.mkdtemp(prefix="omniloc_recording_"))
+        # A short stretch of the paper's tracking path (robot noise, compass, exposure control on) and
+        # of paper 002's kidnapping (covered lens, teleport, coasting): each recorded once.
+        cls.scenarios = {
+            "tracking": scenario("paper/tracking.json", 3.0),
+            "kidnap": scenario("paper/kidnap_002.json", 4.0,
+                               events=[{"type": "kidnap", "t": 1.5, "pose": [-6.75, 3.25, 1.571], "duration": 1.0}]),
+            "landmarks": scenario("paper/landmarks_003.json", 4.0),
+        }
+        cls.files, cls.recordings = {}, {}
+        for name, s in cls.scenarios.items():
+            s["name"] = name  # a live run of the same scenario from another file keeps the name
+            f = cls.tmp / f"{name}.json"
+            f.write_text(json.dumps(s))
+            cls.files[name] = f
+            rec = cls.tmp / f"rec_{name}"
+            r = subprocess.run([BIN, "record", str(f), "-o", str(rec), "--quiet"] + (["--images"] if name == "tracking" else []),
+                               cwd=ROOT, capture_output=True, text=True, timeout=600)
+            assert r.returncode == 0, r.stderr
+            cls.recordings[name] = rec
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def omniloc(self, *args, check=True):
+        r = subprocess.run([BIN, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
+        if check and r.returncode != 0:
+            self.fail(f"omniloc {' '.join(args)} exited {r.returncode}:\n{r.stdout}\n{r.stderr}")
+        return r
+
+    def live_and_replay(self, name, localizer, tag):
+        s = dict(self.scenarios[name], localizer=localizer)
+        f = self.tmp / f"{name}_{tag}.json"
+        f.write_text(json.dumps(s))
+        live, rep = self.tmp / f"live_{name}_{tag}", self.tmp / f"replay_{name}_{tag}"
+        self.omniloc("run", str(f), "-o", str(live), "--quiet")
+        self.omniloc("replay", str(self.recordings[name]), "--localizer", json.dumps(localizer), "-o", str(rep), "--quiet")
+        return live, rep
+
+    def assert_same_run(self, live, rep, command_differs=False):
+        for f in SAME:
+            if f == "config.json" and command_differs:  # the tee'd wire log's file name is in the command
+                a, b = (json.loads((d / f).read_text()) for d in (live, rep))
+                for c in (a, b):
+                    c["localizer"].pop("command")
+                self.assertEqual(a, b, f)
+                continue
+            self.assertEqual((live / f).read_bytes(), (rep / f).read_bytes(), f)
+        a, b = summary_without_provenance(live), summary_without_provenance(rep)
+        if command_differs:
+            for c in (a, b):
+                c["external"].pop("command")
+        self.assertEqual(a, b)
+        # timing.csv: the same frames and columns; only the wall-clock numbers may differ.
+        lt, rt = ((d / "timing.csv").read_text().splitlines() for d in (live, rep))
+        self.assertEqual(lt[0], rt[0])
+        self.assertEqual([x.split(",")[:2] for x in lt], [x.split(",")[:2] for x in rt])
+
+    def test_every_built_in_localizer(self):
+        cases = [("tracking", {"type": "odometry_only"}), ("tracking", {"type": "matching"}), ("tracking", {"type": "mcl"}),
+                 ("tracking", {"type": "hybrid"}), ("tracking", {"type": "grid_global"}), ("kidnap", {"type": "hybrid"}),
+                 ("kidnap", {"type": "matching"}), ("kidnap", {"type": "odometry_only"}), ("landmarks", {"type": "landmarks"})]
+        for name, loc in cases:
+            with self.subTest(scenario=name, localizer=loc["type"]):
+                live, rep = self.live_and_replay(name, loc, loc["type"])
+                self.assert_same_run(live, rep)
+                prov = json.loads((rep / "summary.json").read_text())["omniloc"]["replay"]
+                self.assertEqual(prov["format"], "omniloc-recording/1")
+                self.assertEqual(prov["recorded_seed"], 2)
+
+    def test_external_clients_see_the_same_frames(self):
+        # The client tees what it is sent: live and replayed messages must be the same bytes (the
+        # hello carries omniloc's version and is left out; the frames and reset are compared).
+        for client, tag, images in [("dead_reckoning.py", "py_dr", False), ("particle_filter.py", "py_pf", False), ("own_vision.py", "py_ov", True)]:
+            with self.subTest(client=client):
+                wire = {}
+                for mode in ("live", "replay"):
+                    log = self.tmp / f"wire_{tag}_{mode}.bin"
+                    wire[mode] = log
+                    loc = {"type": "external", "command": ["sh", "-c", f"tee '{log}' | '{PY}' '{EXAMPLES / client}'"], "label": tag}
+                    if mode == "live":
+                        s = dict(self.scenarios["tracking"], localizer=loc)
+                        f = self.tmp / f"tracking_{tag}.json"
+                        f.write_text(json.dumps(s))
+                        self.omniloc("run", str(f), "-o", str(self.tmp / f"live_ext_{tag}"), "--quiet")
+                    else:
+                        self.omniloc("replay", str(self.recordings["tracking"]), "--localizer", json.dumps(loc), "-o",
+                                     str(self.tmp / f"replay_ext_{tag}"), "--quiet")
+                live, rep = (wire[m].read_bytes() for m in ("live", "replay"))
+                self.assertEqual(live.split(b"\n", 1)[1], rep.split(b"\n", 1)[1], "frame messages differ")
+                self.assertGreater(live.count(b'"type":"frame"'), 80)
+                if images:
+                    self.assertGreater(len(live), 90 * 640 * 640 * 3)
+                self.assert_same_run(self.tmp / f"live_ext_{tag}", self.tmp / f"replay_ext_{tag}", command_differs=True)
+
+    def test_readable_without_omniloc(self):
+        # What docs/recording.md promises a reader: plain JSON, the hash of frames.jsonl, one line a frame.
+        rec = self.recordings["tracking"]
+        head = json.loads((rec / "recording.json").read_text())
+        self.assertEqual(head["format"], "omniloc-recording/1")
+        data = (rec / "frames.jsonl").read_bytes()
+        self.assertEqual(hashlib.sha256(data).hexdigest(), head["frames_sha256"])
+        frames = [json.loads(line) for line in data.splitlines()]
+        self.assertEqual(len(frames), head["frames"])
+        self.assertEqual([f["k"] for f in frames], list(range(len(frames))))
+        r0 = frames[10]["robots"][0]
+        self.assertEqual(r0["robot"], head["robots"][0]["id"])
+        self.assertTrue(r0["line_points"] and all(len(p) == 2 for p in r0["line_points"]))
+        self.assertEqual(len(r0["truth"]), 3)
+        self.assertTrue((rec / "images" / "r0_000010.png").exists())
+        # frames.csv of a replay is the truth recorded: gt.tum's poses are the recording's.
+        gt = [line.split() for line in (self.tmp / "replay_tracking_matching" / "gt.tum").read_text().splitlines() if not line.startswith("#")] \
+            if (self.tmp / "replay_tracking_matching").exists() else None
+        if gt:
+            self.assertAlmostEqual(float(gt[10][1]), r0["truth"][0], places=9)
+
+    def bad_replay(self, rec, localizer=None, expect=()):
+        out = self.tmp / "bad_out"
+        r = self.omniloc("replay", str(rec), "--localizer", json.dumps(localizer or {"type": "matching"}), "-o", str(out), check=False)
+        self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+        for e in expect:
+            self.assertIn(e, r.stderr)
+        self.assertFalse(out.exists())
+        self.assertEqual([p.name for p in self.tmp.iterdir() if p.name.startswith(".bad_out")], [])
+
+    def copy(self, name, tag):
+        dst = self.tmp / f"broken_{tag}"
+        shutil.rmtree(dst, ignore_errors=True)
+        shutil.copytree(self.recordings[name], dst)
+        return dst
+
+    def test_bad_recordings_exit_2_before_any_work(self):
+        rec = self.copy("kidnap", "truncated")
+        data = (rec / "frames.jsonl").read_bytes()
+        (rec / "frames.jsonl").write_bytes(data[: len(data) // 2])
+        self.bad_replay(rec, expect=["frames.jsonl", "SHA-256"])
+
+        rec = self.copy("kidnap", "truncated_unhashed")  # without the hash: the frame count and the cut line say it
+        head = json.loads((rec / "recording.json").read_text())
+        head.pop("frames_sha256")
+        (rec / "recording.json").write_text(json.dumps(head))
+        lines = (rec / "frames.jsonl").read_bytes().splitlines(keepends=True)
+        (rec / "frames.jsonl").write_bytes(b"".join(lines[:50]) + lines[50][:100])
+        self.bad_replay(rec, expect=["frames.jsonl line 51", "cut short"])
+
+        rec = self.copy("kidnap", "corrupt")
+        head = json.loads((rec / "recording.json").read_text())
+        head.pop("frames_sha256")
+        (rec / "recording.json").write_text(json.dumps(head))
+        lines = (rec / "frames.jsonl").read_text().splitlines(keepends=True)
+        lines[7] = lines[7].replace('"odometry":[', '"odometry":["x",', 1)
+        (rec / "frames.jsonl").write_text("".join(lines))
+        self.bad_replay(rec, expect=["frames.jsonl line 8", "/robots/0/odometry"])
+
+        rec = self.copy("kidnap", "future")
+        head = json.loads((rec / "recording.json").read_text())
+        head["format"] = "omniloc-recording/2"
+        (rec / "recording.json").write_text(json.dumps(head))
+        self.bad_replay(rec, expect=["recording.json /format", "version 1"])
+
+        rec = self.copy("kidnap", "robots")
+        head = json.loads((rec / "recording.json").read_text())
+        head["scenario"]["robots"][0]["localize"] = False
+        (rec / "recording.json").write_text(json.dumps(head))
+        self.bad_replay(rec, expect=["/robots"])
+
+        # A client that wants the image, on a recording made without images.
+        self.bad_replay(self.recordings["kidnap"], {"type": "external", "command": [PY, str(EXAMPLES / "own_vision.py")]},
+                        expect=["without them", "--images"])
+        self.bad_replay(self.tmp / "no_such_recording", expect=["a recording folder"])
+        self.bad_replay(self.recordings["kidnap"], {"type": "matching", "particles": 3}, expect=["--localizer/particles"])
+
+
+if __name__ == "__main__":
+    unittest.main()
