@@ -311,9 +311,12 @@ int cmd_record(const cli::Args& a) {
   if (!a.has("--quiet")) o.log = &std::cerr;
   const auto r = harness::record_scenario(s, o);
   const double minutes = std::max(1e-9, s.duration / 60.0);
-  std::cout << "scenario " << s.name << ", seed " << r.seed << ": " << r.frames << " frames, frames.jsonl "
-            << r.frames_bytes / 1024 << " KiB (" << static_cast<long long>(r.frames_bytes / minutes / 1024) << " KiB per minute)";
-  if (o.images) std::cout << ", images " << r.image_bytes / (1024 * 1024) << " MiB (" << static_cast<long long>(r.image_bytes / minutes / (1024 * 1024)) << " MiB per minute)";
+  std::cout << "scenario " << s.name << ", seed " << r.seed << ": " << r.frames << " frames, frames.jsonl.gz " << r.frames_bytes / 1024
+            << " KiB (" << static_cast<long long>(static_cast<double>(r.frames_bytes) / minutes / 1024) << " KiB per minute; "
+            << r.frames_text_bytes / 1024 << " KiB of JSON lines)";
+  if (o.images)
+    std::cout << ", images " << r.image_bytes / (1024 * 1024) << " MiB ("
+              << static_cast<long long>(static_cast<double>(r.image_bytes) / minutes / (1024 * 1024)) << " MiB per minute)";
   std::cout << "\nrecording: " << r.out_dir << "\n";
   return 0;
 }

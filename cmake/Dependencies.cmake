@@ -24,3 +24,5 @@ find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)
 
 # SHA-256 of an external localizer's program and script (summary.json provenance).
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)
+# gzip of a recording's frames (harness/recording.cpp, docs/recording.md).
+find_package(ZLIB REQUIRED)

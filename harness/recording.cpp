@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <tuple>
 #include <ostream>
 #include <sstream>
 
@@ -17,6 +19,7 @@
 #include "core/version.hpp"
 #include "external/sha256.hpp"
 #include "harness/external_session.hpp"
+#include "harness/gzip.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/render_frame.hpp"
 
@@ -51,21 +54,22 @@ Json robot_to_json(const RobotFrame& r) {
     blobs.push_back({{"colour", colour_name(b.colour)}, {"kind", kind_name(b.kind)}, {"bearing", b.bearing}, {"left_bearing", b.left_bearing},
                      {"right_bearing", b.right_bearing}, {"distance", b.has_distance ? Json(b.distance) : Json(nullptr)},
                      {"area_px", b.area_px}, {"left_occluded", b.left_occluded}, {"right_occluded", b.right_occluded}});
-  Json events = Json::array();
-  for (const auto& e : r.events) events.push_back(Json::parse(e));
   Json j = {{"robot", r.id},
             {"odometry", pose_json(r.odometry.delta)},
             {"heading", r.heading ? Json(*r.heading) : Json(nullptr)},
             {"camera_ok", r.obs.camera_ok},
             {"line_points", std::move(pts)},
-            {"blobs", std::move(blobs)},
             {"covered", r.covered},
             {"camera", r.settings ? Json{{"exposure_ms", r.settings->exposure_ms}, {"gain", r.settings->gain}} : Json(nullptr)},
             {"stop_robot", r.stop_robot},
-            {"events", std::move(events)},
-            {"render_ms", r.render_ms},
-            {"vision_ms", r.vision_ms},
             {"contact", r.contact}};
+  // Optional, absent when empty (most frames): blobs and this robot's perception events.
+  if (!blobs.empty()) j["blobs"] = std::move(blobs);
+  if (!r.events.empty()) {
+    Json events = Json::array();
+    for (const auto& e : r.events) events.push_back(Json::parse(e));
+    j["events"] = std::move(events);
+  }
   if (r.truth) j["truth"] = pose_json(*r.truth);
   return j;
 }
@@ -171,8 +175,6 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
       r.events.push_back((*e)[i].dump());
     }
   }
-  if (const auto m = j.find("render_ms"); m != j.end()) r.render_ms = finite(*m, json_child(at, "render_ms"));
-  if (const auto m = j.find("vision_ms"); m != j.end()) r.vision_ms = finite(*m, json_child(at, "vision_ms"));
   if (const auto c = j.find("contact"); c != j.end()) r.contact = boolean(*c, json_child(at, "contact"));
   if (truth) r.truth = pose(member(j, "truth", at), json_child(at, "truth"));
   return r;
@@ -204,11 +206,15 @@ std::shared_ptr<const Image> read_png(const std::string& path) {
 }  // namespace
 
 Json frame_to_json(const FrameData& f) {
-  Json events = Json::array();
-  for (const auto& e : f.events) events.push_back(Json::parse(e));
   Json robots = Json::array();
   for (const auto& r : f.robots) robots.push_back(robot_to_json(r));
-  return {{"k", f.k}, {"t", f.t}, {"events", std::move(events)}, {"robots", std::move(robots)}};
+  Json j = {{"k", f.k}, {"t", f.t}, {"robots", std::move(robots)}};
+  if (!f.events.empty()) {
+    Json events = Json::array();
+    for (const auto& e : f.events) events.push_back(Json::parse(e));
+    j["events"] = std::move(events);
+  }
+  return j;
 }
 
 FrameData frame_from_json(const Json& j, const std::string& at, const std::vector<RecordedRobot>& robots, bool truth) {
@@ -240,8 +246,14 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
   LiveSource source(sc, result.seed, true);
   if (opt.images) fs::create_directories(fs::path(dir.staging()) / "images");
   std::string frames;
+  std::string timing = "k,robot,render_ms,vision_ms\n";  // wall time: the one file that differs between recordings of a run
   while (auto f = source.next()) {
     frames += frame_to_json(*f).dump() + "\n";
+    for (const auto& r : f->robots) {
+      char row[128];
+      std::snprintf(row, sizeof row, "%lld,%d,%.4f,%.4f\n", f->k, r.id, r.render_ms, r.vision_ms);
+      timing += row;
+    }
     if (opt.images)
       for (const auto& r : f->robots)
         if (r.obs.image) {
@@ -269,13 +281,17 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
                        {"camera_rate_hz", sc.camera_rate},
                        {"duration_s", sc.duration},
                        {"frames", result.frames},
+                       {"frames_file", kFramesFile},
                        {"robots", robots},
                        {"ground_truth", true},
                        {"images", opt.images},
                        {"render", source.render_device()},
                        {"frames_sha256", external::sha256_hex(frames)}};
-  result.frames_bytes = frames.size();
-  dir.write("frames.jsonl", frames);
+  const std::string gz = gzip_compress(frames);
+  result.frames_bytes = gz.size();
+  result.frames_text_bytes = frames.size();
+  dir.write(kFramesFile, gz);
+  dir.write("timing.csv", timing);
   dir.write("recording.json", header.dump(2) + "\n");
   dir.commit();
   result.out_dir = dir.final_dir();
@@ -340,13 +356,21 @@ RecordingHeader RecordingHeader::read(const std::string& dir) {
   h.images = r.boolean("images", false);
   if (const Json* rd = r.raw("render")) h.render = *rd;
   h.frames_sha256 = r.string("frames_sha256", std::string());
+  h.frames_file = r.string("frames_file", std::string("frames.jsonl"), {"frames.jsonl", "frames.jsonl.gz"});
   r.finish();
   return h;
 }
 
 RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(header)) {
-  const std::string file = (fs::path(header_.dir) / "frames.jsonl").string();
-  const std::string text = read_text(file, kMaxFramesBytes);
+  const std::string file = (fs::path(header_.dir) / header_.frames_file).string();
+  std::string text = read_text(file, kMaxFramesBytes);
+  if (header_.frames_file.size() > 3 && header_.frames_file.compare(header_.frames_file.size() - 3, 3, ".gz") == 0) {
+    try {
+      text = gzip_decompress(text, kMaxFramesBytes);
+    } catch (const std::exception& e) {
+      throw ConfigError(file, e.what(), "a whole gzip stream of frames.jsonl");
+    }
+  }
   if (!header_.frames_sha256.empty() && external::sha256_hex(text) != header_.frames_sha256)
     throw ConfigError(file, "SHA-256 " + external::sha256_hex(text),
                       "the SHA-256 recording.json gives (" + header_.frames_sha256 + "): the file was changed or cut short");
@@ -367,6 +391,7 @@ RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(hea
   }
   if (line_no != header_.frames)
     throw ConfigError(file, std::to_string(line_no) + " frames", std::to_string(header_.frames) + " frames (recording.json): the file is cut short");
+  read_timing();
   if (header_.images) {
     std::error_code ec;
     for (const auto& f : frames_)
@@ -375,6 +400,24 @@ RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(hea
         if (!fs::is_regular_file(p, ec)) throw ConfigError(p.string(), "missing", "an image for every frame (recording.json says \"images\": true)");
       }
   }
+}
+
+// timing.csv (optional): the render and vision times the recording's frames cost, for the run's
+// timing.csv. A line that does not parse is ignored: these are wall-clock figures, never results.
+void RecordingSource::read_timing() {
+  std::ifstream in(fs::path(header_.dir) / "timing.csv");
+  std::string line;
+  if (!std::getline(in, line)) return;
+  std::map<std::pair<long long, int>, std::pair<double, double>> ms;
+  while (std::getline(in, line)) {
+    long long k = 0;
+    int robot = 0;
+    double render = 0, vision = 0;
+    if (std::sscanf(line.c_str(), "%lld,%d,%lf,%lf", &k, &robot, &render, &vision) == 4) ms[{k, robot}] = {render, vision};
+  }
+  for (auto& f : frames_)
+    for (auto& r : f.robots)
+      if (const auto it = ms.find({f.k, r.id}); it != ms.end()) std::tie(r.render_ms, r.vision_ms) = it->second;
 }
 
 std::optional<FrameData> RecordingSource::next() {

@@ -4,8 +4,8 @@
 // so any localizer can be run on the same frames later without simulating or rendering them again.
 //
 // A recording is a folder: recording.json (what was recorded: scenario, field, camera per robot,
-// frame count, the SHA-256 of frames.jsonl), frames.jsonl (one JSON object a camera frame) and, when
-// recorded with images, images/r<robot>_<k>.png (lossless). It is written like a run folder: staged
+// frame count, the SHA-256 of the frames), frames.jsonl.gz (one JSON object a camera frame) and, when
+// recorded with images, images/r<robot>_<k>.png (lossless); timing.csv keeps what rendering cost. It is written like a run folder: staged
 // and renamed into place at the end, so an interrupted recording leaves nothing that looks whole.
 #include <cstdint>
 #include <memory>
@@ -22,6 +22,8 @@ namespace omniloc::harness {
 
 /// The format this build writes and reads.
 inline constexpr const char* kRecordingFormat = "omniloc-recording/1";
+/// The frames file this build writes (readers take "frames.jsonl" too: recording.json "frames_file").
+inline constexpr const char* kFramesFile = "frames.jsonl.gz";
 
 struct RecordOptions {
   std::optional<std::uint64_t> seed;  ///< overrides the scenario's seed
@@ -34,7 +36,8 @@ struct RecordResult {
   std::string out_dir;
   std::uint64_t seed = 0;
   long long frames = 0;
-  std::size_t frames_bytes = 0;  ///< size of frames.jsonl
+  std::size_t frames_bytes = 0;       ///< size of frames.jsonl.gz
+  std::size_t frames_text_bytes = 0;  ///< size of the JSON lines it holds
   std::size_t image_bytes = 0;   ///< size of all images
 };
 
@@ -69,7 +72,8 @@ struct RecordingHeader {
   bool ground_truth = true;
   bool images = false;
   Json render;              ///< the renderer, null when none
-  std::string frames_sha256;
+  std::string frames_sha256;  ///< of the JSON lines (uncompressed)
+  std::string frames_file = "frames.jsonl";
 
   static RecordingHeader read(const std::string& dir);
 };
@@ -88,6 +92,7 @@ class RecordingSource : public FrameSource {
   const RecordingHeader& header() const { return header_; }
 
  private:
+  void read_timing();
   RecordingHeader header_;
   std::vector<FrameData> frames_;
   std::size_t next_ = 0;

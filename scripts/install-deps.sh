@@ -10,7 +10,7 @@ PKGS=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
   libbenchmark-dev libgtest-dev libgmock-dev
-  libssl-dev
+  libssl-dev zlib1g-dev
   python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
 )

@@ -4,6 +4,7 @@ messages byte for byte); a recording reads in plain Python without omniloc; bad 
 before any work and leave nothing behind.
 
 Run by ctest as `recording_py` with OMNILOC_BIN set (Debian's python3)."""
+import gzip
 import hashlib
 import json
 import os
@@ -138,7 +139,8 @@ class Recording(unittest.TestCase):
         rec = self.recordings["tracking"]
         head = json.loads((rec / "recording.json").read_text())
         self.assertEqual(head["format"], "omniloc-recording/1")
-        data = (rec / "frames.jsonl").read_bytes()
+        self.assertEqual(head["frames_file"], "frames.jsonl.gz")
+        data = gzip.decompress((rec / head["frames_file"]).read_bytes())
         self.assertEqual(hashlib.sha256(data).hexdigest(), head["frames_sha256"])
         frames = [json.loads(line) for line in data.splitlines()]
         self.assertEqual(len(frames), head["frames"])
@@ -169,28 +171,47 @@ class Recording(unittest.TestCase):
         shutil.copytree(self.recordings[name], dst)
         return dst
 
-    def test_bad_recordings_exit_2_before_any_work(self):
-        rec = self.copy("kidnap", "truncated")
-        data = (rec / "frames.jsonl").read_bytes()
-        (rec / "frames.jsonl").write_bytes(data[: len(data) // 2])
-        self.bad_replay(rec, expect=["frames.jsonl", "SHA-256"])
-
-        rec = self.copy("kidnap", "truncated_unhashed")  # without the hash: the frame count and the cut line say it
+    def rewrite(self, rec, lines=None, gz=None, drop_hash=True):
         head = json.loads((rec / "recording.json").read_text())
-        head.pop("frames_sha256")
+        if drop_hash:
+            head.pop("frames_sha256")
         (rec / "recording.json").write_text(json.dumps(head))
-        lines = (rec / "frames.jsonl").read_bytes().splitlines(keepends=True)
-        (rec / "frames.jsonl").write_bytes(b"".join(lines[:50]) + lines[50][:100])
-        self.bad_replay(rec, expect=["frames.jsonl line 51", "cut short"])
+        if lines is not None:
+            gz = gzip.compress(b"".join(lines))
+        if gz is not None:
+            (rec / "frames.jsonl.gz").write_bytes(gz)
+
+    def lines(self, rec):
+        return gzip.decompress((rec / "frames.jsonl.gz").read_bytes()).splitlines(keepends=True)
+
+    def test_bad_recordings_exit_2_before_any_work(self):
+        rec = self.copy("kidnap", "truncated_gz")  # the compressed file cut in half
+        data = (rec / "frames.jsonl.gz").read_bytes()
+        (rec / "frames.jsonl.gz").write_bytes(data[: len(data) // 2])
+        self.bad_replay(rec, expect=["frames.jsonl.gz", "cut short"])
+
+        rec = self.copy("kidnap", "truncated_lines")  # whole gzip, half the frames: the hash says so
+        self.rewrite(rec, lines=self.lines(rec)[:60], drop_hash=False)
+        self.bad_replay(rec, expect=["frames.jsonl.gz", "SHA-256"])
+
+        rec = self.copy("kidnap", "truncated_unhashed")  # without the hash: the cut line says it
+        lines = self.lines(rec)
+        self.rewrite(rec, lines=lines[:50] + [lines[50][:100]])
+        self.bad_replay(rec, expect=["frames.jsonl.gz line 51", "cut short"])
+
+        rec = self.copy("kidnap", "fewer")  # whole lines, fewer than recording.json says
+        self.rewrite(rec, lines=self.lines(rec)[:50])
+        self.bad_replay(rec, expect=["50 frames", "cut short"])
 
         rec = self.copy("kidnap", "corrupt")
-        head = json.loads((rec / "recording.json").read_text())
-        head.pop("frames_sha256")
-        (rec / "recording.json").write_text(json.dumps(head))
-        lines = (rec / "frames.jsonl").read_text().splitlines(keepends=True)
-        lines[7] = lines[7].replace('"odometry":[', '"odometry":["x",', 1)
-        (rec / "frames.jsonl").write_text("".join(lines))
-        self.bad_replay(rec, expect=["frames.jsonl line 8", "/robots/0/odometry"])
+        lines = self.lines(rec)
+        lines[7] = lines[7].replace(b'"odometry":[', b'"odometry":["x",', 1)
+        self.rewrite(rec, lines=lines)
+        self.bad_replay(rec, expect=["frames.jsonl.gz line 8", "/robots/0/odometry"])
+
+        rec = self.copy("kidnap", "not_gzip")
+        self.rewrite(rec, gz=b"this is not gzip")
+        self.bad_replay(rec, expect=["frames.jsonl.gz", "gzip"])
 
         rec = self.copy("kidnap", "future")
         head = json.loads((rec / "recording.json").read_text())
@@ -203,6 +224,10 @@ class Recording(unittest.TestCase):
         head["scenario"]["robots"][0]["localize"] = False
         (rec / "recording.json").write_text(json.dumps(head))
         self.bad_replay(rec, expect=["/robots"])
+
+        rec = self.copy("tracking", "no_image")
+        (rec / "images" / "r0_000042.png").unlink()
+        self.bad_replay(rec, expect=["r0_000042.png", "missing"])
 
         # A client that wants the image, on a recording made without images.
         self.bad_replay(self.recordings["kidnap"], {"type": "external", "command": [PY, str(EXAMPLES / "own_vision.py")]},
