@@ -63,6 +63,8 @@ class FrameSource {
   virtual bool has_images() const = 0;
   /// Provenance of the renderer (summary.json "omniloc"."render"), null when none.
   virtual Json render_device() const = 0;
+  /// Whether frames carry the true pose (a real robot's log may not): without it nothing is scored.
+  virtual bool has_ground_truth() const { return true; }
 };
 
 /// Simulation and perception of a scenario, frame by frame (the live run). With `camera` false the

@@ -276,7 +276,8 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
                        {"seed", result.seed},
                        {"scenario", scenario},
                        {"scenario_source", sc.source},
-                       {"field", field_for_client(sc.field)},
+                       {"field", sc.input.contains("field") ? sc.input["field"] : Json(sc.field.name)},
+                       {"field_markings", field_for_client(sc.field)},
                        {"field_fingerprint", sc.field.fingerprint()},
                        {"camera_rate_hz", sc.camera_rate},
                        {"duration_s", sc.duration},
@@ -318,6 +319,7 @@ RecordingHeader RecordingHeader::read(const std::string& dir) {
   JsonReader r(j, file);
   r.allow("format");
   r.allow("comment");
+  r.allow("written_by");  // a writer's name (clients/python/omniloc_recording.py)
   if (const Json* o = r.raw("omniloc")) h.omniloc = *o;
   h.name = r.string("name", std::string("recording"));
   h.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, 1LL << 53));
@@ -327,8 +329,10 @@ RecordingHeader RecordingHeader::read(const std::string& dir) {
   }
   h.scenario_source = r.string("scenario_source", std::string());
   const Json* field = r.raw("field", true);
-  if (!field->is_object() && !field->is_string()) throw ConfigError(r.child_path("field"), json_brief(*field), "hello.field's object, or a field preset name");
+  if (!field->is_object() && !field->is_string())
+    throw ConfigError(r.child_path("field"), json_brief(*field), "a field preset name (omniloc list) or a field object, as a scenario's \"field\"");
   h.field = *field;
+  if (const Json* m = r.raw("field_markings")) h.field_markings = *m;
   h.field_fingerprint = r.string("field_fingerprint", std::string());
   h.camera_rate_hz = r.positive("camera_rate_hz", std::nullopt, 1000.0);
   h.duration_s = r.number("duration_s", std::nullopt, 0.0, 1e6);
@@ -440,9 +444,23 @@ bool RecordingSource::detects_blobs() const {
   return false;
 }
 
+// The scenario of a log not made by omniloc: its field, rate, duration and robots (at their start
+// poses when given), nothing simulated. A localizer that needs the start pose needs it given.
+Json scenario_of_log(const RecordingHeader& h, const Json& localizer) {
+  Json robots = Json::array();
+  for (const auto& r : h.robots)
+    robots.push_back({{"id", r.id}, {"start", r.start ? pose_json(*r.start) : Json::array({0.0, 0.0, 0.0})}, {"localize", true}});
+  Json j = {{"field", h.field}, {"camera_rate", h.camera_rate_hz}, {"duration", h.duration_s}, {"noise_profile", "ideal"}, {"robots", robots}};
+  if (localizer.is_object() && localizer.contains("type") && localizer["type"].is_string())
+    for (std::size_t i = 0; i < h.robots.size(); ++i)
+      if (!h.robots[i].start && localizer_info(localizer["type"].get<std::string>(), "--localizer/type").needs_start_pose)
+        throw ConfigError(h.dir + "/recording.json /robots/" + std::to_string(i) + "/start", "nothing",
+                          "the start pose: " + localizer["type"].get<std::string>() + " tracks from it");
+  return j;
+}
+
 Scenario replay_scenario(const RecordingHeader& h, const Json& localizer) {
-  if (h.scenario.is_null()) throw ConfigError(h.dir + "/recording.json /scenario", "null", "a recording made by omniloc record (logs without a scenario: docs/recording.md)");
-  Json j = h.scenario;
+  Json j = h.scenario.is_null() ? scenario_of_log(h, localizer) : h.scenario;
   j["localizer"] = localizer;
   j["name"] = h.name;
   j["seed"] = h.seed;

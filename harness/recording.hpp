@@ -63,7 +63,8 @@ struct RecordingHeader {
   std::uint64_t seed = 0;
   Json scenario;            ///< the scenario as given (localizer included), null in a log not made by omniloc
   std::string scenario_source;
-  Json field;               ///< olp/1 hello.field
+  Json field;               ///< the field as a scenario's "field" holds it: a preset name or a field object
+  Json field_markings;      ///< olp/1 hello.field (the markings), when written
   std::string field_fingerprint;  ///< omniloc's Field::fingerprint(), empty when not known
   double camera_rate_hz = 30.0;
   double duration_s = 0.0;
@@ -89,6 +90,7 @@ class RecordingSource : public FrameSource {
   bool detects_blobs() const override;
   bool has_images() const override { return header_.images; }
   Json render_device() const override { return header_.render; }
+  bool has_ground_truth() const override { return header_.ground_truth; }
   const RecordingHeader& header() const { return header_; }
 
  private:

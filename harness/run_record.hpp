@@ -31,6 +31,7 @@ struct FrameRecord {
 struct RobotRecord {
   int id = 0;
   std::vector<FrameRecord> frames;
+  bool has_truth = true;  ///< false for a log without ground truth: `truth` is meaningless, nothing is scored
 };
 
 }  // namespace omniloc::harness

@@ -33,9 +33,11 @@ std::string frames_csv(const std::vector<RobotRecord>& robots) {
   for (const auto& robot : robots)
     for (const auto& r : robot.frames) {
       const double ex = r.est.x - r.truth.x, ey = r.est.y - r.truth.y, eth = angle_diff(r.est.theta, r.truth.theta);
-      csv += fmt("%.4f", r.t) + "," + std::to_string(robot.id) + "," + fmt("%.5f", r.truth.x) + "," + fmt("%.5f", r.truth.y) + "," +
-             fmt("%.5f", r.truth.theta) + "," + fmt("%.5f", r.est.x) + "," + fmt("%.5f", r.est.y) + "," + fmt("%.5f", r.est.theta) + "," +
-             fmt("%.5f", ex) + "," + fmt("%.5f", ey) + "," + fmt("%.5f", eth) + "," + fmt("%.5f", std::hypot(ex, ey)) + "," +
+      // Without ground truth (a log not made by omniloc) the truth and error cells stay empty.
+      const auto t = [&](double v) { return robot.has_truth ? fmt("%.5f", v) : std::string(); };
+      csv += fmt("%.4f", r.t) + "," + std::to_string(robot.id) + "," + t(r.truth.x) + "," + t(r.truth.y) + "," + t(r.truth.theta) + "," +
+             fmt("%.5f", r.est.x) + "," + fmt("%.5f", r.est.y) + "," + fmt("%.5f", r.est.theta) + "," + t(ex) + "," + t(ey) + "," + t(eth) +
+             "," + t(std::hypot(ex, ey)) + "," +
              (r.valid ? "1" : "0") + "," + (r.mode_label.empty() ? std::string(mode_name(r.mode)) : r.mode_label) + "," + (r.camera_ok ? "1" : "0") + "," + std::to_string(r.points) + "," +
              fmt("%.6g", r.match_error) + "," + (r.contact ? "1" : "0");
       for (const auto& k : extra_keys) {

@@ -124,8 +124,20 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RobotRecord& rec = records[i];
     const std::string suffix = i == 0 ? "" : "_r" + std::to_string(rec.id);
-    dir.write("gt" + suffix + ".tum", truth_tum(rec));
     dir.write("est" + suffix + ".tum", estimate_tum(rec));
+    if (!rec.has_truth) {  // a log without ground truth: the estimates and the localizer's own figures only
+      std::size_t valid = 0;
+      for (const auto& f : rec.frames) valid += f.valid;
+      summary["scored"] = false;
+      summary["robots"].push_back({{"robot", rec.id},
+                                   {"frames", rec.frames.size()},
+                                   {"valid_frames", valid},
+                                   {"scored", false},
+                                   {"why", "the recording has no ground truth: nothing was scored"}});
+      result.robots.push_back({rec.id, ErrorSummary{}, rec.frames.size(), valid});
+      continue;
+    }
+    dir.write("gt" + suffix + ".tum", truth_tum(rec));
     const RobotScore score = score_robot(rec, sc.events, sc.duration);
     result.robots.push_back({rec.id, score.all, rec.frames.size(), score.all.frames});
     summary["robots"].push_back(score.json);
@@ -141,7 +153,7 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   dir.write("field.json", sc.field.markings_json().dump() + "\n");
   dir.commit();
   result.summary = summary;
-  result.table = paper_table(rows);
+  result.table = rows.empty() && !records.empty() ? "no ground truth in the frames: estimates written, nothing scored\n" : paper_table(rows);
 }
 
 }  // namespace
@@ -156,6 +168,7 @@ RunResult run_frames(const Scenario& sc, std::uint64_t seed, FrameSource& source
   effective["seed"] = seed;
   const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
   std::vector<Tracked> tracked = make_tracked(sc, seed, info, source, dir.staging(), effective);
+  for (auto& tr : tracked) tr.record.has_truth = source.has_ground_truth();
   for (const auto& tr : tracked)
     if (const auto* ext = dynamic_cast<const external::ExternalLocalizer*>(tr.localizer.get()); ext && ext->wants_image() && !source.has_images())
       throw ConfigError("/localizer", "a client that asked for images (ready.wants_image)",
