@@ -156,6 +156,8 @@ const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                            {"--shard", "I/N", "run only runs with index % N == I (0 <= I < N)"},
                            {"--resume", "", "skip runs already finished; runs another live process holds are skipped too"},
                            {"--aggregate-only", "", "run nothing, aggregate what is in the folder"},
+                           {"--draw-each", "", "simulate and render every run itself (by default runs that differ only in a built-in\n"
+                                               "vision localizer share one recording of their world: docs/recording.md)"},
                            {"--stop-after", "N", "run at most N runs (integer >= 0; 0: all)"},
                            {"-o", "DIR", "sweep folder (default results/sweeps/<name>)"},
                            {"--slurm", "", "submit as a Slurm job array of --tasks shards plus a merge job (docs/cluster.md)"},
@@ -399,6 +401,7 @@ int cmd_sweep(const cli::Args& a) {
   }
   o.resume = a.has("--resume");
   o.aggregate_only = a.has("--aggregate-only");
+  o.share_worlds = !a.has("--draw-each");
   o.stop_after = static_cast<std::size_t>(a.integer("--stop-after", 0, 0, 1000000000));
   o.out_dir = a.value("-o");
   const auto spec = batch::load_sweep(a.positional[0]);

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <ostream>
 #include <thread>
+#include <vector>
 
 #include "core/atomic_file.hpp"
 #include "core/version.hpp"
@@ -52,10 +53,14 @@ std::string fmt_duration(double s) {
   return b;
 }
 
-// Runs one child `omniloc run`; returns its wait status. `lock_fd` (the run's lock, opened
+// Runs one child `omniloc ARGS...`; returns its wait status. `lock_fd` (the run's lock, opened
 // close-on-exec) is handed to the child as a plain descriptor, so the lock stays held as long as
 // either process lives.
-int spawn_run(const std::string& exe, const std::string& spec, const std::string& out, const std::string& log, int lock_fd) {
+int spawn(const std::string& exe, const std::vector<std::string>& args, const std::string& log, int lock_fd) {
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(exe.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) return -1;
@@ -73,8 +78,7 @@ int spawn_run(const std::string& exe, const std::string& spec, const std::string
       ::dup2(fd, 2);
       ::close(fd);
     }
-    // --overwrite: the sweep owns runs/<id>/ and replaces a previous result of the same run.
-    ::execl(exe.c_str(), exe.c_str(), "run", spec.c_str(), "-o", out.c_str(), "--overwrite", "--quiet", static_cast<char*>(nullptr));
+    ::execv(exe.c_str(), argv.data());
     ::_exit(127);
   }
   int status = 0;
@@ -203,7 +207,17 @@ class SweepWorkers {
       write_file_atomic(spec_path, r.scenario.dump(2) + "\n");
       const std::string log = (folder_.dir / "logs" / (r.id + ".log")).string();
       const auto r0 = std::chrono::steady_clock::now();
-      const int st = spawn_run(folder_.exe, spec_path, (folder_.dir / "runs" / r.id).string(), log, lock_fd);
+      const std::string out = (folder_.dir / "runs" / r.id).string();
+      // --overwrite: the sweep owns runs/<id>/ and replaces a previous result of the same run.
+      std::vector<std::string> args = {"run", spec_path, "-o", out, "--overwrite", "--quiet"};
+      const std::string recording = r.recording.empty() && !r.world.empty() && o_.share_worlds ? world_recording(r) : r.recording;
+      if (!recording.empty()) {
+        // The localizer alone, as replay takes it; the rest of the run is the recording's.
+        const std::string loc_path = (folder_.dir / "specs" / (r.id + ".localizer.json")).string();
+        write_file_atomic(loc_path, r.scenario.value("localizer", Json::object()).dump(2) + "\n");
+        args = {"replay", recording, "--localizer", loc_path, "--seed", std::to_string(r.seed), "-o", out, "--overwrite", "--quiet"};
+      }
+      const int st = spawn(folder_.exe, args, log, lock_fd);
       secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
       const bool ok = st >= 0 && WIFEXITED(st) && WEXITSTATUS(st) == 0 && run_finished(folder_.dir, r);
       if (ok) {
@@ -226,6 +240,39 @@ class SweepWorkers {
       }
       return Result::failed;
     }
+  }
+
+  // The recording of `r`'s world in the sweep folder (recordings/<world>/), drawn by whichever worker
+  // (or shard, or Slurm task) needs it first while the others wait on its lock; throws when it could
+  // not be drawn, which fails the run (the next run of the same world tries again).
+  std::string world_recording(const SweepRun& r) {
+    const fs::path dir = folder_.dir / "recordings" / r.world;
+    const std::string lock_path = (folder_.dir / "locks" / ("world_" + r.world + ".lock")).string();
+    const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) throw RuntimeFailure("cannot create lock " + lock_path + ": " + std::strerror(errno));
+    while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+    }
+    struct Unlock {
+      int fd;
+      ~Unlock() { ::close(fd); }
+    } unlock{fd};
+    if (fs::exists(dir / "recording.json")) return dir.string();
+    fs::create_directories(dir.parent_path());
+    remove_stale_partials(dir.parent_path().string());
+    Json world = r.scenario;
+    world.erase("localizer");  // perception runs whatever the localizer; the recording keeps no localizer
+    const std::string spec_path = (folder_.dir / "specs" / ("world_" + r.world + ".json")).string();
+    write_file_atomic(spec_path, world.dump(2) + "\n");
+    const std::string log = (folder_.dir / "logs" / ("world_" + r.world + ".log")).string();
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (o_.progress && !tty_) *o_.progress << "drawing " << r.scenario_name << (r.params_label == "default" ? "" : " / " + r.params_label)
+                                              << ", seed " << r.seed << " once for its localizers\n";
+    }
+    const int st = spawn(folder_.exe, {"record", spec_path, "-o", dir.string(), "--overwrite", "--quiet"}, log, -1);
+    if (!(st >= 0 && WIFEXITED(st) && WEXITSTATUS(st) == 0 && fs::exists(dir / "recording.json")))
+      throw RuntimeFailure("drawing the world " + r.world + " failed: " + tail_of(log, 1500));
+    return dir.string();
   }
 
   void report(const SweepRun& r, bool ok, double secs) {

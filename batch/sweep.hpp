@@ -19,6 +19,7 @@ struct SweepOptions {
   int shard_index = 0, shard_count = 1;
   bool resume = false;
   bool aggregate_only = false;
+  bool share_worlds = true;    ///< runs with the same SweepRun::world replay one recording of it (false: each draws its own)
   std::size_t stop_after = 0;  ///< testing aid: stop launching after this many runs (0 = no limit)
   std::string out_dir;         ///< default results/sweeps/<name>
   std::string omniloc_exe;     ///< the binary to spawn for runs (default /proc/self/exe)

@@ -1,6 +1,8 @@
 #include "batch/sweep_spec.hpp"
 
 #include <filesystem>
+#include <map>
+#include <optional>
 #include <regex>
 #include <set>
 
@@ -8,6 +10,9 @@
 #include "external/external_config.hpp"
 #include "harness/scenario.hpp"
 #include "harness/scenario_schema.hpp"
+#include "external/sha256.hpp"
+#include "harness/localizer_registry.hpp"
+#include "harness/recording.hpp"
 
 namespace omniloc::batch {
 
@@ -50,6 +55,8 @@ struct ScenarioEntry {
   Json json;
   Localizers locs;
   std::vector<Combo> combos;
+  std::string recording;                   ///< a {"recording": DIR} entry: the folder, absolute
+  std::optional<harness::RecordingHeader> header;
 };
 
 // The row name of localizer entry `lj` at JSON path `at`: its "label" (checked here, before anything
@@ -109,12 +116,35 @@ std::vector<Combo> parse_combos(const Json& pj, const std::string& at, const std
   return combos;
 }
 
+// Entry `sp` of "scenarios" written {"recording": DIR, "localizers": ...}: a stored recording (omniloc
+// record, docs/recording.md) replayed into each localizer at the recording's seed; no parameters (the
+// world is fixed) and no seeds of its own.
+ScenarioEntry read_recording_entry(const Json& entry, const std::string& sp, const fs::path& base, const Localizers& locs) {
+  JsonReader er(entry, sp);
+  er.allow("comment");
+  const std::string rel = er.string("recording", std::nullopt);
+  ScenarioEntry sc{"", Json(), locs, {{}}, "", std::nullopt};
+  if (const Json* l = er.raw("localizers")) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
+  er.finish();
+  fs::path p = rel;
+  if (p.is_relative()) p = base / p;
+  sc.recording = fs::absolute(p).lexically_normal().string();
+  try {
+    sc.header = harness::RecordingHeader::read(sc.recording);
+  } catch (const ConfigError& e) {
+    throw ConfigError(json_child(sp, "recording") + " (" + e.path() + ")", e.value(), e.expected());
+  }
+  sc.name = sc.header->name;
+  return sc;
+}
+
 // Entry `sp` of "scenarios": a path, or {"file": ..., "parameters": ..., "localizers": ...}.
 ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, const fs::path& base, const Localizers& locs,
                                   const std::vector<Combo>& combos) {
-  ScenarioEntry sc{"", Json(), locs, combos};
+  ScenarioEntry sc{"", Json(), locs, combos, "", std::nullopt};
   const Json* file = &entry;
   std::string fp = sp;
+  if (entry.is_object() && entry.contains("recording")) return read_recording_entry(entry, sp, base, locs);
   if (entry.is_object()) {
     JsonReader er(entry, sp);
     er.allow("comment");
@@ -137,7 +167,8 @@ ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, cons
 
 std::vector<ScenarioEntry> read_scenario_entries(const Json& scen, const fs::path& base, const Localizers& locs,
                                                  const std::vector<Combo>& combos) {
-  if (!scen.is_array() || scen.empty()) throw ConfigError("/scenarios", json_brief(scen), "a non-empty array of scenario file paths");
+  if (!scen.is_array() || scen.empty())
+    throw ConfigError("/scenarios", json_brief(scen), "a non-empty array of scenario file paths (or {\"file\": ...} / {\"recording\": ...} entries)");
   std::vector<ScenarioEntry> scenarios;
   for (std::size_t i = 0; i < scen.size(); ++i)
     scenarios.push_back(read_scenario_entry(scen[i], json_child("/scenarios", i), base, locs, combos));
@@ -194,6 +225,63 @@ Json apply_combo(const Json& scenario, const Combo& combo, std::string& label) {
   return patched;
 }
 
+// The run of a {"recording": DIR} entry with one localizer (null: the recording's own), validated
+// as the replay will read it.
+void add_recording_run(const std::string& path, const ScenarioEntry& sc, const std::string& llabel, const Json& lj, const std::string& lat,
+                       std::set<std::string>& ids, SweepSpec& spec) {
+  const harness::RecordingHeader& h = *sc.header;
+  Json loc = lj;
+  if (loc.is_null()) {
+    if (!h.scenario.is_object() || !h.scenario.contains("localizer"))
+      throw ConfigError(lat.empty() ? "/localizers" : lat, "nothing", "a localizer for the recording " + sc.recording + " (it has none of its own)");
+    loc = h.scenario["localizer"];
+  }
+  external::anchor_external_paths(loc);
+  const std::string label = lj.is_null() ? sanitize(row_label(loc, "/localizer")) : llabel;
+  harness::Scenario parsed;
+  try {
+    parsed = harness::replay_scenario(h, loc);
+  } catch (const ConfigError& e) {
+    const std::string context = "sweep " + path + ", recording " + sc.recording + ", localizer \"" + label + "\"";
+    const std::string& ep = e.path();
+    if (!lj.is_null() && ep.rfind("--localizer", 0) == 0) throw ConfigError(lat + ep.substr(11) + " (" + context + ")", e.value(), e.expected());
+    throw ConfigError(context + ": " + ep, e.value(), e.expected());
+  }
+  SweepRun run;
+  run.index = spec.runs.size();
+  run.scenario_name = sc.name;
+  run.localizer_label = label;
+  run.params_label = "recording";
+  run.seed = h.seed;
+  run.scenario = parsed.input;
+  run.recording = sc.recording;
+  run.id = sanitize(sc.name) + "__" + label + "__recording__s" + std::to_string(h.seed);
+  if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two entries give the same run id; add \"label\"s)");
+  spec.runs.push_back(std::move(run));
+}
+
+// Runs that differ only in a built-in localizer that needs vision share their world: it is drawn
+// once and replayed into each (docs/recording.md, "Sweeps"). External clients and localizers without
+// vision run live (a client may want images; a localizer without a camera must see the world no
+// exposure search paused, as its live run does).
+void share_worlds(SweepSpec& spec) {
+  std::map<std::string, std::vector<SweepRun*>> by_world;
+  for (auto& r : spec.runs) {
+    if (!r.recording.empty() || !r.scenario.is_object()) continue;
+    const Json loc = r.scenario.value("localizer", Json::object());
+    const std::string type = loc.is_object() ? loc.value("type", std::string("odometry_only")) : std::string();
+    const harness::LocalizerInfo& info = harness::localizer_info(type, "/localizer/type");
+    if (type == "external" || !info.needs_vision) continue;
+    Json world = r.scenario;
+    world.erase("localizer");
+    const std::string key = sanitize(r.scenario_name) + "__s" + std::to_string(r.seed) + "__" + external::sha256_hex(world.dump()).substr(0, 16);
+    by_world[key].push_back(&r);
+  }
+  for (auto& [key, runs] : by_world)
+    if (runs.size() >= 2)
+      for (SweepRun* r : runs) r->world = key;
+}
+
 // Validates every combination once, before any run, then adds one run per seed.
 void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenarios, const std::vector<std::uint64_t>& seeds,
               SweepSpec& spec) {
@@ -201,6 +289,10 @@ void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenari
   for (const auto& sc : scenarios)
     for (const auto& [llabel, lj, lat] : sc.locs)
       for (const auto& combo : sc.combos) {
+        if (sc.header) {
+          add_recording_run(path, sc, llabel, lj, lat, ids, spec);
+          continue;
+        }
         std::string plabel;
         Json patched = apply_combo(sc.json, combo, plabel);
         if (!lj.is_null()) patched["localizer"] = lj;
@@ -263,6 +355,7 @@ SweepSpec load_sweep(const std::string& path) {
 
   check_sweep_size(scenarios, seeds.size());
   add_runs(path, scenarios, seeds, spec);
+  share_worlds(spec);
   return spec;
 }
 

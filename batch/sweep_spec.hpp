@@ -17,6 +17,12 @@ struct SweepRun {
   std::string params_label;
   std::uint64_t seed = 0;
   Json scenario;               ///< the scenario JSON with overrides applied
+  /// A recording this run replays (a {"recording": DIR} entry of "scenarios"), absolute; empty: the
+  /// world is simulated.
+  std::string recording;
+  /// Runs with the same non-empty `world` differ only in their localizer: the sweep draws their world
+  /// once (omniloc record into the sweep folder's recordings/<world>/) and replays it into each.
+  std::string world;
   std::string group() const { return scenario_name + "|" + localizer_label + "|" + params_label; }
 };
 
@@ -27,6 +33,9 @@ struct SweepSpec {
 };
 
 /// Reads a sweep file; every scenario/localizer/override combination is validated here, before any run.
+/// Runs that differ only in a built-in localizer that needs vision get a shared `world` (external
+/// clients and localizers without vision run live: a client may want images, and a localizer without
+/// a camera sees a world no exposure search paused).
 SweepSpec load_sweep(const std::string& path);
 
 /// JSON Schema (draft 2020-12) of sweep files (`omniloc schema --sweep`): every key load_sweep reads,

@@ -156,6 +156,36 @@ class Recording(unittest.TestCase):
         if gt:
             self.assertAlmostEqual(float(gt[10][1]), r0["truth"][0], places=9)
 
+    def test_sweeps_draw_each_world_once(self):
+        sweep = self.tmp / "share.json"
+        sweep.write_text(json.dumps({"name": "share", "scenarios": [str(self.files["kidnap"])], "seeds": [1, 2],
+                                     "localizers": [{"type": "matching"}, {"type": "hybrid"}, {"type": "odometry_only"},
+                                                    {"type": "external", "command": [PY, str(EXAMPLES / "dead_reckoning.py")], "label": "py_dr"}]}))
+        shared, each = self.tmp / "sweep_shared", self.tmp / "sweep_each"
+        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(shared))
+        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(each), "--draw-each")
+        # One recording per seed, shared by matching and hybrid; odometry_only and the client run live.
+        self.assertEqual(len(list((shared / "recordings").iterdir())), 2)
+        self.assertFalse((each / "recordings").exists())
+        runs = sorted(p.name for p in (each / "runs").iterdir())
+        self.assertEqual(len(runs), 8)
+        for run in runs:
+            with self.subTest(run=run):
+                self.assert_same_run(each / "runs" / run, shared / "runs" / run)
+        self.assertEqual((shared / "aggregate.csv").read_bytes(), (each / "aggregate.csv").read_bytes())
+        replayed = [r for r in runs if "replay" in json.loads((shared / "runs" / r / "summary.json").read_text())["omniloc"]]
+        self.assertEqual(sorted(replayed), sorted(r for r in runs if "__matching__" in r or "__hybrid__" in r))
+
+        # A stored recording as a sweep's scenario: replayed into each localizer at its seed.
+        stored = self.tmp / "stored.json"
+        stored.write_text(json.dumps({"name": "stored", "scenarios": [{"recording": str(self.recordings["kidnap"]),
+                                                                        "localizers": [{"type": "matching"}, {"type": "hybrid"}]}]}))
+        out = self.tmp / "sweep_stored"
+        self.omniloc("sweep", str(stored), "-o", str(out))
+        live, _ = self.live_and_replay("kidnap", {"type": "matching"}, "stored_check")
+        self.assert_same_run(live, out / "runs" / "kidnap__matching__recording__s2")
+        self.assertEqual(len(list((out / "runs").iterdir())), 2)
+
     def bad_replay(self, rec, localizer=None, expect=()):
         out = self.tmp / "bad_out"
         r = self.omniloc("replay", str(rec), "--localizer", json.dumps(localizer or {"type": "matching"}), "-o", str(out), check=False)
