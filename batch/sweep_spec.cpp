@@ -372,12 +372,17 @@ Json sweep_schema() {
                            {"additionalProperties", {{"type", "array"}, {"minItems", 1}}},
                            {"description", "JSON pointer into the scenario -> the values to sweep (cross product)"}};
   const Json file = {{"type", "string"}, {"minLength", 1}, {"description", "a scenario file, relative to the sweep file"}};
+  const Json recording = {{"type", "string"}, {"minLength", 1}, {"description", "a recording folder (omniloc record, docs/recording.md), relative to the sweep file"}};
   const Json scenario_entry = {
       {"oneOf", Json::array({file,
                              {{"type", "object"},
                               {"required", {"file"}},
                               {"additionalProperties", false},
-                              {"properties", {{"file", file}, {"comment", {{"type", "string"}}}, {"parameters", parameters}, {"localizers", localizers}}}}})}};
+                              {"properties", {{"file", file}, {"comment", {{"type", "string"}}}, {"parameters", parameters}, {"localizers", localizers}}}},
+                             {{"type", "object"},
+                              {"required", {"recording"}},
+                              {"additionalProperties", false},
+                              {"properties", {{"recording", recording}, {"comment", {{"type", "string"}}}, {"localizers", localizers}}}}})}};
   const Json seed = {{"type", "integer"}, {"minimum", 0}, {"maximum", 9007199254740992LL}};
   return {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
           {"title", "omniloc sweep file"},

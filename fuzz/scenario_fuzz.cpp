@@ -3,7 +3,10 @@
 // The only acceptable failure is a ConfigError; any other exception, a crash, a sanitizer report or
 // a timeout is a finding. Inputs that start with "olp\n" are instead a byte stream from an external
 // localizer's client (docs/protocol.md): the olp/1 framing reader and the strict readers of ready and
-// estimate, where the only acceptable failure is a ProtocolError. Every finding becomes a test in tests/robust_input_test.cpp.
+// estimate, where the only acceptable failure is a ProtocolError. Inputs that start with "rec\n" are a
+// recording (docs/recording.md): recording.json's text, a blank line, frames.jsonl's text, read by
+// the recording reader as `omniloc replay` reads it (only a ConfigError is acceptable). Every finding
+// becomes a test in tests/robust_input_test.cpp.
 // Built by scripts/fuzz.sh (clang-14, -fsanitize=fuzzer,address,undefined); seed corpus: scenarios/.
 #include <unistd.h>
 
@@ -18,6 +21,7 @@
 #include "experiments/cooperative_001.hpp"
 #include "external/external_localizer.hpp"
 #include "external/olp_framing.hpp"
+#include "harness/recording.hpp"
 #include "harness/scenario.hpp"
 #include "batch/sweep.hpp"
 
@@ -62,8 +66,33 @@ void fuzz_olp_stream(std::string_view bytes) {
   }
 }
 
+// A recording folder written from the input, then read and every frame taken, as a replay does.
+void fuzz_recording(std::string_view bytes) {
+  const std::size_t sep = bytes.find("\n\n");
+  const std::string dir = sweep_dir() + "/recording";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/recording.json", std::ios::binary | std::ios::trunc) << bytes.substr(0, sep);
+  std::ofstream(dir + "/frames.jsonl", std::ios::binary | std::ios::trunc) << (sep == std::string_view::npos ? std::string_view() : bytes.substr(sep + 2));
+  try {
+    omniloc::harness::RecordingSource source(omniloc::harness::RecordingHeader::read(dir));
+    while (source.next()) {
+    }
+  } catch (const omniloc::ConfigError&) {
+    // The expected outcome for a bad recording: exit 2 naming the file.
+  }
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  if (text.rfind("rec\n", 0) == 0) {
+    try {
+      fuzz_recording(std::string_view(text).substr(4));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "finding: recording: exception other than ConfigError: %s\n", e.what());
+      std::abort();
+    }
+    return 0;
+  }
   if (text.rfind("olp\n", 0) == 0) {
     try {
       fuzz_olp_stream(std::string_view(text).substr(4));

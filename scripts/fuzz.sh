@@ -16,6 +16,8 @@ i=0
 while IFS= read -r f; do cp "$f" "$seeds/$i.json"; i=$((i + 1)); done < <(find scenarios -name '*.json' | sort)
 # olp/1 client streams (docs/protocol.md): inputs starting with "olp\n" go to the protocol reader.
 for f in fuzz/olp_corpus/*; do cp "$f" "$seeds/olp_$(basename "$f")"; done
+# Recordings (docs/recording.md): inputs starting with "rec\n" go to the recording reader.
+for f in fuzz/recording_corpus/*; do cp "$f" "$seeds/rec_$(basename "$f")"; done
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export LSAN_OPTIONS="suppressions=$PWD/.ci/lsan-mesa.supp"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"

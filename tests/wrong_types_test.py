@@ -88,6 +88,13 @@ class WrongTypes(unittest.TestCase):
         for name in ("clients", "tests", "data"):
             os.symlink(os.path.join(ROOT, name), os.path.join(cls.work, name))
         os.symlink(os.path.dirname(os.path.abspath(BIN)), os.path.join(cls.work, "build"))
+        # A tiny recording for the sweeps' {"recording": ...} entries (docs/recording.md).
+        tiny = os.path.join(cls.work, "tiny.json")
+        with open(tiny, "w") as fh:
+            json.dump(dict(BASE, duration=0.1), fh)
+        r = subprocess.run([BIN, "record", tiny, "-o", os.path.join(cls.work, "scenarios", "sweeps", "tiny_rec"), "--quiet"],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
 
     @classmethod
     def tearDownClass(cls):
@@ -126,6 +133,7 @@ class WrongTypes(unittest.TestCase):
             docs.append({"scenarios": ["../paper/tracking.json"], "localizers": [dict(EXTERNAL, label="x")]})
             docs.append({"scenarios": [{"file": "../paper/tracking.json", "localizers": list(LOCALIZERS.values())}]})
             docs.append({"scenarios": ["../paper/tracking.json"], "localizers": list(LOCALIZERS.values())})
+            docs.append({"scenarios": [{"recording": "tiny_rec", "localizers": [{"type": "matching", "label": "m"}]}]})
         return docs + shipped
 
     def cases(self, schema, kind):
