@@ -68,7 +68,7 @@ commands:
   schema [--sweep | --markdown] [-o FILE]
                          the JSON Schema of scenario files (for editors), or the parameter
                          reference docs/localizers.md generated from the same lists
-  sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [-o DIR]
+  sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [--draw-each] [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
   sweep SWEEP.json --slurm [--tasks N] [--partition P] [--time HH:MM:SS] [--cpus-per-task C]

@@ -1,0 +1,86 @@
+// Record once, replay many (docs/recording.md, docs/performance.md "Recordings"): the cost of a
+// replay of the paper's tracking path (60 s, 1801 frames) with `matching` (reading and checking
+// frames.jsonl.gz, the localizer, scoring and writing the run folder), of reading the recording
+// alone, and of a live run and a recording of the same stretch, for the ratios in one process.
+// Run with LP_NUM_THREADS=1 so llvmpipe rendering stays on one core.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "harness/recording.hpp"
+#include "harness/runner.hpp"
+#include "harness/scenario.hpp"
+
+using namespace omniloc;
+namespace fs = std::filesystem;
+
+namespace {
+
+harness::Scenario tracking(double duration) {
+  Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+  j["duration"] = duration;
+  return harness::parse_scenario(j, "bench_replay_tracking");
+}
+
+fs::path tmp(const std::string& name) { return fs::temp_directory_path() / ("omniloc_bench_replay_" + name); }
+
+// The 60 s recording, made once per process (about 20 s of rendering).
+const std::string& recording() {
+  static const std::string dir = [] {
+    harness::RecordOptions o;
+    o.out_dir = tmp("recording").string();
+    harness::record_scenario(tracking(60.0), o);
+    return o.out_dir;
+  }();
+  return dir;
+}
+
+}  // namespace
+
+static void BM_ReplayTrackingMatching(benchmark::State& state) {
+  const std::string dir = recording();
+  const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
+  const harness::Scenario sc = harness::replay_scenario(head, {{"type", "matching"}});
+  harness::RunOptions o;
+  o.out_dir = tmp("replay_out").string();
+  o.replay = true;
+  double frames = 0;
+  for (auto _ : state) {
+    harness::RecordingSource source(harness::RecordingHeader::read(dir));
+    const auto r = harness::run_frames(sc, head.seed, source, o, Json::object());
+    frames += static_cast<double>(r.robots.at(0).frames);
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(frames, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ReplayTrackingMatching)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// Reading alone: decompressing, parsing and checking every frame.
+static void BM_ReadTrackingRecording(benchmark::State& state) {
+  const std::string dir = recording();
+  double frames = 0;
+  for (auto _ : state) {
+    harness::RecordingSource source(harness::RecordingHeader::read(dir));
+    while (auto f = source.next()) frames += 1;
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(frames, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_ReadTrackingRecording)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// A live run and a recording of the same 10 s: what recording adds to drawing the frames.
+static void BM_LiveTracking10s(benchmark::State& state) {
+  const harness::Scenario sc = tracking(10.0);
+  harness::RunOptions o;
+  o.out_dir = tmp("live_out").string();
+  for (auto _ : state) benchmark::DoNotOptimize(harness::run_scenario(sc, o));
+}
+BENCHMARK(BM_LiveTracking10s)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+static void BM_RecordTracking10s(benchmark::State& state) {
+  const harness::Scenario sc = tracking(10.0);
+  harness::RecordOptions o;
+  o.out_dir = tmp("record_out").string();
+  for (auto _ : state) benchmark::DoNotOptimize(harness::record_scenario(sc, o));
+}
+BENCHMARK(BM_RecordTracking10s)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
