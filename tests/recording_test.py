@@ -112,13 +112,17 @@ class Recording(unittest.TestCase):
     def test_external_clients_see_the_same_frames(self):
         # The client tees what it is sent: live and replayed messages must be the same bytes (the
         # hello carries omniloc's version and is left out; the frames and reset are compared).
-        for client, tag, images in [("dead_reckoning.py", "py_dr", False), ("particle_filter.py", "py_pf", False), ("own_vision.py", "py_ov", True)]:
-            with self.subTest(client=client):
+        cpp = Path(BIN).resolve().parent / "olp_cpp_example"  # the C++ header's example, built beside omniloc
+        clients = [(f"'{PY}' '{EXAMPLES / 'dead_reckoning.py'}'", "py_dr", False), (f"'{PY}' '{EXAMPLES / 'particle_filter.py'}'", "py_pf", False),
+                   (f"'{PY}' '{EXAMPLES / 'own_vision.py'}'", "py_ov", True), (f"'{cpp}'", "cpp_dr", False)]
+        self.assertTrue(cpp.exists(), f"{cpp}: build it (scripts/build.sh builds it with omniloc)")
+        for client, tag, images in clients:
+            with self.subTest(client=tag):
                 wire = {}
                 for mode in ("live", "replay"):
                     log = self.tmp / f"wire_{tag}_{mode}.bin"
                     wire[mode] = log
-                    loc = {"type": "external", "command": ["sh", "-c", f"tee '{log}' | '{PY}' '{EXAMPLES / client}'"], "label": tag}
+                    loc = {"type": "external", "command": ["sh", "-c", f"tee '{log}' | {client}"], "label": tag}
                     if mode == "live":
                         s = dict(self.scenarios["tracking"], localizer=loc)
                         f = self.tmp / f"tracking_{tag}.json"
@@ -242,6 +246,23 @@ class Recording(unittest.TestCase):
         rec = self.copy("kidnap", "not_gzip")
         self.rewrite(rec, gz=b"this is not gzip")
         self.bad_replay(rec, expect=["frames.jsonl.gz", "gzip"])
+
+        # Keys a later omniloc adds to version 1 are ignored (docs/recording.md): the replay is unchanged.
+        rec = self.copy("kidnap", "added_keys")
+        head = json.loads((rec / "recording.json").read_text())
+        head["a_later_key"] = {"x": 1}
+        head["robots"][0]["another"] = True
+        (rec / "recording.json").write_text(json.dumps(head))
+        lines = [json.loads(x) for x in self.lines(rec)]
+        for f in lines:
+            f["later"] = 1
+            f["robots"][0]["later_too"] = [1, 2]
+        self.rewrite(rec, lines=[json.dumps(f).encode() + b"\n" for f in lines])
+        out = self.tmp / "added_keys_out"
+        self.omniloc("replay", str(rec), "--localizer", '{"type": "matching"}', "-o", str(out), "--quiet")
+        ref = self.tmp / "added_keys_ref"
+        self.omniloc("replay", str(self.recordings["kidnap"]), "--localizer", '{"type": "matching"}', "-o", str(ref), "--quiet")
+        self.assertEqual((out / "est.tum").read_bytes(), (ref / "est.tum").read_bytes())
 
         rec = self.copy("kidnap", "future")
         head = json.loads((rec / "recording.json").read_text())
