@@ -123,17 +123,19 @@ Estimate ExternalLocalizer::parse_estimate(const Json& msg, long long expected_k
   return e;
 }
 
+Json blob_json(const Blob& b) {
+  const char* colour = b.colour == kYellow ? "yellow" : b.colour == kBlue ? "blue" : b.colour == kRed ? "red" : "unknown";
+  return {{"colour", colour}, {"kind", kind_name(b.kind)}, {"bearing", b.bearing}, {"left_bearing", b.left_bearing},
+          {"right_bearing", b.right_bearing}, {"distance", b.has_distance ? Json(b.distance) : Json(nullptr)},
+          {"area_px", b.area_px}, {"left_occluded", b.left_occluded}, {"right_occluded", b.right_occluded}};
+}
+
 Json ExternalLocalizer::frame_json(long long k, const Observations& obs, const Odometry& odometry, std::optional<double> heading) {
   Json pts = Json::array();
   pts.get_ref<Json::array_t&>().reserve(obs.line_points.size());
   for (const auto& p : obs.line_points) pts.push_back(Json::array({p.x(), p.y()}));
   Json blobs = Json::array();
-  for (const auto& b : obs.blobs) {
-    const char* colour = b.colour == kYellow ? "yellow" : b.colour == kBlue ? "blue" : b.colour == kRed ? "red" : "unknown";
-    blobs.push_back({{"colour", colour}, {"kind", kind_name(b.kind)}, {"bearing", b.bearing}, {"left_bearing", b.left_bearing},
-                     {"right_bearing", b.right_bearing}, {"distance", b.has_distance ? Json(b.distance) : Json(nullptr)},
-                     {"area_px", b.area_px}, {"left_occluded", b.left_occluded}, {"right_occluded", b.right_occluded}});
-  }
+  for (const auto& b : obs.blobs) blobs.push_back(blob_json(b));
   return {{"type", "frame"},
           {"k", k},
           {"t", obs.t},

@@ -27,6 +27,9 @@ struct Session {
   std::vector<std::string> reserved_names;  ///< built-in localizer names a client may not take
 };
 
+/// One blob as olp/1's frame.blobs holds it (docs/protocol.md); recordings store blobs the same way.
+Json blob_json(const Blob& blob);
+
 class ExternalLocalizer : public Localizer {
  public:
   /// Starts the client, sends hello and waits for ready (hello_timeout_s). Throws RuntimeFailure.

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "core/version.hpp"
+#include "external/external_localizer.hpp"
 #include "external/sha256.hpp"
 #include "harness/external_session.hpp"
 #include "harness/gzip.hpp"
@@ -34,8 +35,6 @@ namespace {
 constexpr long long kMaxFrames = 720000;
 constexpr std::uintmax_t kMaxFramesBytes = 8ULL << 30;
 
-const char* colour_name(ColourClass c) { return c == kYellow ? "yellow" : c == kBlue ? "blue" : c == kRed ? "red" : "unknown"; }
-const char* kind_name(Blob::Kind k) { return k == Blob::Kind::kLeftEdge ? "left_edge" : k == Blob::Kind::kRightEdge ? "right_edge" : "region"; }
 
 std::string image_name(int robot, long long k) {
   char name[64];
@@ -50,10 +49,7 @@ Json robot_to_json(const RobotFrame& r) {
   pts.get_ref<Json::array_t&>().reserve(r.obs.line_points.size());
   for (const auto& p : r.obs.line_points) pts.push_back(Json::array({p.x(), p.y()}));
   Json blobs = Json::array();
-  for (const auto& b : r.obs.blobs)
-    blobs.push_back({{"colour", colour_name(b.colour)}, {"kind", kind_name(b.kind)}, {"bearing", b.bearing}, {"left_bearing", b.left_bearing},
-                     {"right_bearing", b.right_bearing}, {"distance", b.has_distance ? Json(b.distance) : Json(nullptr)},
-                     {"area_px", b.area_px}, {"left_occluded", b.left_occluded}, {"right_occluded", b.right_occluded}});
+  for (const auto& b : r.obs.blobs) blobs.push_back(external::blob_json(b));  // olp/1's frame.blobs format
   Json j = {{"robot", r.id},
             {"odometry", pose_json(r.odometry.delta)},
             {"heading", r.heading ? Json(*r.heading) : Json(nullptr)},
