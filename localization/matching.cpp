@@ -25,6 +25,11 @@ const ParamList<MatchingParams>& MatchingParams::params() {
       number_param("heading_prior", &P::heading_prior, 0.0, 1000.0, "", "weight of (theta - predicted theta)^2 (Tribots: 2.5)"),
       positive_param("point_sigma", &P::point_sigma, 2.0, "m", "line-point noise that turns the error's curvature into a covariance"),
       number_param("cell", &P::cell, 0.005, 0.5, "m", "distance-map cell (Tribots: 50 mm)"),
+      bool_param("range_weights", &P::range_weights, "weigh line points by range: (weight_ref^2 + weight_d^2) / (weight_d^2 + r^2) (NuBot)"),
+      positive_param("weight_d", &P::weight_d, 100.0, "m", "range weights: the range scale d (NuBot: 2.5 m)"),
+      positive_param("weight_ref", &P::weight_ref, 100.0, "m", "range weights: the range whose points weigh 1 (NuBot: 1.5 m)"),
+      number_param("tilt_sd", &P::tilt_sd, 0.0, 0.2, "rad", "camera tilt std (roll, pitch) shared by a frame's points, in the match covariance; 0: none"),
+      positive_param("camera_height", &P::camera_height, 5.0, "m", "mirror viewpoint above the floor, for tilt_sd"),
   };
   return list;
 }
@@ -62,8 +67,47 @@ double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts,
   return match_data_term(map, pts, {pose.x, pose.y, pose.theta}, c, nullptr) / pts.size();
 }
 
+PointWeights range_weights(const std::vector<Eigen::Vector2d>& pts, const MatchingParams& p) {
+  PointWeights w;
+  if (!p.range_weights) return w;
+  const double d2 = p.weight_d * p.weight_d, num = p.weight_ref * p.weight_ref + d2;
+  w.w.reserve(pts.size());
+  for (const auto& o : pts) {
+    w.w.push_back(num / (d2 + o.squaredNorm()));
+    w.total += w.w.back();
+  }
+  return w;
+}
+
+namespace {
+
+// The points as a camera tilted by tau (radians; tau.x() tips the view along the robot's x axis,
+// tau.y() along y) would place them: a floor point at range r and unit direction u seen from height
+// h moves by (h^2 + r^2) / h per radian of tilt towards u (d(h / tan(a)) / da = -(h^2 + r^2) / h).
+std::vector<Eigen::Vector2d> tilted(const std::vector<Eigen::Vector2d>& pts, const Eigen::Vector2d& tau, double h) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(pts.size());
+  for (const auto& o : pts) {
+    const double r = o.norm();
+    if (r <= 0) {
+      out.push_back(o);
+      continue;
+    }
+    const Eigen::Vector2d u = o / r;
+    out.push_back(o + u * (u.dot(tau) * (h * h + r * r) / h));
+  }
+  return out;
+}
+
+}  // namespace
+
 MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>& pts, const Pose2& start, const MatchingParams& p,
                         int max_iterations, std::optional<double> prior_theta, std::vector<double>* trace) {
+  const PointWeights pw = range_weights(pts, p);
+  const double total = p.range_weights ? pw.total : static_cast<double>(pts.size());
+  const auto term = [&](const std::vector<Eigen::Vector2d>& at, const Eigen::Vector3d& x, double c, Eigen::Vector3d* g) {
+    return match_data_term(map, at, x, c, g, &pw);
+  };
   Eigen::Vector3d q(start.x, start.y, start.theta);
   Eigen::Vector3d step(p.step_xy, p.step_xy, p.step_theta), prev = Eigen::Vector3d::Zero();
   const Eigen::Vector3d max_step(1.0, 1.0, 0.5), min_step(1e-6, 1e-6, 1e-6);
@@ -89,8 +133,8 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     prev.setZero();
     while (r.iterations < end) {
       Eigen::Vector3d g;
-      match_data_term(map, pts, q, c, &g);
-      if (trace) trace->push_back(pts.empty() ? 1.0 : match_data_term(map, pts, q, p.c, nullptr) / pts.size());
+      term(pts, q, c, &g);
+      if (trace) trace->push_back(pts.empty() ? 1.0 : term(pts, q, p.c, nullptr) / total);
       if (prior_theta && p.heading_prior > 0) g.z() += 2.0 * p.heading_prior * angle_diff(q.z(), *prior_theta);
       for (int k = 0; k < 3; ++k) {
         // iRPROP-: on a sign change shrink the step and skip this update.
@@ -111,7 +155,7 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     }
   }
   r.pose = Pose2(q.x(), q.y(), q.z());
-  r.error = pts.empty() ? 1.0 : match_data_term(map, pts, q, p.c, nullptr) / pts.size();
+  r.error = pts.empty() ? 1.0 : term(pts, q, p.c, nullptr) / total;
   if (trace) trace->push_back(r.error);
   // Curvature of the data term by central differences of its gradient. Near the optimum
   // e(d) ~ d^2 / c^2, so the Gauss-Newton information of points with noise sigma is H c^2 / (2 sigma^2).
@@ -121,16 +165,33 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     Eigen::Vector3d qp = q, qm = q, gp, gm;
     qp[k] += h[k];
     qm[k] -= h[k];
-    match_data_term(map, pts, qp, p.c, &gp);
-    match_data_term(map, pts, qm, p.c, &gm);
+    term(pts, qp, p.c, &gp);
+    term(pts, qm, p.c, &gm);
     H.col(k) = (gp - gm) / (2 * h[k]);
   }
   H = 0.5 * (H + H.transpose()).eval();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H * (p.c * p.c / (2 * p.point_sigma * p.point_sigma)));
+  const double info_per_curvature = p.c * p.c / (2 * p.point_sigma * p.point_sigma);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(H * info_per_curvature);
   Eigen::Vector3d ev = es.eigenvalues();
   // A flat direction (all points on one line) gets a large variance instead of an infinite one.
   for (int k = 0; k < 3; ++k) ev[k] = 1.0 / std::max(ev[k], 1.0);
   r.covariance = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+  if (p.tilt_sd > 0 && !pts.empty()) {
+    // A tilt moves all points together, so its share of the error does not average out over them:
+    // the minimum moves by dq / dtau = -H^-1 d(grad E) / dtau (implicit function theorem), with
+    // d(grad E) / dtau by central differences of tilted points. r.covariance is (H s)^-1, s the
+    // information per curvature, so H^-1 = s r.covariance (flat directions capped as above).
+    const double eps = 1e-3;  // rad: moves a point at 6 m by 5 cm, within the error's quadratic range
+    Eigen::Matrix<double, 3, 2> J;
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector2d tau = eps * Eigen::Vector2d::Unit(k);
+      Eigen::Vector3d gp, gm;
+      term(tilted(pts, tau, p.camera_height), q, p.c, &gp);
+      term(tilted(pts, -tau, p.camera_height), q, p.c, &gm);
+      J.col(k) = -info_per_curvature * r.covariance * ((gp - gm) / (2 * eps));
+    }
+    r.covariance += p.tilt_sd * p.tilt_sd * J * J.transpose();
+  }
   return r;
 }
 

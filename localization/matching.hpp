@@ -14,6 +14,7 @@
 #include "localization/filter/odometry_noise.hpp"
 #include "localization/filter/pose_kalman.hpp"
 #include "localization/localizer.hpp"
+#include "localization/match_data_term.hpp"
 
 namespace omniloc {
 
@@ -40,6 +41,20 @@ struct MatchingParams {
   double heading_prior = 2.5;    ///< weight of (theta - predicted theta)^2 (Tribots: 2.5)
   double point_sigma = 0.05;     ///< m, line-point noise used to turn curvature into covariance
   double cell = 0.05;            ///< m, distance-map cell (Tribots: 50 mm)
+  /// Range weights (NuBot, Whites::calculateWeights): point i at range r_i (metres from the robot)
+  /// weighs w_i = (weight_ref^2 + weight_d^2) / (weight_d^2 + r_i^2), so a point at weight_ref weighs
+  /// 1 and far points, whose floor positions a pixel or a tilt of the camera moves most, less.
+  bool range_weights = true;
+  double weight_d = 2.5;         ///< m (NuBot: 250 cm)
+  double weight_ref = 1.5;       ///< m (NuBot: 150 cm)
+  /// Standard deviation of the camera's tilt (roll and pitch each, radians) that moves every line
+  /// point of a frame at once: a floor point at range r seen from height camera_height moves
+  /// radially by (h^2 + r^2) / h per radian. Its effect on the matched pose enters the Kalman
+  /// measurement covariance (it does not shrink with the number of points). 0: points independent.
+  /// Default 0: 0.0052 (0.3 deg, docs/camera.md vibration) halves heading errors again on the paper
+  /// path but loses on the occlusion path's p95 (docs/vision_and_tracking.md "Against NuBot's code").
+  double tilt_sd = 0.0;          ///< rad
+  double camera_height = 0.75;   ///< m, mirror viewpoint above the floor (docs/camera.md mount_height)
   /// Odometry process noise of the Kalman filter per frame (JSON odo_trans_frac 0.05, odo_rot_frac
   /// 0.05, odo_rot_per_m 0.02 rad/m, odo_floor_xy 0.002 m, odo_floor_theta 0.002 rad).
   filter::OdometryNoiseParams odometry{0.05, 0.05, 0.02, 0.002, 0.002};
@@ -58,6 +73,9 @@ struct MatchResult {
   bool converged = false;  ///< the steps fell below step_tol at the final c before the cap
   int points = 0;
 };
+
+/// The range weights of `pts` (robot frame) under p (empty when p.range_weights is off).
+PointWeights range_weights(const std::vector<Eigen::Vector2d>& pts, const MatchingParams& p);
 
 /// Mean error of the points (robot frame) at `pose`.
 double match_error(const FieldMap& map, const std::vector<Eigen::Vector2d>& points, const Pose2& pose, double c);
