@@ -1,9 +1,11 @@
 #include "batch/aggregate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <initializer_list>
 #include <map>
+#include <set>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -96,12 +98,41 @@ struct Group {
   std::size_t finished = 0, failed = 0, missing = 0;
   std::map<std::string, std::vector<double>> values;
   Json external;  // an external client's provenance (summary.json "external"), one entry per distinct client
+  std::vector<std::string> names;  // the names an external client's runs recorded (summary.json "localizer"), distinct
+  std::set<std::string> given;     // the runs' start_pose_given: "true", "false", "" (a run from before the key)
 };
+
+// The name a finished run carries (docs/protocol.md "Which name"): an external client's run records
+// it (its label, else ready.name), which the sweep cannot know before the client said ready; a
+// built-in localizer's row keeps the sweep's label (two labelled entries of one type stay apart).
+std::string run_name(const SweepRun& r, const Json& summary) {
+  if (summary.value("localizer_type", std::string()) == "external" && summary.contains("localizer") && summary["localizer"].is_string())
+    return summary["localizer"].get<std::string>();
+  return r.localizer_label;
+}
+
+// summary.json's start_pose_given as a CSV value: "true", "false", or "" where the run predates it.
+std::string given_text(const Json& summary) {
+  const auto it = summary.find("start_pose_given");
+  return it != summary.end() && it->is_boolean() ? (it->get<bool>() ? "true" : "false") : "";
+}
+
+// A group's start_pose_given: "true" / "false" when its finished runs agree, "mixed" when not (a
+// resume after the client changed its mind; the row then mixes two tasks and says so), "" unknown.
+std::string group_given(const Group& g) {
+  if (g.given.size() > 1) return "mixed";
+  return g.given.empty() ? "" : *g.given.begin();
+}
+
+Json given_json(const std::string& v) {
+  if (v == "true" || v == "false") return v == "true";
+  return v.empty() ? Json(nullptr) : Json(v);
+}
 
 // What the folder holds of every run of the sweep, in run order.
 struct Census {
   std::vector<Group> groups;
-  std::string runs_csv = "index,id,scenario,localizer,params,seed,status\n";
+  std::string runs_csv = "index,id,scenario,localizer,params,seed,status,start_pose_given\n";
   std::map<std::string, std::size_t> run_versions;  // which builds made the finished runs (a resume may mix them)
   std::size_t missing = 0, failed = 0;
 };
@@ -119,7 +150,7 @@ Census take_census(const SweepSpec& spec, const fs::path& dir) {
       c.groups.push_back(std::move(g));
     }
     Group& g = c.groups[it->second];
-    std::string status;
+    std::string status, name = r.localizer_label, given;
     if (run_finished(dir, r)) {
       status = "ok";
       ++g.finished;
@@ -130,6 +161,11 @@ Census take_census(const SweepSpec& spec, const fs::path& dir) {
         throw RuntimeFailure("cannot read the finished run " + r.id + ": " + e.what());
       }
       for (const auto& [k, v] : run_metrics(s)) g.values[k].push_back(v);
+      name = run_name(r, s);
+      given = given_text(s);
+      g.given.insert(given);
+      const bool external = s.value("localizer_type", std::string()) == "external";
+      if (external && std::find(g.names.begin(), g.names.end(), name) == g.names.end()) g.names.push_back(name);
       // Which client made the group's runs (a resume after the client changed may mix several).
       if (s.contains("external")) {
         if (g.external.is_null()) g.external = Json::array();
@@ -145,14 +181,28 @@ Census take_census(const SweepSpec& spec, const fs::path& dir) {
       ++g.missing;
       ++c.missing;
     }
-    c.runs_csv +=
-        csv_row({std::to_string(r.index), r.id, r.scenario_name, r.localizer_label, r.params_label, std::to_string(r.seed), status});
+    c.runs_csv += csv_row({std::to_string(r.index), r.id, r.scenario_name, name, r.params_label, std::to_string(r.seed), status, given});
+  }
+  // A row is named as its runs are; several names only when a resume mixed two clients.
+  for (Group& g : c.groups) {
+    if (g.names.empty()) continue;
+    g.localizer.clear();
+    for (const auto& n : g.names) g.localizer += (g.localizer.empty() ? "" : "+") + n;
   }
   return c;
 }
 
-// A group's line of the printed table: robot 0's mean errors, its position RMSE with interval.
-std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, bool phased) {
+// A group's name in the printed table. `mark_given`: the table holds rows given the start pose and
+// rows that were not; those given it say so.
+std::string group_label(const Group& g, bool mark_given) {
+  const std::string given = group_given(g);
+  const std::string mark = given == "mixed" ? " (start pose: mixed)" : mark_given && given == "true" ? " (given the start pose)" : "";
+  return g.scenario + " / " + g.localizer + mark + " / " + g.params;
+}
+
+// A group's line of the printed table, its name padded to `width`: robot 0's mean errors, its
+// position RMSE with interval.
+std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, bool phased, bool mark_given, int width) {
   auto m = [&](const std::string& k) {
     const std::string key = phased ? "r0/tracking_phase/" + k : "r0/" + k;
     return ivs.count(key) ? ivs[key].mean : NAN;
@@ -165,41 +215,47 @@ std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, boo
   } else {
     std::snprintf(ci, sizeof ci, "-");
   }
-  const std::string label = g.scenario + " / " + g.localizer + " / " + g.params + (phased ? " *" : "");
+  const std::string label = group_label(g, mark_given) + (phased ? " *" : "");
   char line[512];
-  std::snprintf(line, sizeof line, "%-44s %4zu %4zu | %9.3f %9.3f %9.4f | %s\n", label.c_str(), g.finished, g.failed,
-                m("x_cm/mean"), m("y_cm/mean"), m("theta_rad/mean"), ci);
-  return line;
+  std::snprintf(line, sizeof line, " %4zu %4zu | %9.3f %9.3f %9.4f | %s\n", g.finished, g.failed, m("x_cm/mean"), m("y_cm/mean"),
+                m("theta_rad/mean"), ci);
+  return label + std::string(static_cast<std::size_t>(std::max(0, width - static_cast<int>(label.size()))), ' ') + line;
 }
 
 // Aggregates every run of the sweep found finished in the folder, in run order: writes runs.csv and
 // aggregate.{csv,json} when nothing is missing, and the printed table into `out`.
 void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Census& census, AggregateOutcome& out) {
-  std::string csv = "scenario,localizer,params,metric,n,mean,ci95_low,ci95_high\n";
+  std::string csv = "scenario,localizer,params,start_pose_given,metric,n,mean,ci95_low,ci95_high\n";
   // expected / done / failed: a reader sees at once whether every run is in (done counts failed ones).
   Json agg{{"sweep", spec.name}, {"runs", spec.runs.size()}, {"expected", out.expected}, {"done", out.done}, {"failed", out.failed},
            {"complete", out.missing == 0}, {"omniloc", build_info_json()}, {"run_versions", census.run_versions},
            {"groups", Json::array()}};
+  bool any_phased = false;
+  std::set<std::string> kinds;
+  for (const auto& g : census.groups) kinds.insert(group_given(g));
+  const bool mark_given = kinds.count("true") && (kinds.count("false") || kinds.count("mixed"));
+  int width = 44;  // the names' column: as wide as the longest name (with a phase's " *")
+  for (const auto& g : census.groups) width = std::max(width, static_cast<int>(group_label(g, mark_given).size()) + 2);
   char line[512];
-  std::snprintf(line, sizeof line, "%-44s %4s %4s | %9s %9s %9s | %-26s\n", "scenario / localizer / params", "ok", "fail", "mean x cm",
+  std::snprintf(line, sizeof line, "%-*s %4s %4s | %9s %9s %9s | %-26s\n", width, "scenario / localizer / params", "ok", "fail", "mean x cm",
                 "mean y cm", "mean th", "position RMSE m (95 % CI)");
   out.table = line;
-  bool any_phased = false;
   for (const auto& g : census.groups) {
-    Json gj{{"scenario", g.scenario}, {"localizer", g.localizer}, {"params", g.params}, {"finished", g.finished},
-            {"failed", g.failed}, {"missing", g.missing}, {"metrics", Json::object()}};
+    const std::string given = group_given(g);
+    Json gj{{"scenario", g.scenario}, {"localizer", g.localizer}, {"params", g.params}, {"start_pose_given", given_json(given)},
+            {"finished", g.finished}, {"failed", g.failed}, {"missing", g.missing}, {"metrics", Json::object()}};
     if (!g.external.is_null()) gj["external"] = g.external;
     std::map<std::string, Interval> ivs;
     for (const auto& [k, v] : g.values) {
       const Interval iv = mean_ci95(v);
       ivs[k] = iv;
       gj["metrics"][k] = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}};
-      csv += csv_row({g.scenario, g.localizer, g.params, k, std::to_string(iv.n), fmt(iv.mean), fmt(iv.low), fmt(iv.high)});
+      csv += csv_row({g.scenario, g.localizer, g.params, given, k, std::to_string(iv.n), fmt(iv.mean), fmt(iv.low), fmt(iv.high)});
     }
     agg["groups"].push_back(gj);
     // Runs with kidnaps or covers: the tracking phase, as the papers' tables (marked "*").
     const bool phased = ivs.count("r0/tracking_phase/x_cm/mean") > 0;
-    out.table += table_line(g, ivs, phased);
+    out.table += table_line(g, ivs, phased, mark_given, width);
     any_phased = any_phased || phased;
   }
   if (any_phased) out.table += "* runs with kidnaps or covers: errors of the tracking phase (summary.json tracking_phase); RMSE over all frames\n";
@@ -218,6 +274,15 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
 }
 
 }  // namespace
+
+std::string run_localizer_name(const fs::path& dir, const SweepRun& r) {
+  if (!run_finished(dir, r)) return r.localizer_label;
+  try {
+    return run_name(r, Json::parse(read_file((dir / "runs" / r.id / "summary.json").string())));
+  } catch (const std::exception&) {
+    return r.localizer_label;  // only a progress line asks; the aggregate reports an unreadable run
+  }
+}
 
 AggregateOutcome write_final_aggregate(const SweepSpec& spec, const fs::path& dir) {
   const Census census = take_census(spec, dir);

@@ -23,6 +23,11 @@ Interval mean_ci95(const std::vector<double>& v);
 /// Whether run `r` has a finished folder (its summary.json is written last, by rename).
 bool run_finished(const std::filesystem::path& dir, const SweepRun& r);
 
+/// The localizer name run `r` carries in runs.csv, the aggregate and progress lines (docs/protocol.md
+/// "Which name"): an external client's finished run, the name it recorded in summary.json (the
+/// entry's label, else the client's ready.name); otherwise the sweep's row label.
+std::string run_localizer_name(const std::filesystem::path& dir, const SweepRun& r);
+
 struct AggregateOutcome {
   std::size_t expected = 0, done = 0, failed = 0, missing = 0;
   bool written = false;  ///< the final files were written (nothing missing)

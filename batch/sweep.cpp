@@ -33,10 +33,11 @@ using harness::remove_stale_partials;
 namespace {
 
 // A run as a person reads it in progress lines ("tracking / mcl / occlusion={...}, seed 2"); the
-// folder id (sanitized for file names) stays in the files.
-std::string readable(const SweepRun& r) {
-  return r.scenario_name + " / " + r.localizer_label + (r.params_label == "default" ? "" : " / " + r.params_label) + ", seed " +
-         std::to_string(r.seed);
+// folder id (sanitized for file names) stays in the files. `name`: the localizer's (default: the
+// row label; a finished external client's run: the name it recorded, as the aggregate shows it).
+std::string readable(const SweepRun& r, const std::string& name = "") {
+  return r.scenario_name + " / " + (name.empty() ? r.localizer_label : name) + (r.params_label == "default" ? "" : " / " + r.params_label) +
+         ", seed " + std::to_string(r.seed);
 }
 
 std::string fmt(double v) {
@@ -287,7 +288,8 @@ class SweepWorkers {
       *o_.progress << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done_ << "/" << todo_.size()
                    << " failed " << failed_ << " ETA " << fmt_duration(eta) << "   " << std::flush;
     } else {
-      *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << readable(r) << (ok ? ": ok " : ": FAILED ") << fmt(secs) << " s, ETA "
+      *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << readable(r, ok ? run_localizer_name(folder_.dir, r) : "")
+                   << (ok ? ": ok " : ": FAILED ") << fmt(secs) << " s, ETA "
                    << fmt_duration(eta) << "\n";
     }
   }

@@ -61,6 +61,8 @@ struct ScenarioEntry {
 
 // The row name of localizer entry `lj` at JSON path `at`: its "label" (checked here, before anything
 // reads it as a string), else an external client's script stem (docs/protocol.md), else the type.
+// It names the run folders; an external client's rows are named by what its runs record
+// (aggregate.cpp run_name: the label, else the client's ready.name).
 std::string row_label(const Json& lj, const std::string& at) {
   if (const auto it = lj.find("label"); it != lj.end()) {
     static const std::regex re("[A-Za-z0-9_.-]{1,64}");
@@ -84,7 +86,9 @@ Localizers parse_localizers(const Json& l, const std::string& at) {
     const std::string lp = json_child(at, i);
     if (!lj["type"].is_string()) throw ConfigError(json_child(lp, "type"), json_brief(lj["type"]), "a localizer type name (omniloc list)");
     std::string label = row_label(lj, lp);
-    lj.erase("label");  // it names the sweep's row; the localizer's reader never sees it
+    // It names the sweep's row; a built-in localizer's reader never sees it. An external client's run
+    // keeps it: the name its results carry is the label the user gave (docs/protocol.md "Which name").
+    if (lj["type"] != "external") lj.erase("label");
     locs.push_back({sanitize(label), lj, lp});
   }
   return locs;
@@ -364,7 +368,7 @@ Json sweep_schema() {
   Json entry = localizer;  // a sweep's localizer entry: a scenario's localizer with a row name
   entry["required"] = Json::array({"type"});
   const Json label = {{"type", "string"}, {"pattern", "^[A-Za-z0-9_.-]{1,64}$"},
-                      {"description", "the sweep's row name (default: the type, or an external client's script name)"}};
+                      {"description", "the sweep's row name (default: the type; an external client's rows: its ready.name, its run folders: the script's name)"}};
   const Json localizers = {{"type", "array"}, {"minItems", 1}, {"items", {{"allOf", Json::array({entry, {{"properties", {{"label", label}}}}})}}},
                            {"description", "localizers each scenario runs with (default: the scenario's own)"}};
   const Json parameters = {{"type", "object"},

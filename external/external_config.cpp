@@ -109,7 +109,7 @@ Json ExternalConfig::schema() {
       {"hello_timeout_s", num("seconds from starting the client to its ready message", 60, 3600)},
       {"frame_timeout_s", num("seconds from sending a frame to its estimate", 10, 3600)},
       {"exit_timeout_s", num("seconds from end to the client's exit", 5, 600)},
-      {"label", {{"type", "string"}, {"pattern", "^[A-Za-z0-9_.-]{1,64}$"}, {"description", "sweeps: the row name (default: the script's file name)"}}},
+      {"label", {{"type", "string"}, {"pattern", "^[A-Za-z0-9_.-]{1,64}$"}, {"description", "the name results carry (default: the client's ready.name; a sweep's run folders: the script's file name)"}}},
       {"hash", {{"type", "array"}, {"items", {{"type", "string"}, {"minLength", 1}}}, {"maxItems", 256},
                 {"description", "more files whose SHA-256 summary.json records beside the command's (the client's modules, models); relative to cwd"}}},
   };

@@ -18,7 +18,7 @@ struct ExternalConfig {
   double hello_timeout_s = 60.0;             ///< seconds from start to ready
   double frame_timeout_s = 10.0;             ///< seconds from sending a frame to its estimate
   double exit_timeout_s = 5.0;               ///< seconds from end to the client's exit
-  std::string label;                         ///< sweeps: row name (default: the script's stem)
+  std::string label;                         ///< the name results carry (default: ready.name; run folders: the script's stem)
   std::vector<std::string> hash;             ///< more files whose SHA-256 provenance records (the client's modules), absolute
   std::string program;                       ///< command[0] resolved (PATH or cwd), absolute
 

@@ -37,7 +37,9 @@ class ExternalLocalizer : public Localizer {
   ~ExternalLocalizer() override;  ///< ends the client's process group if finish() was not reached
 
   std::string type() const override { return "external"; }
-  std::string name() const override { return name_; }
+  /// The name results carry: the entry's "label" when the user gave one, else ready.name (never
+  /// empty once ready was read). One rule for summary.json, the aggregate and the report.
+  std::string name() const override { return cfg_.label.empty() ? name_ : cfg_.label; }
   bool wants_start_pose() const override { return needs_start_pose_; }
   bool wants_image() const { return wants_image_; }
   Json provenance() const override;

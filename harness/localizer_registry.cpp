@@ -9,6 +9,18 @@
 
 namespace omniloc::harness {
 
+namespace {
+// An external localizer's keys. Its "label" is the name its results carry, so it may not be a
+// built-in localizer's: tables pair rows by that name and would take the client for the built-in.
+external::ExternalConfig read_external(JsonReader& r) {
+  external::ExternalConfig cfg = external::ExternalConfig::from_json(r);
+  for (const auto& l : localizers())
+    if (!cfg.label.empty() && cfg.label == l.type)
+      throw ConfigError(r.child_path("label"), "\"" + cfg.label + "\"", "a name that is not a built-in localizer's (omniloc list)");
+  return cfg;
+}
+}  // namespace
+
 const std::vector<LocalizerInfo>& localizers() {
   static const std::vector<LocalizerInfo> list = {
       {"odometry_only", "dead reckoning from the true start pose (odometry drift baseline)", true, false,
@@ -36,15 +48,15 @@ const std::vector<LocalizerInfo>& localizers() {
       {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },
        [] { return params_schema(LandmarkLocalizerParams::params()); }},
-      {"external", "a user's localizer in any language, run as its own process and spoken to in olp/1 (docs/protocol.md); named in results by the name the client reports", false, true,
+      {"external", "a user's localizer in any language, run as its own process and spoken to in olp/1 (docs/protocol.md); named in results by its label, else by the name the client reports", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) -> std::unique_ptr<Localizer> {
-         external::ExternalConfig cfg = external::ExternalConfig::from_json(r);
+         external::ExternalConfig cfg = read_external(r);
          if (!ctx.session)
            throw ConfigError(r.child_path("type"), "\"external\"", "a localizer that can run here (an external localizer runs only in a scenario run)");
          return std::make_unique<external::ExternalLocalizer>(std::move(cfg), *ctx.session);
        },
        &external::ExternalConfig::schema,
-       [](JsonReader& r) { external::ExternalConfig::from_json(r); }},
+       [](JsonReader& r) { read_external(r); }},
   };
   return list;
 }

@@ -39,18 +39,20 @@ ErrorSummary summarize(const std::vector<FrameError>& errors) {
   s.frames = errors.size();
   if (errors.empty()) return s;
   std::vector<double> ax, ay, at, pos;
-  double se2 = 0, st2 = 0;
+  double se2 = 0, st2 = 0, sum_pos = 0;
   for (const auto& e : errors) {
     ax.push_back(std::fabs(e.ex) * 100.0);
     ay.push_back(std::fabs(e.ey) * 100.0);
     at.push_back(std::fabs(e.eth));
     pos.push_back(std::hypot(e.ex, e.ey));
+    sum_pos += pos.back();
     se2 += e.ex * e.ex + e.ey * e.ey;
     st2 += e.eth * e.eth;
   }
   s.x_cm = stats(ax);
   s.y_cm = stats(ay);
   s.theta_rad = stats(at);
+  s.pos_mean_m = sum_pos / errors.size();
   s.pos_rmse_m = std::sqrt(se2 / errors.size());
   s.theta_rmse_rad = std::sqrt(st2 / errors.size());
   s.pos_p50_m = percentile(pos, 50);
@@ -66,7 +68,7 @@ Json to_json(const ErrorSummary& s) {
               {"x_cm", axis(s.x_cm)},
               {"y_cm", axis(s.y_cm)},
               {"theta_rad", axis(s.theta_rad)},
-              {"position_m", {{"rmse", s.pos_rmse_m}, {"p50", s.pos_p50_m}, {"p90", s.pos_p90_m}, {"p95", s.pos_p95_m}, {"max", s.pos_max_m}}},
+              {"position_m", {{"mean", s.pos_mean_m}, {"rmse", s.pos_rmse_m}, {"p50", s.pos_p50_m}, {"p90", s.pos_p90_m}, {"p95", s.pos_p95_m}, {"max", s.pos_max_m}}},
               {"theta_rmse_rad", s.theta_rmse_rad}};
 }
 

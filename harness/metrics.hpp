@@ -1,7 +1,7 @@
 #pragma once
 // Scoring: the only place where ground truth meets estimates. Errors per frame, and the papers'
 // table layout (mean, std and max of |x|, |y| errors in cm and |theta| error in rad) plus position
-// RMSE and percentiles.
+// mean, RMSE and percentiles.
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +27,7 @@ struct ErrorSummary {
   std::size_t frames = 0;        ///< frames scored
   AxisStats x_cm, y_cm;          ///< |x|, |y| errors, centimetres (papers' unit)
   AxisStats theta_rad;           ///< |theta| error, radians
+  double pos_mean_m = 0.0;       ///< mean(hypot(ex, ey)), metres: the typical error (RMSE weighs large ones more)
   double pos_rmse_m = 0.0;       ///< sqrt(mean(ex^2 + ey^2)), metres
   double pos_p50_m = 0.0, pos_p90_m = 0.0, pos_p95_m = 0.0, pos_max_m = 0.0;
   double theta_rmse_rad = 0.0;

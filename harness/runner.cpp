@@ -28,6 +28,7 @@ struct Tracked {
   std::unique_ptr<Localizer> localizer;
   std::string last_mode;  // as written to events.jsonl
   RobotRecord record;
+  bool start_pose_given = false;  // reset() got the true start pose (summary.json start_pose_given)
 };
 
 // One localizer per localized robot, each with its own random stream; tracking localizers start at
@@ -52,8 +53,8 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
     Json eff;
     tr.localizer = make_localizer(sc.localizer, "/localizer", ctx, &eff);
     effective["localizer"] = eff;
-    const bool start = info.needs_start_pose || tr.localizer->wants_start_pose();
-    tr.localizer->reset(start ? std::optional<Pose2>(sc.robot(id)->spec.start) : std::nullopt);
+    tr.start_pose_given = info.needs_start_pose || tr.localizer->wants_start_pose();
+    tr.localizer->reset(tr.start_pose_given ? std::optional<Pose2>(sc.robot(id)->spec.start) : std::nullopt);
     tracked.push_back(std::move(tr));
   }
   return tracked;
@@ -100,14 +101,18 @@ void robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOption
 }
 
 // Scores every robot and writes the result files; the table rows go to `result`.
-// `localizer`: the name results carry; `external`: an external client's provenance (else null).
-void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const Json& external,
+// `localizer`: the name results carry; `external`: an external client's provenance (else null);
+// `start_pose_given`: whether the localizer was reset with the true start pose.
+void write_results(const Scenario& sc, std::uint64_t seed, const std::string& localizer, const Json& external, bool start_pose_given,
                    const std::vector<RobotRecord>& records, const EventLog& log, const Json& effective, const Json& provenance,
                    RunDirectory& dir, RunResult& result) {
   Json summary;
   summary["scenario"] = sc.name;
   summary["seed"] = seed;
   summary["localizer"] = localizer;
+  // Tables must not pair a run that knew where it started with one that localized globally (tracking
+  // from the true pose is a far easier task), so every run states which it was.
+  summary["start_pose_given"] = start_pose_given;
   if (!external.is_null()) {
     summary["localizer_type"] = "external";
     summary["external"] = external;
@@ -191,9 +196,10 @@ RunResult run_frames(const Scenario& sc, std::uint64_t seed, FrameSource& source
   for (auto& tr : tracked) tr.localizer->finish();  // an external client must end cleanly, or the run fails
   const std::string name = tracked.empty() ? info.type : tracked.front().localizer->name();
   const Json external = tracked.empty() ? Json(nullptr) : tracked.front().localizer->provenance();
+  const bool start_pose_given = !tracked.empty() && tracked.front().start_pose_given;
   std::vector<RobotRecord> records;
   for (auto& tr : tracked) records.push_back(std::move(tr.record));
-  write_results(sc, seed, name, external, records, log, effective, provenance, dir, result);
+  write_results(sc, seed, name, external, start_pose_given, records, log, effective, provenance, dir, result);
   result.out_dir = dir.final_dir();
   return result;
 }

@@ -10,7 +10,10 @@ the seed and the run's name): the same condition on both sides pairs BY KEY, wha
 position a run has. Conditions left over pair with their nearest counterpart (same scenario and
 localizer, fewest differing values; then the same scenario with another localizer, to compare
 two localizers), and every value that differs is named ("differs: /occlusion/fraction: 0.125 ->
-0.25"). The text output fits 100 columns; --markdown gives one wide table. Per group and metric: mean over seeds of A and of B (n each), B - A, and
+0.25"). A condition given the true start pose (summary.json start_pose_given) never pairs with one
+that started from an unknown pose: tracking and global localization are different tasks; such a
+condition is listed as unpaired with the reason ("not comparable: ..."). Runs made before omniloc
+recorded start_pose_given pair as before. The text output fits 100 columns; --markdown gives one wide table. Per group and metric: mean over seeds of A and of B (n each), B - A, and
 Welch's unequal-variance t-test over the seeds; "yes" where p < alpha (default 0.05), i.e. the
 difference exceeds the seed-to-seed spread. With fewer than two seeds on a side there is no spread
 to compare with, and the difference is shown alone ("n < 2"). Identical numbers give "same".
@@ -25,7 +28,7 @@ import textwrap
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import omniloc_results as R  # noqa: E402
 
-METRICS = ["x_cm/mean", "y_cm/mean", "theta_rad/mean", "position_m/rmse", "position_m/p95", "line_points/mean", "wrong_frames",
+METRICS = ["x_cm/mean", "y_cm/mean", "theta_rad/mean", "position_m/mean", "position_m/rmse", "position_m/p95", "line_points/mean", "wrong_frames",
            "coasting_frames", "recovery/recovered", "recovery/recovery_time_s/median"]
 EXPLANATION = ("Runs pair by scenario, localizer and effective configuration (not by folder or position); numbers are robot 0's, "
                "tracking phase where a run has one. 'exceeds spread': Welch's t-test over seeds, p < alpha; n < 2: no spread to compare with.")
@@ -33,10 +36,17 @@ ALPHA = 0.05
 
 
 def group_key(run):
+    """(scenario, localizer, configuration, start_pose_given): the start pose is part of the
+    condition (True, False, or None for runs from before omniloc recorded it)."""
     cfg = dict(run.config)
     cfg.pop("seed", None)
     cfg.pop("name", None)
-    return (run.scenario, run.localizer, json.dumps(cfg, sort_keys=True))
+    return (run.scenario, run.localizer, json.dumps(cfg, sort_keys=True), run.start_pose_given)
+
+
+def same_task(x, y):
+    """Whether two conditions ran the same start-pose task (R.start_pose_compatible)."""
+    return R.start_pose_compatible(x[3], y[3])
 
 
 def flatten(obj, prefix=""):
@@ -72,9 +82,11 @@ def labels(keys):
     for sl, ks in by.items():
         flat = {k: flat_config(k) for k in ks}
         ptrs = sorted({p for f in flat.values() for p in f if len({f.get(p) for f in flat.values()}) > 1})
+        # Where one side holds a condition both with and without the start pose, the given one says so.
+        both = {k[3] for k in ks} >= {True, False}
         for k in ks:
             extra = ", ".join(f"{p}={flat[k].get(p, 'absent')}" for p in ptrs)
-            out[k] = f"{sl[0]} / {sl[1]}" + (f" / {extra}" if extra else "")
+            out[k] = f"{sl[0]} / {sl[1]}" + (f" / {extra}" if extra else "") + (" (given the start pose)" if both and k[3] is True else "")
     return out
 
 
@@ -120,20 +132,40 @@ def compare_pairs(runs_a, runs_b):
     another localizer (comparing two localizers on one scenario). differences: 'localizer: a -> b'
     and every differing configuration value 'pointer: a -> b'."""
     ga, gb = groups(runs_a), groups(runs_b)
-    pairs = [(k, k) for k in sorted(set(ga) & set(gb))]
-    left_a, left_b = [k for k in sorted(ga) if k not in gb], [k for k in sorted(gb) if k not in ga]
-    for same, skip in ((lambda x, y: x[:2] == y[:2], False), (lambda x, y: x[0] == y[0], True)):
+    pairs = [(k, k) for k in sorted(set(ga) & set(gb), key=sort_key)]
+    left_a, left_b = [k for k in sorted(ga, key=sort_key) if k not in gb], [k for k in sorted(gb, key=sort_key) if k not in ga]
+    # Identical but for a start pose one side did not record (an older build): the same condition.
+    found = mutual_nearest(left_a, left_b, lambda x, y: x[:3] == y[:3] and same_task(x, y))
+    pairs += found
+    left_a = [k for k in left_a if k not in {p[0] for p in found}]
+    left_b = [k for k in left_b if k not in {p[1] for p in found}]
+    for same, skip in ((lambda x, y: x[:2] == y[:2] and same_task(x, y), False), (lambda x, y: x[0] == y[0] and same_task(x, y), True)):
         found = mutual_nearest(left_a, left_b, same, skip)
         pairs += found
         left_a = [k for k in left_a if k not in {p[0] for p in found}]
         left_b = [k for k in left_b if k not in {p[1] for p in found}]
     out = []
-    for ka, kb in sorted(pairs, key=lambda p: (p[0][0], p[0][1])):
+    for ka, kb in sorted(pairs, key=lambda p: (p[0][0], p[0][1], p[0][2], sort_key(p[0]))):
         diffs = [] if ka[1] == kb[1] else [f"localizer: {ka[1]} -> {kb[1]}"]
         fa, fb = flat_config(ka), flat_config(kb)
         diffs += [f"{p}: {fa.get(p, 'absent')} -> {fb.get(p, 'absent')}" for p in differing(fa, fb, skip_localizer=ka[1] != kb[1])]
         out.append((ka, kb, diffs))
     return out, left_a, left_b, ga, gb
+
+
+def sort_key(k):
+    """Keys sort with their start pose (None, False, True do not compare with each other)."""
+    return (k[0], k[1], k[2], {None: 0, False: 1, True: 2}[k[3]])
+
+
+def unpaired_reason(k, other):
+    """Why condition `k` of one side has no counterpart: '' (the other side did not run it), or
+    'not comparable: ...' when the other side ran the same scenario with the other start-pose task."""
+    clash = [o for o in other if o[0] == k[0] and not same_task(k, o)]
+    if not clash:
+        return ""
+    return (f"not comparable: {R.start_pose_text(k[3])} here, {R.start_pose_text(clash[0][3])} on the other side "
+            "(tracking from the true start pose and global localization are different tasks)")
 
 
 def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
@@ -148,9 +180,11 @@ def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
             rows.append([label, m, R.fnum(sa["mean"], 4), sa["n"], R.fnum(sb["mean"], 4), sb["n"],
                          R.fnum(w["diff"], 4), R.fnum(w["p"], 3) if w["p"] is not None else "-", v])
     for k in only_a:
-        rows.append([names[k], "(only in A)", "", len(ga[k]), "", "", "", "", ""])
+        why = unpaired_reason(k, gb)
+        rows.append([names[k], f"(only in A{': ' + why if why else ''})", "", len(ga[k]), "", "", "", "", ""])
     for k in only_b:
-        rows.append([names[k], "(only in B)", "", "", "", len(gb[k]), "", "", ""])
+        why = unpaired_reason(k, ga)
+        rows.append([names[k], f"(only in B{': ' + why if why else ''})", "", "", "", len(gb[k]), "", "", ""])
     return header, rows
 
 
@@ -190,9 +224,10 @@ def print_text(runs_a, runs_b, alpha, width=100):
             print(line([m, R.fnum(sa["mean"], 4), str(sa["n"]), R.fnum(sb["mean"], 4), str(sb["n"]), R.fnum(w["diff"], 4),
                         R.fnum(w["p"], 3) if w["p"] is not None else "-", v]))
         print()
-    for side, keys, g in (("A", only_a, ga), ("B", only_b, gb)):
+    for side, keys, g, other in (("A", only_a, ga, gb), ("B", only_b, gb, ga)):
         for k in keys:
-            print(wrap(f"only in {side} ({len(g[k])} runs): {names[k]}", ""))
+            why = unpaired_reason(k, other)
+            print(wrap(f"only in {side} ({len(g[k])} runs): {names[k]}" + (f"; {why}" if why else ""), ""))
     print()
     print(textwrap.fill(EXPLANATION + " p: Welch's t-test over seeds.", width))
 

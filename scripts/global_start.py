@@ -141,9 +141,14 @@ def collect(folders):
         if f.exists():
             j = json.loads(f.read_text())
             half = (0.5 * j["length"] + j.get("margin", 1.0), 0.5 * j["width"] + j.get("margin", 1.0))
-        # In a sweep the folder is scenario__label__params__sN: the label tells variants of one type apart.
+        # In a sweep the folder is scenario__label__params__sN: the label tells variants of one type
+        # apart. An external client's run records its name (docs/protocol.md "Which name").
         parts = run.folder.name.split("__")
-        key = parts[1] if len(parts) == 4 else run.localizer
+        key = parts[1] if len(parts) == 4 and run.summary.get("localizer_type") != "external" else run.localizer
+        # A run that was given the start pose did not start globally: a row of its own, never
+        # averaged into a global-start one.
+        if run.start_pose_given:
+            key += " (given the start pose)"
         by.setdefault(key, []).append((run.seed, score_run(run.frames(), half)))
     return by
 

@@ -10,6 +10,8 @@ statistics). A published row in results/reference/papers.json names the runs tha
 A run matches a key when its summary's scenario and localizer are the key's and every JSON pointer
 of "config" has that value in the run's effective configuration (config.json); a pointer absent
 from the configuration takes its value from "config_defaults" (absent and no default: no match).
+A key may say "start_pose_given" (true / false); a run that recorded the other value never matches
+it (paper_claims.row_key gives every "(global start)" row false).
 "scenario" may be a list of names: the first name that has matching runs is taken (the same
 condition may be run under two names, e.g. the 50 % row as occlusion_002 or as tracking with a
 swept occlusion; taking one avoids counting a seed twice). Where a run comes from (which sweep, its
@@ -141,6 +143,13 @@ class Run:
     version = property(lambda self: (self.summary.get("omniloc") or {}).get("version", "unrecorded"))
 
     @property
+    def start_pose_given(self):
+        """Whether the localizer was reset with the true start pose (summary.json start_pose_given):
+        True, False, or None for a run made before omniloc recorded it."""
+        v = self.summary.get("start_pose_given")
+        return v if isinstance(v, bool) else None
+
+    @property
     def config(self):
         if self._config is None:
             f = self.folder / "config.json"
@@ -246,6 +255,8 @@ def key_matches(run, key, defaults=None, scenario=None):
             return False
     if "localizer" in key and run.localizer != key["localizer"]:
         return False
+    if not start_pose_compatible(key.get("start_pose_given"), run.start_pose_given):
+        return False
     for ptr, want in (key.get("config") or {}).items():
         found, have = pointer(run.config, ptr)
         if not found:
@@ -255,6 +266,18 @@ def key_matches(run, key, defaults=None, scenario=None):
         if not same_value(have, want):
             return False
     return True
+
+
+def start_pose_compatible(a, b):
+    """Whether two start_pose_given values may share a row or be compared: equal, or either unknown
+    (None: a key that does not say, a run made before omniloc recorded it). A run that tracked from
+    the true start pose never pairs with one that had to find itself."""
+    return a is None or b is None or a == b
+
+
+def start_pose_text(given):
+    """How a row says which task it ran: "given the start pose", "global start", or "" unknown."""
+    return {True: "given the start pose", False: "global start"}.get(given, "")
 
 
 def select(runs, key, defaults=None):

@@ -17,13 +17,25 @@ import global_start as G
 import omniloc_results as R
 
 
+GLOBAL_START = "(global start)"  # in a row's label: its localizer starts from an unknown pose
+
+
 def row_key(papers, table, label):
-    """(key, defaults, command) of one published or extra row of a table."""
+    """(key, defaults, command) of one published or extra row of a table. A row labelled "(global
+    start)" takes only runs that were not given the start pose (key "start_pose_given": false)."""
     rb = papers[table]["reproduced_by"]
     key = (rb.get("rows") or {}).get(label) or (rb.get("extra_rows") or {}).get(label)
     if key is None:
         raise KeyError(f"{table} has no row \"{label}\" (rows: {', '.join(list(rb.get('rows', {})) + list(rb.get('extra_rows', {})))})")
+    if GLOBAL_START in label and "start_pose_given" not in key:
+        key = dict(key, start_pose_given=False)
     return key, rb.get("config_defaults", {}), rb.get("command", "")
+
+
+def runs_given(sel):
+    """The start_pose_given the runs share (True / False), None when unknown or mixed."""
+    vals = {r.start_pose_given for r in sel}
+    return vals.pop() if len(vals) == 1 else None
 
 
 def row_stats(runs, key, defaults, metrics, phase="tracking"):
@@ -37,21 +49,63 @@ def row_stats(runs, key, defaults, metrics, phase="tracking"):
 
 def external_peers(runs, key, defaults, metrics):
     """The external localizers (summary.json localizer_type "external", docs/protocol.md) that ran
-    a row's scenario and configuration: [{"name", "runs", "stats"}], by name. They pair by the same
-    key with the localizer replaced by the client's name, so they sit beside the built-in row."""
+    a row's scenario and configuration: [{"name", "runs", "stats", "start_pose_given"}], by name
+    and by whether the client was given the start pose (two rows when one name ran both ways).
+    They pair by the same key with the localizer replaced by the client's name, whatever the row's
+    start pose; pair_table decides which may sit beside the row."""
     names = sorted({r.localizer for r in runs if r.summary.get("localizer_type") == "external" and r.localizer != key.get("localizer")})
     peers = []
+    base = {k: v for k, v in key.items() if k != "start_pose_given"}
     for name in names:
-        sel, st = row_stats(runs, dict(key, localizer=name), defaults, metrics)
-        if sel:
-            peers.append({"name": name, "runs": sel, "stats": st, "version": (sel[0].summary.get("external") or {}).get("version", "")})
+        everything = R.select(runs, dict(base, localizer=name), defaults)
+        for given in sorted({r.start_pose_given for r in everything}, key=lambda g: (g is None, g is True)):
+            sel = [r for r in everything if r.start_pose_given is given]
+            st = {m: R.stats([r.metric(m) for r in sel]) for m in metrics}
+            peers.append({"name": name, "runs": sel, "stats": st, "start_pose_given": given,
+                          "version": (sel[0].summary.get("external") or {}).get("version", "")})
     return peers
 
 
+def place_peers(rows):
+    """Every external peer under a row whose start pose it shares ("row": that row's label). A peer
+    that shares no row's task on its scenario and configuration (a client given the start pose
+    beside global-start rows, or one starting globally beside tracking rows) gets a row of its own,
+    "<scenario / configuration> (given the start pose)" or "(global start)": never a row that ran
+    the other task."""
+    placed = set()  # (name, given, run folders) already beside a row that shares its task
+    for p in rows:
+        for q in p["peers"]:
+            if R.start_pose_compatible(p["start_pose_given"], q["start_pose_given"]):
+                placed.add((q["name"], q["start_pose_given"], tuple(str(r.folder) for r in q["runs"])))
+    own = set()
+    for p in rows:
+        kept = []
+        for q in p["peers"]:
+            ident = (q["name"], q["start_pose_given"], tuple(str(r.folder) for r in q["runs"]))
+            if R.start_pose_compatible(p["start_pose_given"], q["start_pose_given"]):
+                kept.append(dict(q, row=p["shown"]))
+            elif ident not in placed and ident not in own:
+                own.add(ident)
+                where = R.describe_key({k: v for k, v in p["key"].items() if k not in ("localizer", "start_pose_given")})
+                kept.append(dict(q, row=f"{where} ({R.start_pose_text(q['start_pose_given'])})"))
+        p["peers"] = kept
+
+
+def shown_labels(rows):
+    """A row's printed label: where a table holds rows given the start pose and rows that were not,
+    those given it say "(given the start pose)" (global-start rows say so in papers.json already)."""
+    kinds = {p["start_pose_given"] for p in rows} | {q["start_pose_given"] for p in rows for q in p["peers"]}
+    both = True in kinds and False in kinds
+    for p in rows:
+        p["shown"] = p["label"] + (" (given the start pose)" if both and p["start_pose_given"] is True and GLOBAL_START not in p["label"] else "")
+
+
 def pair_table(papers, table, runs, labels=None, include_extra=True):
-    """Rows of a 9-column error table: [{"label", "published" (list or None), "runs", "stats" (per
-    column), "key", "command", "peers"}], published rows first in the paper's order, then our extra
-    rows; "peers" are the external localizers run on the row's scenario and configuration."""
+    """Rows of a 9-column error table: [{"label", "shown", "published" (list or None), "runs", "stats"
+    (per column), "key", "command", "start_pose_given", "peers"}], published rows first in the
+    paper's order, then our extra rows; "peers" are the external localizers run on the row's
+    scenario and configuration, each with the "row" label it is printed under (place_peers: never
+    beside a row that ran the other start-pose task). "shown": the label to print (shown_labels)."""
     t = papers[table]
     rb = t["reproduced_by"]
     metrics = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
@@ -65,9 +119,13 @@ def pair_table(papers, table, runs, labels=None, include_extra=True):
     for label in wanted:
         key, defaults, command = row_key(papers, table, label)
         sel, st = row_stats(runs, key, defaults, metrics + ["line_points/mean", "frames"])
+        given = key.get("start_pose_given", runs_given(sel))
         rows.append({"label": label, "published": t["rows"].get(label) if label in rb["rows"] else None, "runs": sel, "stats": st,
                      "key": key, "command": command, "phased": any("tracking_phase" in (r.robot() or {}) for r in sel),
+                     "start_pose_given": given if sel or "start_pose_given" in key else None,
                      "peers": external_peers(runs, key, defaults, metrics + ["line_points/mean", "frames"])})
+    shown_labels(rows)
+    place_peers(rows)
     return rows
 
 

@@ -13,7 +13,11 @@ their position in a sweep. --rows keeps only the named rows (published or extra)
 A row without runs says "not run" and prints the command that runs it. Ours: mean over seeds (n
 shown); runs with kidnaps or covers use their tracking phase. Only the published numbers come from
 papers.json. External localizers (docs/protocol.md) found in RESULTS on a row's scenario and
-configuration are printed beside it, named "external: <the client's name>".
+configuration are printed beside it, named "external: <the client's name>", but only beside a row
+of the same task: a run given the true start pose (summary.json start_pose_given) never sits in a
+"(global start)" row, nor a globally started one beside a tracking row; such a client gets a row
+of its own, labelled "(given the start pose)" or "(global start)". Where a table holds both kinds,
+its rows given the start pose say "(given the start pose)".
 
 Noise profile: rows pair runs of one profile. --profile NAME picks it (robot, field_robot, ...);
 without it the profile is read from the runs: robot where there are robot runs, else the one
@@ -127,14 +131,14 @@ def print_error_table(papers, key, runs, labels, markdown):
     for p in rows:
         st = p["stats"]
         if p["runs"]:
-            lines.append([p["label"] + (" (tracking phase)" if p["phased"] else ""), "omniloc"] +
+            lines.append([p["shown"] + (" (tracking phase)" if p["phased"] else ""), "omniloc"] +
                          [f"{st[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] + [f"{st['line_points/mean']['mean']:.0f}", str(st["x_cm/mean"]["n"])])
         else:
             lines.append([p["label"], "not run"] + ["-"] * 9 + ["-", "0"])
             notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {report_command(p['command'])}")
-        for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario and configuration
+        for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario, configuration and start pose
             pst = peer["stats"]
-            lines.append([p["label"], f"external: {peer['name']}"] + [f"{pst[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] +
+            lines.append([peer["row"], f"external: {peer['name']}"] + [f"{pst[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] +
                          [f"{pst['line_points/mean']['mean']:.0f}", str(pst["x_cm/mean"]["n"])])
         if p["published"]:
             lines.append([p["label"], "paper"] + [f"{v:.3f}" for v in p["published"]] + ["-", "-"])

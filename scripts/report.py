@@ -730,16 +730,16 @@ def error_table(rep, papers, table, runs):
     for p in pairs:
         st = p["stats"]
         if p["runs"]:
-            label = p["label"] + (" (tracking phase)" if p["phased"] else "")
+            label = p["shown"] + (" (tracking phase)" if p["phased"] else "")
             rows.append([label, "omniloc"] + [fnum(st[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
                         [fnum(st["line_points/mean"]["mean"], 0), st["x_cm/mean"]["n"]])
             classes.append("")
         else:
             rows.append([p["label"], "not run"] + ["-"] * 9 + ["-", 0])
             classes.append("missing")
-        for peer in p.get("peers", []):  # external localizers (docs/protocol.md), same scenario and configuration
+        for peer in p.get("peers", []):  # external localizers (docs/protocol.md), same scenario, configuration and start pose
             pst = peer["stats"]
-            rows.append([p["label"], f"external: {peer['name']}"] + [fnum(pst[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
+            rows.append([peer["row"], f"external: {peer['name']}"] + [fnum(pst[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
                         [fnum(pst["line_points/mean"]["mean"], 0), pst["x_cm/mean"]["n"]])
             classes.append("")
         if p["published"]:
@@ -756,7 +756,7 @@ def error_table(rep, papers, table, runs):
             rep.para(f"Not run: \"{p['label']}\" ({R.describe_key(p['key'])}). Run: `{command(p['command'])}`")
         rep.end_details()
     # Every seed beside its mean, and the outlying seeds plotted with their cause.
-    rows_runs = [(p["label"], p["runs"]) for p in pairs] + [(f"{p['label']} (external: {q['name']})", q["runs"]) for p in pairs for q in p.get("peers", [])]
+    rows_runs = [(p["shown"], p["runs"]) for p in pairs] + [(f"{q['row']} (external: {q['name']})", q["runs"]) for p in pairs for q in p.get("peers", [])]
     flagged = seed_table(rep, rows_runs)
     strip_plot(rep, t.get("source", table), rows_runs)
     for run in flagged:
@@ -1125,18 +1125,31 @@ def run_title(run, params=None):
     return " / ".join(str(p) for p in parts)
 
 
+# Position error statistics of a run's table (summary.json position_m): the mean is the typical
+# error, the RMSE weighs the large ones more; a run from before position_m.mean shows "-".
+POSITION_COLS = ["position mean m", "position RMSE m", "position p95 m"]
+
+
+def position_cells(block):
+    pm = block.get("position_m") or {}
+    return [fnum(pm.get(k), 3) for k in ("mean", "rmse", "p95")]
+
+
 def report_run(rep, run, plots, params=None, note=None):
     s = run.summary
     title = run_title(run, params) + (f" ({note})" if note else "")
     rep.heading(f"Run {title}", 3)
     rows = []
     for r in s.get("robots", []):
-        rows.append([f"r{r['robot']}" + (" all frames" if "tracking_phase" in r else "")] + [fnum(r[a][st], 3) for a, st in R.TABLE_KEYS] + [r.get("frames", "-")])
+        rows.append([f"r{r['robot']}" + (" all frames" if "tracking_phase" in r else "")] + [fnum(r[a][st], 3) for a, st in R.TABLE_KEYS] +
+                    position_cells(r) + [r.get("frames", "-")])
         if "tracking_phase" in r:
             tp = r["tracking_phase"]
-            rows.append([f"r{r['robot']} tracking phase"] + [fnum(tp[a][st], 3) for a, st in R.TABLE_KEYS] + [tp.get("frames", "-")])
-    rep.table(["robot"] + R.TABLE_COLS + ["frames"], rows,
-              f"noise profile {s.get('noise_profile')}, {s.get('duration_s')} s at {s.get('camera_rate_hz')} Hz; omniloc {(s.get('omniloc') or {}).get('version', 'unrecorded')}")
+            rows.append([f"r{r['robot']} tracking phase"] + [fnum(tp[a][st], 3) for a, st in R.TABLE_KEYS] + position_cells(tp) + [tp.get("frames", "-")])
+    task = R.start_pose_text(run.start_pose_given)
+    rep.table(["robot"] + R.TABLE_COLS + POSITION_COLS + ["frames"], rows,
+              f"noise profile {s.get('noise_profile')}, {s.get('duration_s')} s at {s.get('camera_rate_hz')} Hz" + (f"; {task}" if task else "") +
+              f"; omniloc {(s.get('omniloc') or {}).get('version', 'unrecorded')}")
     for r in s.get("robots", []):
         rec = r.get("recovery")
         if rec:
@@ -1150,21 +1163,24 @@ def report_run(rep, run, plots, params=None, note=None):
 
 
 def sweep_runs(sweep, all_runs):
-    """The sweep's runs in the aggregate's order (group by group, seeds in run order), with their params."""
+    """The sweep's runs in the aggregate's order (group by group, seeds in run order), with their
+    params and the localizer name of their row: runs.csv's, the name the aggregate gives the row
+    (docs/protocol.md "Which name"; a run missing from runs.csv: the name in its summary.json)."""
     by_folder = {r.folder: r for r in all_runs}
     order = {}
     for row in R.read_csv(sweep / "runs.csv"):
-        order[row["id"]] = (int(row["index"]), row["params"])
+        order[row["id"]] = (int(row["index"]), row["params"], row.get("localizer"))
     agg = json.loads((sweep / "aggregate.json").read_text())
     group_rank = {(g.get("scenario"), g.get("localizer"), g.get("params")): k for k, g in enumerate(agg["groups"])}
     out = []
     for folder, run in by_folder.items():
         if folder.parent != sweep / "runs":
             continue
-        idx, params = order.get(folder.name, (10 ** 9, "default"))
-        rank = group_rank.get((run.scenario, folder.name.split("__")[1] if "__" in folder.name else run.localizer, params), 10 ** 9)
-        out.append((rank, idx, run, params))
-    return [(r, p) for _, _, r, p in sorted(out, key=lambda x: (x[0], x[1]))]
+        idx, params, name = order.get(folder.name, (10 ** 9, "default", None))
+        name = name or run.localizer
+        rank = group_rank.get((run.scenario, name, params), 10 ** 9)
+        out.append((rank, idx, run, params, name))
+    return [(r, p, n) for _, _, r, p, n in sorted(out, key=lambda x: (x[0], x[1]))]
 
 
 def report_sweep(rep, sweep, all_runs, max_runs):
@@ -1175,33 +1191,40 @@ def report_sweep(rep, sweep, all_runs, max_runs):
     rep.para(f"{sweep}: {agg.get('runs')} runs; aggregated by omniloc {o.get('version', 'unrecorded')}; runs made by "
              + ", ".join(f"{v} ({n})" for v, n in (agg.get("run_versions") or {}).items()) + ".")
     rows = []
+    # Groups given the start pose say so where the sweep also has groups that were not (a sweep
+    # from before start_pose_given has neither).
+    kinds = {g.get("start_pose_given") for g in agg["groups"]}
+    mark = True in kinds and (False in kinds or "mixed" in kinds)
     for g in agg["groups"]:
         m = g["metrics"]
         phase = "r0/tracking_phase/x_cm/mean" in m
         val = lambda a, s: m.get(f"r0/tracking_phase/{a}/{s}" if phase else f"r0/{a}/{s}", {}).get("mean")
         n = m.get("r0/x_cm/mean", {}).get("n", 0)
-        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')} / {g.get('params', '')}" + (" (tracking phase)" if phase else "")] +
-                    [fnum(val(a, s), 3) for a, s in R.TABLE_KEYS] + [f"{g.get('finished', '-')}/{g.get('failed', 0)}", n])
-    rep.table(["group"] + R.TABLE_COLS + ["runs ok/failed", "n"], rows,
+        given = g.get("start_pose_given")
+        task = " (given the start pose)" if mark and given is True else " (start pose: mixed)" if given == "mixed" else ""
+        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')}{task} / {g.get('params', '')}" + (" (tracking phase)" if phase else "")] +
+                    [fnum(val(a, s), 3) for a, s in R.TABLE_KEYS] + [fnum(val("position_m", "mean"), 3), fnum(val("position_m", "rmse"), 3)] +
+                    [f"{g.get('finished', '-')}/{g.get('failed', 0)}", n])
+    rep.table(["group"] + R.TABLE_COLS + ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
               "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'.")
     runs = sweep_runs(sweep, all_runs)
     groups = {}
-    for run, params in runs:
-        groups.setdefault((run.scenario, run.localizer, params), []).append(run)
+    for run, params, name in runs:
+        groups.setdefault((run.scenario, name, params), []).append(run)
     rows_runs = [(" / ".join(str(x) for x in k), sorted(v, key=lambda r: r.seed)) for k, v in groups.items()]
     flagged = seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json keeps Student-t intervals for scripts; this report recomputes them from the runs.")
     # Per run: its tables always; plots for the first seed of each group (every condition shown
     # once, at most max_runs) and for every outlying seed, collapsed: a reader opens what they need.
     rep.details(f"Runs of sweep {name}: {len(runs)} runs, tables and plots")
     plotted, seen = 0, set()
-    for run, params in runs:
-        first = (run.scenario, run.localizer, params) not in seen
-        seen.add((run.scenario, run.localizer, params))
+    for run, params, name in runs:
+        first = (run.scenario, name, params) not in seen
+        seen.add((run.scenario, name, params))
         report_run(rep, run, plots=(first and plotted < max_runs) or run in flagged, params=params,
                    note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None)
         plotted += first
     rep.end_details()
-    return [r for r, _ in runs]
+    return [r for r, _, _ in runs]
 
 
 def tracking_errors(run):

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "harness/metrics.hpp"
 #include "harness/recovery.hpp"
 
 using namespace omniloc;
@@ -102,4 +105,18 @@ TEST(Recovery, ExcludedTimeOfAnEpisodeNeverRecoveredEndsWithTheRun) {
   EXPECT_NEAR(p.excluded[0].second, 11.0, 1e-9);
   EXPECT_NEAR(p.excluded_s, 299.0 / 30.0 - 8.0, 1e-9);
   EXPECT_EQ(summarize(p.tracking).frames, 240u);
+}
+
+TEST(Metrics, PositionMeanIsTheMeanDistanceNotTheRmse) {
+  // Errors of 3-4-5 and 6-8-10 triangles: distances 5 and 10 m. Mean 7.5, RMSE sqrt((25 + 100) / 2).
+  const std::vector<FrameError> e = {{0.0, 3.0, 4.0, 0.0}, {0.1, -6.0, 8.0, 0.0}};
+  const ErrorSummary s = summarize(e);
+  EXPECT_DOUBLE_EQ(s.pos_mean_m, 7.5);
+  EXPECT_DOUBLE_EQ(s.pos_rmse_m, std::sqrt(62.5));
+  EXPECT_LT(s.pos_mean_m, s.pos_rmse_m);  // the RMSE weighs the larger error more
+  EXPECT_DOUBLE_EQ(s.pos_max_m, 10.0);
+  const Json j = to_json(s);
+  EXPECT_DOUBLE_EQ(j["position_m"]["mean"].get<double>(), 7.5);
+  EXPECT_DOUBLE_EQ(j["position_m"]["rmse"].get<double>(), std::sqrt(62.5));
+  EXPECT_DOUBLE_EQ(summarize({}).pos_mean_m, 0.0);  // no frames scored: zero, as the other statistics
 }

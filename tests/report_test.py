@@ -27,17 +27,23 @@ OMNILOC = os.environ.get("OMNILOC_BIN", str(ROOT / "build" / "omniloc"))
 def robot(x_mean, y_mean=1.0, th=0.01, extra=None):
     axis = lambda m: {"mean": m, "std": m / 2, "max": 3 * m}
     r = {"robot": 0, "frames": 100, "x_cm": axis(x_mean), "y_cm": axis(y_mean), "theta_rad": axis(th),
-         "position_m": {"rmse": x_mean / 100, "p50": 0, "p90": 0, "p95": 0, "max": 0}, "line_points": {"mean": 80, "min": 50},
+         "position_m": {"mean": x_mean / 125, "rmse": x_mean / 100, "p50": 0, "p90": 0, "p95": 0, "max": 0}, "line_points": {"mean": 80, "min": 50},
          "wrong_frames": 0, "coasting_frames": 0}
     r.update(extra or {})
     return r
 
 
-def write_run(folder, scenario, localizer, seed, config, rob, version="abc123"):
+def write_run(folder, scenario, localizer, seed, config, rob, version="abc123", start_pose_given=None, external=False):
+    """A run folder; start_pose_given None: a run from before omniloc recorded it (no key)."""
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / "summary.json").write_text(json.dumps({"scenario": scenario, "localizer": localizer, "seed": seed, "robots": [rob],
-                                                     "omniloc": {"version": version, "compiler": "GNU", "build_type": "Release"}}))
+    summary = {"scenario": scenario, "localizer": localizer, "seed": seed, "robots": [rob],
+               "omniloc": {"version": version, "compiler": "GNU", "build_type": "Release"}}
+    if start_pose_given is not None:
+        summary["start_pose_given"] = start_pose_given
+    if external:
+        summary["localizer_type"] = "external"
+    (folder / "summary.json").write_text(json.dumps(summary))
     (folder / "config.json").write_text(json.dumps(dict(config, seed=seed, name=scenario)))
 
 
@@ -563,6 +569,106 @@ class Tools(unittest.TestCase):
             self.assertEqual(len(xr), 2)
             self.assertIn("localizer: matching -> mcl", xr[0][0])
             self.assertAlmostEqual(float(xr[0][6]), 25.0 - 2.52, places=4)
+
+
+class StartPoseAndPositionMean(unittest.TestCase):
+    """Issue 37: position_m.mean is carried and shown; a run given the true start pose never shares a
+    row with one that started globally (paper_table, report, compare)."""
+
+    def tracking_table(self, tmp, external_given=True, mcl_given=False):
+        for s in (1, 2):
+            write_run(tmp / "res" / f"matching{s}", "tracking", "matching", s, {}, robot(3.0 + s / 10), start_pose_given=True)
+            write_run(tmp / "res" / f"mcl{s}", "tracking", "mcl", s, {}, robot(30.0 + s), start_pose_given=mcl_given)
+            write_run(tmp / "res" / f"ext{s}", "tracking", "js_client", s, {}, robot(5.0 + s / 10), start_pose_given=external_given, external=True)
+        return R.discover([tmp / "res"])[0]
+
+    def test_a_client_given_the_start_pose_is_never_in_a_global_start_row(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            runs = self.tracking_table(tmp)
+            rows = {p["label"]: p for p in C.pair_table(R.load_papers(), "000_tracking", runs)}
+            mcl = rows["tracking path, MCL alone (global start)"]
+            self.assertEqual([q["name"] for q in mcl["peers"]], [])
+            self.assertEqual(mcl["stats"]["x_cm/mean"]["n"], 2)
+            track = rows["tracking"]
+            self.assertEqual([(q["name"], q["row"]) for q in track["peers"]], [("js_client", "tracking (given the start pose)")])
+            self.assertEqual(track["shown"], "tracking (given the start pose)")  # the table holds both kinds
+            # A global-start row with only a given client beside it: the client gets a row of its own.
+            only = C.pair_table(R.load_papers(), "000_tracking", runs, labels=["tracking path, MCL alone (global start)"])[0]
+            self.assertEqual(len(only["peers"]), 1)
+            self.assertNotIn("global start", only["peers"][0]["row"])
+            self.assertTrue(only["peers"][0]["row"].endswith("(given the start pose)"))
+            # A built-in MCL run somebody gave the start pose is not taken into the global-start row.
+            write_run(tmp / "res" / "mcl_given", "tracking", "mcl", 9, {}, robot(1.0), start_pose_given=True)
+            runs = R.discover([tmp / "res"])[0]
+            mcl = {p["label"]: p for p in C.pair_table(R.load_papers(), "000_tracking", runs)}["tracking path, MCL alone (global start)"]
+            self.assertEqual(sorted(r.seed for r in mcl["runs"]), [1, 2])
+            out = subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), str(tmp / "res"), "--paper", "000_tracking"], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            ext = [l for l in out.stdout.splitlines() if "external: js_client" in l]
+            self.assertEqual(len(ext), 1, out.stdout)
+            self.assertTrue(ext[0].startswith("tracking (given the start pose)"), out.stdout)
+
+    def test_a_global_client_sits_beside_the_global_start_rows(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            runs = self.tracking_table(pathlib.Path(tmp), external_given=False)
+            rows = {p["label"]: p for p in C.pair_table(R.load_papers(), "000_tracking", runs)}
+            self.assertEqual(rows["tracking"]["peers"], [])
+            self.assertEqual([q["name"] for q in rows["tracking path, MCL alone (global start)"]["peers"]], ["js_client"])
+
+    def test_runs_without_the_new_keys_are_read_as_before(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            old = robot(4.0)
+            del old["position_m"]["mean"]
+            for s in (1, 2):
+                write_run(tmp / "res" / f"mcl{s}", "tracking", "mcl", s, {}, old)  # no start_pose_given either
+                write_run(tmp / "res" / f"ext{s}", "tracking", "js_client", s, {}, robot(5.0), external=True)
+            runs = R.discover([tmp / "res"])[0]
+            self.assertIsNone(runs[0].start_pose_given)
+            self.assertIsNone(runs[2].metric("position_m/mean"))
+            rows = {p["label"]: p for p in C.pair_table(R.load_papers(), "000_tracking", runs)}
+            self.assertEqual(rows["tracking path, MCL alone (global start)"]["stats"]["x_cm/mean"]["n"], 2)
+            self.assertEqual([q["name"] for q in rows["tracking path, MCL alone (global start)"]["peers"]], ["js_client"])
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(tmp / "res"), "-o", str(tmp / "rep"), "--history", "none"],
+                                 capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+
+    def test_the_report_and_compare_show_the_position_mean(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            for s in (1, 2):
+                write_run(tmp / "A" / f"r{s}", "tracking", "matching", s, {}, robot(2.5), start_pose_given=True)
+                write_run(tmp / "B" / f"r{s}", "tracking", "matching", s, {}, robot(5.0), start_pose_given=True)
+            header, rows = compare.compare_rows(R.discover([tmp / "A"])[0], R.discover([tmp / "B"])[0])
+            pm = [r for r in rows if r[1] == "position_m/mean"]
+            self.assertEqual(len(pm), 1)
+            self.assertAlmostEqual(float(pm[0][header.index("B - A")]), 0.02, places=4)  # 5/125 - 2.5/125
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(tmp / "A"), "-o", str(tmp / "rep"), "--history", "none"],
+                                 capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            md = (tmp / "rep" / "report.md").read_text()
+            self.assertIn("position mean m", md)
+            self.assertIn("| 0.020 | 0.025 |", md)  # position mean and RMSE of robot(2.5)
+
+    def test_compare_does_not_pair_given_with_global(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            for s in (1, 2):
+                write_run(tmp / "A" / f"r{s}", "tracking", "mcl", s, {}, robot(30.0), start_pose_given=False)
+                write_run(tmp / "B" / f"r{s}", "tracking", "js_client", s, {}, robot(5.0), start_pose_given=True, external=True)
+                write_run(tmp / "old" / f"r{s}", "tracking", "mcl", s, {}, robot(31.0))  # before start_pose_given
+            header, rows = compare.compare_rows(R.discover([tmp / "A"])[0], R.discover([tmp / "B"])[0])
+            self.assertEqual([r[1] for r in rows if r[1].startswith("(only")],
+                             ["(only in A: not comparable: global start here, given the start pose on the other side "
+                              "(tracking from the true start pose and global localization are different tasks))",
+                              "(only in B: not comparable: given the start pose here, global start on the other side "
+                              "(tracking from the true start pose and global localization are different tasks))"])
+            self.assertFalse([r for r in rows if r[1] == "x_cm/mean"])
+            # An older run of the same condition, without the key: still paired.
+            _, rows = compare.compare_rows(R.discover([tmp / "old"])[0], R.discover([tmp / "A"])[0])
+            self.assertEqual(len([r for r in rows if r[1] == "x_cm/mean"]), 1)
+            self.assertFalse([r for r in rows if r[1].startswith("(only")])
 
 
 if __name__ == "__main__":
