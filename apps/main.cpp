@@ -512,6 +512,7 @@ int cmd_compare(int argc, char** argv) {
   std::vector<char*> args{const_cast<char*>(py), const_cast<char*>(script.c_str())};
   for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
   args.push_back(nullptr);
+  ::setenv("OMNILOC_COMPARE_PROG", "omniloc compare", 1);  // its --help and errors name the command the user typed
   ::execvp(py, args.data());
   std::cerr << "failed: cannot run " << py << " " << script << "\n";
   return 1;

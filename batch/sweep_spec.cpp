@@ -223,8 +223,13 @@ Json apply_combo(const Json& scenario, const Combo& combo, std::string& label) {
     } catch (const std::exception& e) {
       throw ConfigError("/parameters" + ptr, json_brief(v), std::string("a pointer into the scenario (") + e.what() + ")");
     }
-    const std::string leaf = ptr.substr(ptr.find_last_of('/') + 1);
-    label += (label.empty() ? "" : ",") + leaf + "=" + v.dump();
+    const std::size_t cut = ptr.find_last_of('/');
+    const std::string leaf = ptr.substr(cut + 1);
+    // "enabled=true" does not say what is enabled: a switch is named by what it switches.
+    std::string part = leaf + "=" + v.dump();
+    if (leaf == "enabled" && v.is_boolean() && cut != std::string::npos && cut > 0)
+      part = ptr.substr(ptr.find_last_of('/', cut - 1) + 1, cut - ptr.find_last_of('/', cut - 1) - 1) + (v.get<bool>() ? "=on" : "=off");
+    label += (label.empty() ? "" : ",") + part;
   }
   return patched;
 }

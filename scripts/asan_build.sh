@@ -4,6 +4,7 @@
 # so the libraries are compiled once for both. Installs clang-14 and its runtimes (libFuzzer is in
 # libclang-rt-14-dev) from Debian when missing. Usage: scripts/asan_build.sh TARGET...
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh >/dev/null
 missing=()

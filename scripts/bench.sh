@@ -3,6 +3,7 @@
 # with the commit and machine in its context, to OUT_DIR (default results/bench/<commit>).
 # Usage: scripts/bench.sh [OUT_DIR] [extra benchmark flags], e.g. --benchmark_min_time=0.05 (seconds; Debian 12 ships Google Benchmark 1.7.1, which takes a plain number)
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 [ -x build/omniloc ] || scripts/build.sh
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)

@@ -7,6 +7,7 @@
 # (size, rendering, raw markdown, absolute paths, scorecard first). Exit 1 when one fails.
 # Usage: scripts/check_report.sh [results/report/report.html] [screenshot.png]
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 html="${1:-results/report/report.html}"
 png="${2:-$(dirname "$html")/screenshot.png}"

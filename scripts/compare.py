@@ -1,8 +1,7 @@
 #!/usr/bin/env python3
 """Two result sets side by side per metric: the difference and whether it exceeds the seed-to-seed spread.
 
-usage: compare.py A B [--markdown] [--alpha P] [--all-metrics]
-       omniloc compare A B ...     (the same)
+Run as `omniloc compare A B [--markdown] [--alpha P]` or `scripts/compare.py A B ...` (the same).
 
 A and B are result folders (runs, sweeps, or folders holding them), e.g. the paper suite of two
 commits. Runs are grouped by scenario, localizer and effective configuration (config.json without
@@ -240,7 +239,9 @@ def versions(runs):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    import os
+    ap = argparse.ArgumentParser(prog=os.environ.get("OMNILOC_COMPARE_PROG", "scripts/compare.py"), description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("a")
     ap.add_argument("b")
     ap.add_argument("--markdown", action="store_true", help="a markdown table instead of aligned text")

@@ -5,6 +5,7 @@
 # as build-asan/fuzz-artifacts/crash-* (turn it into a test in tests/robust_input_test.cpp).
 # Usage: scripts/fuzz.sh [SECONDS=60] [libFuzzer flags]
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 secs="${1:-60}"
 shift || true

@@ -4,6 +4,18 @@
 # OpenCV: we take the split -dev packages (core, imgproc, imgcodecs); they are ~10x smaller than
 # libopencv-dev but ship no CMake config, so CMakeLists.txt finds headers and libraries itself.
 set -euo pipefail
+case "${1:-}" in
+  -h|--help)
+    cat <<'USAGE'
+usage: scripts/install-deps.sh [--report-check]
+Installs, with apt (sudo when not root), the Debian 12 packages omniloc needs to build, test and run,
+and only those that are missing; does nothing when all are present.
+  --report-check  also Debian's chromium, for the headless check of report.html (scripts/check_report_html.py)
+USAGE
+    exit 0 ;;
+  ""|--report-check) ;;
+  *) echo "install-deps: unknown option $1 (try --help)" >&2; exit 2 ;;
+esac
 PKGS=(
   build-essential cmake pkg-config git
   libbox2d-dev libeigen3-dev nlohmann-json3-dev

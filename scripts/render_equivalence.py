@@ -58,6 +58,9 @@ def load(top):
 
 
 def main():
+    if sys.argv[1:2] in (["-h"], ["--help"]):
+        print(__doc__)
+        return 0
     if len(sys.argv) < 3:
         print(__doc__)
         return 2

@@ -14,6 +14,7 @@
 # `omniloc run`s (seeds 1..P) after one run that fills the calibration and colour-table caches:
 # frames of all runs / wall time. Nothing here is a pass/fail gate: the targets are in the docs.
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bin="$root/build" out="" procs="" backends="osmesa egl" secs=3 scenario="$root/scenarios/paper/tracking.json"
 while getopts "b:o:p:B:s:e:" opt; do

@@ -5,6 +5,7 @@
 # Leaks inside Mesa (llvmpipe, OSMesa, LLVM) are suppressed by .ci/lsan-mesa.supp, nothing else.
 # Usage: scripts/sanitize.sh [ctest arguments]
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 # olp_cpp_example: the one-header C++ client, whose stream tests (ctest olp_cpp_client) are unit tests.
 targets=(omniloc olp_cpp_example)

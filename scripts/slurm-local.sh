@@ -17,6 +17,7 @@
 #  - proctrack/linuxproc and task/none: no cgroups needed (containers, CI machines).
 #  - no slurmdbd: sacct does not work here; poll squeue / scontrol show job instead.
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 DIR="${OMNILOC_SLURM_DIR:-/tmp/omniloc-slurm}"
 PORT="${OMNILOC_SLURM_PORT:-16817}"
 CONF="$DIR/slurm.conf"

@@ -2,6 +2,7 @@
 # Installs what is missing, builds, and runs every test through ctest.
 # Usage: scripts/test.sh [ctest arguments], e.g. scripts/test.sh -LE scenario (skip slow scenario tests).
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh

@@ -3,6 +3,7 @@
 # scenarios/regression/*.json. Run it only when a change of numbers is deliberate; the diff of the
 # reference files then shows exactly what moved, and belongs in the same commit as its cause.
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 [ -x build/omniloc ] || scripts/build.sh
 for s in scenarios/regression/*.json; do

@@ -211,6 +211,15 @@ TEST(Sweep, ScenarioEntriesCarryTheirOwnParametersAndLocalizers) {
   EXPECT_EQ(spec.runs[6].localizer_label, "dead_reckoning");
   EXPECT_DOUBLE_EQ(spec.runs[4].scenario["robots"][0]["motion"]["speed"].get<double>(), 1.5);
 
+  // A switch is labelled by what it switches, not "enabled=true".
+  const std::string sw = (test_dir() / "switch.json").string();
+  write_file_atomic(sw, R"({"name": "switch", "scenarios": ["short.json"],
+    "parameters": {"/vision/exposure_control/enabled": [true, false]}, "seeds": [1]})");
+  const SweepSpec s2 = load_sweep(sw);
+  ASSERT_EQ(s2.runs.size(), 2u);
+  EXPECT_EQ(s2.runs[0].params_label, "exposure_control=on");
+  EXPECT_EQ(s2.runs[1].params_label, "exposure_control=off");
+
   const std::string bad = (test_dir() / "bad_entry.json").string();
   write_file_atomic(bad, R"({"scenarios": [{"file": "short.json", "parameters": {"speed": [1]}}]})");
   try {
