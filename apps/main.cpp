@@ -70,7 +70,8 @@ commands:
                          reference docs/localizers.md generated from the same lists
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [--draw-each] [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
-                         with mean and 95 % interval in results/sweeps/<name>/aggregate.{csv,json}
+                         with mean and interval (docs/results.md "Intervals": t95 from 5 seeds,
+                         else the seeds' range) in results/sweeps/<name>/aggregate.{csv,json}
   sweep SWEEP.json --slurm [--tasks N] [--partition P] [--time HH:MM:SS] [--cpus-per-task C]
         [--gpus-per-task G] [--sbatch-arg ARG]... [--dry-run] [--resubmit-missing] [-o DIR]
                          a Slurm job array of N shards and a merge job (docs/cluster.md);
@@ -150,7 +151,8 @@ const cli::Command kSchema{"schema", "", 0, 0, "The JSON Schema of scenario file
                             {"--sweep", "", "the JSON Schema of sweep files instead"},
                             {"-o", "FILE", "write to FILE (atomically) instead of standard output"}}};
 const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
-                          "Scenarios x localizers x parameters x seeds, in parallel; aggregate with mean and 95 % interval\n"
+                          "Scenarios x localizers x parameters x seeds, in parallel; aggregate with mean and interval\n"
+                          "(t95 from 5 seeds, else the seeds' range: docs/results.md \"Intervals\")\n"
                           "in results/sweeps/<name>/aggregate.{csv,json}.",
                           {{"-j", "N", "parallel runs (integer in [1, 256], default 1)"},
                            {"--shard", "I/N", "run only runs with index % N == I (0 <= I < N)"},

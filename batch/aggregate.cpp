@@ -17,12 +17,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Student t 0.975 quantiles for 1..30 degrees of freedom, then the normal value.
+// Student t 0.975 quantiles for 1..30 degrees of freedom (the values scripts/omniloc_results.py's
+// t_quantile_975 computes), then the Cornish-Fisher expansion (within 2e-6 of them above 30).
 double t975(std::size_t df) {
-  static const double t[] = {0,     12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
-                             2.201, 2.179,  2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080,
-                             2.074, 2.069,  2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
-  return df <= 30 ? t[df] : 1.96;
+  static const double t[] = {0,        12.706205, 4.302653, 3.182446, 2.776445, 2.570582, 2.446912, 2.364624,
+                             2.306004, 2.262157,  2.228139, 2.200985, 2.178813, 2.160369, 2.144787, 2.131450,
+                             2.119905, 2.109816,  2.100922, 2.093024, 2.085963, 2.079614, 2.073873, 2.068658,
+                             2.063899, 2.059539,  2.055529, 2.051831, 2.048407, 2.045230, 2.042272};
+  if (df <= 30) return t[df];
+  const double z = 1.959964, d = static_cast<double>(df);
+  return z + (z * z * z + z) / (4 * d) + (5 * std::pow(z, 5) + 16 * z * z * z + 3 * z) / (96 * d * d) +
+         (3 * std::pow(z, 7) + 19 * std::pow(z, 5) + 17 * z * z * z - 15 * z) / (384 * d * d * d);
 }
 
 void flatten(const Json& j, const std::string& prefix, std::map<std::string, double>& out) {
@@ -76,16 +81,39 @@ Interval mean_ci95(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
   iv.mean = s / v.size();
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
   if (v.size() < 2) {
     iv.low = iv.high = iv.mean;
+    iv.kind = kNoInterval;
+    return iv;
+  }
+  if (v.size() < kMinTSeeds) {  // no reliable interval with so few seeds: their range, said as such
+    iv.low = *lo;
+    iv.high = *hi;
+    iv.kind = kRangeInterval;
     return iv;
   }
   double s2 = 0;
   for (double x : v) s2 += (x - iv.mean) * (x - iv.mean);
   const double half = t975(v.size() - 1) * std::sqrt(s2 / (v.size() - 1)) / std::sqrt(static_cast<double>(v.size()));
   iv.low = iv.mean - half;
+  if (*lo >= 0) iv.low = std::max(iv.low, 0.0);  // a non-negative quantity never gets a negative bound
   iv.high = iv.mean + half;
+  iv.kind = kT95Interval;
   return iv;
+}
+
+std::string interval_text(const Interval& iv, int digits) {
+  char b[160];
+  if (iv.n == 0) return "-";
+  if (iv.n == 1) {
+    std::snprintf(b, sizeof b, "%.*f (n=1, no interval)", digits, iv.mean);
+  } else if (std::string(iv.kind) == kRangeInterval) {
+    std::snprintf(b, sizeof b, "%.*f (seeds' range %.*f to %.*f, n=%zu)", digits, iv.mean, digits, iv.low, digits, iv.high, iv.n);
+  } else {
+    std::snprintf(b, sizeof b, "%.*f [%.*f, %.*f] (n=%zu, %s)", digits, iv.mean, digits, iv.low, digits, iv.high, iv.n, iv.kind);
+  }
+  return b;
 }
 
 bool run_finished(const fs::path& dir, const SweepRun& r) { return fs::exists(dir / "runs" / r.id / "summary.json"); }
@@ -207,25 +235,20 @@ std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, boo
     const std::string key = phased ? "r0/tracking_phase/" + k : "r0/" + k;
     return ivs.count(key) ? ivs[key].mean : NAN;
   };
-  char ci[64];
-  if (ivs.count("r0/position_m/rmse")) {
-    const Interval& iv = ivs["r0/position_m/rmse"];
-    if (iv.n >= 2) std::snprintf(ci, sizeof ci, "%.4f [%.4f, %.4f] n=%zu", iv.mean, iv.low, iv.high, iv.n);
-    else std::snprintf(ci, sizeof ci, "%.4f (n=1, no interval)", iv.mean);  // one seed has no spread
-  } else {
-    std::snprintf(ci, sizeof ci, "-");
-  }
+  const std::string ci = ivs.count("r0/position_m/rmse") ? interval_text(ivs["r0/position_m/rmse"], 4) : "-";
   const std::string label = group_label(g, mark_given) + (phased ? " *" : "");
   char line[512];
   std::snprintf(line, sizeof line, " %4zu %4zu | %9.3f %9.3f %9.4f | %s\n", g.finished, g.failed, m("x_cm/mean"), m("y_cm/mean"),
-                m("theta_rad/mean"), ci);
+                m("theta_rad/mean"), ci.c_str());
   return label + std::string(static_cast<std::size_t>(std::max(0, width - static_cast<int>(label.size()))), ' ') + line;
 }
 
 // Aggregates every run of the sweep found finished in the folder, in run order: writes runs.csv and
 // aggregate.{csv,json} when nothing is missing, and the printed table into `out`.
 void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Census& census, AggregateOutcome& out) {
-  std::string csv = "scenario,localizer,params,start_pose_given,metric,n,mean,ci95_low,ci95_high\n";
+  // ci95_low / ci95_high hold what "interval" says (mean_ci95): t95, range (the seeds' min and max)
+  // or none (n = 1: the value); "interval" is last so readers of the old columns read them as before.
+  std::string csv = "scenario,localizer,params,start_pose_given,metric,n,mean,ci95_low,ci95_high,interval\n";
   // expected / done / failed: a reader sees at once whether every run is in (done counts failed ones).
   Json agg{{"sweep", spec.name}, {"runs", spec.runs.size()}, {"expected", out.expected}, {"done", out.done}, {"failed", out.failed},
            {"complete", out.missing == 0}, {"omniloc", build_info_json()}, {"run_versions", census.run_versions},
@@ -238,7 +261,7 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
   for (const auto& g : census.groups) width = std::max(width, static_cast<int>(group_label(g, mark_given).size()) + 2);
   char line[512];
   std::snprintf(line, sizeof line, "%-*s %4s %4s | %9s %9s %9s | %-26s\n", width, "scenario / localizer / params", "ok", "fail", "mean x cm",
-                "mean y cm", "mean th", "position RMSE m (95 % CI)");
+                "mean y cm", "mean th", "position RMSE m (t95 for n>=5, else seeds' range)");
   out.table = line;
   for (const auto& g : census.groups) {
     const std::string given = group_given(g);
@@ -249,8 +272,8 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
     for (const auto& [k, v] : g.values) {
       const Interval iv = mean_ci95(v);
       ivs[k] = iv;
-      gj["metrics"][k] = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}};
-      csv += csv_row({g.scenario, g.localizer, g.params, given, k, std::to_string(iv.n), fmt(iv.mean), fmt(iv.low), fmt(iv.high)});
+      gj["metrics"][k] = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}, {"interval", iv.kind}};
+      csv += csv_row({g.scenario, g.localizer, g.params, given, k, std::to_string(iv.n), fmt(iv.mean), fmt(iv.low), fmt(iv.high), iv.kind});
     }
     agg["groups"].push_back(gj);
     // Runs with kidnaps or covers: the tracking phase, as the papers' tables (marked "*").

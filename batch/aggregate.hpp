@@ -1,6 +1,6 @@
 #pragma once
-// The aggregate of a sweep: per scenario x localizer x parameters, the mean and 95 % interval over
-// seeds of every number in the runs' summary.json. Computed from the finished run folders in run
+// The aggregate of a sweep: per scenario x localizer x parameters, the mean and interval (mean_ci95's
+// rule) over seeds of every number in the runs' summary.json. Computed from the finished run folders in run
 // order, so it does not depend on -j, sharding or interruptions; written (runs.csv, aggregate.csv,
 // aggregate.json) only when it is final: every run of the sweep done or failed, by the process that
 // covers the whole sweep (a local sweep, or the merge after Slurm shards), never by a shard.
@@ -13,12 +13,24 @@
 
 namespace omniloc::batch {
 
-/// Mean and 95 % confidence interval (Student t) of a sample.
+/// The interval rule, the same as scripts/omniloc_results.py's interval() (docs/results.md
+/// "Intervals", chosen by the coverage measured by scripts/interval_coverage.py): with n >= 5 seeds
+/// the 95 % Student t interval of the mean, its lower bound clipped at 0 when no value is negative
+/// ("t95"); with 2 to 4 seeds no interval is reliable, so low / high are the seeds' minimum and
+/// maximum ("range"); one seed: low = high = the value ("none").
+inline constexpr const char* kT95Interval = "t95";
+inline constexpr const char* kRangeInterval = "range";
+inline constexpr const char* kNoInterval = "none";
+inline constexpr std::size_t kMinTSeeds = 5;
 struct Interval {
   double mean = 0, low = 0, high = 0;
   std::size_t n = 0;
+  const char* kind = kNoInterval;  ///< kT95Interval, kRangeInterval or kNoInterval
 };
 Interval mean_ci95(const std::vector<double>& v);
+/// How the terminal prints it, as the Python tools do: "m [lo, hi] (n=5, t95)",
+/// "m (seeds' range lo to hi, n=3)", "m (n=1, no interval)".
+std::string interval_text(const Interval& iv, int digits);
 
 /// Whether run `r` has a finished folder (its summary.json is written last, by rename).
 bool run_finished(const std::filesystem::path& dir, const SweepRun& r);

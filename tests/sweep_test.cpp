@@ -139,11 +139,36 @@ TEST(Sweep, BadSweepFailsBeforeAnyRun) {
 }
 
 TEST(Sweep, ConfidenceInterval) {
-  const Interval iv = mean_ci95({1.0, 2.0, 3.0, 4.0});
-  EXPECT_DOUBLE_EQ(iv.mean, 2.5);
-  // sd = 1.29099, t(3) = 3.182: half width 3.182 * 1.29099 / 2 = 2.05397
-  EXPECT_NEAR(iv.high - iv.mean, 2.05397, 1e-4);
+  // The one rule (docs/results.md "Intervals"; scripts/omniloc_results.py interval() gives the same).
+  // n >= 5: Student t. 1..5: mean 3, sd 1.58114, t(4) = 2.776445: half width 1.963243.
+  const Interval iv = mean_ci95({1.0, 2.0, 3.0, 4.0, 5.0});
+  EXPECT_DOUBLE_EQ(iv.mean, 3.0);
+  EXPECT_STREQ(iv.kind, kT95Interval);
+  EXPECT_NEAR(iv.high - iv.mean, 1.963243, 1e-5);
+  EXPECT_NEAR(iv.mean - iv.low, 1.963243, 1e-5);
+  EXPECT_EQ(interval_text(iv, 3), "3.000 [1.037, 4.963] (n=5, t95)");
+  // 2..4 seeds: no reliable interval; the seeds' range, said as such.
+  const Interval r = mean_ci95({1.0, 2.0, 3.0, 4.0});
+  EXPECT_STREQ(r.kind, kRangeInterval);
+  EXPECT_EQ(r.low, 1.0);
+  EXPECT_EQ(r.high, 4.0);
+  EXPECT_EQ(interval_text(r, 2), "2.50 (seeds' range 1.00 to 4.00, n=4)");
+  // One seed: none.
   EXPECT_EQ(mean_ci95({5.0}).low, 5.0);
+  EXPECT_STREQ(mean_ci95({5.0}).kind, kNoInterval);
+  EXPECT_EQ(interval_text(mean_ci95({5.0}), 4), "5.0000 (n=1, no interval)");
+  // A non-negative sample never gets a negative bound (unclipped t: 2.06 - 5.53 < 0); a signed one may.
+  const Interval skew = mean_ci95({0.05, 0.1, 0.1, 0.05, 10.0});
+  EXPECT_EQ(skew.low, 0.0);
+  EXPECT_GT(skew.high, skew.mean);
+  EXPECT_LT(mean_ci95({-1.0, 0.05, 0.1, 0.05, 10.0}).low, 0.0);
+  // df above the table: t(40) = 2.021075.
+  std::vector<double> many(41);
+  for (std::size_t i = 0; i < many.size(); ++i) many[i] = i % 2 ? 1.0 : 3.0;
+  const Interval m = mean_ci95(many);
+  double s2 = 0;
+  for (double x : many) s2 += (x - m.mean) * (x - m.mean);
+  EXPECT_NEAR(m.high - m.mean, 2.021075 * std::sqrt(s2 / 40) / std::sqrt(41.0), 1e-5);
 }
 
 namespace {
@@ -191,6 +216,18 @@ TEST(Sweep, CsvFilesAreValidWithJsonObjectParameters) {
   const auto runs = parse_csv(read_file((test_dir() / "csv" / "runs.csv").string()));
   EXPECT_EQ(runs[1][4], spec.runs[0].params_label);
   EXPECT_NE(runs[1][4].find("odometry={\"trans_sigma\":0.01}"), std::string::npos) << runs[1][4];
+  // Issue 38: every row names its interval kind (last column, so old readers of ci95_low / ci95_high
+  // read them as before); kind follows n; a non-negative metric never has a negative bound.
+  const auto agg = parse_csv(read_file((test_dir() / "csv" / "aggregate.csv").string()));
+  ASSERT_EQ(agg[0].back(), "interval");
+  ASSERT_EQ(agg[0][7], "ci95_low");
+  for (std::size_t i = 1; i < agg.size(); ++i) {
+    const std::size_t n = std::stoul(agg[i][5]);
+    EXPECT_EQ(agg[i].back(), n >= kMinTSeeds ? kT95Interval : n >= 2 ? kRangeInterval : kNoInterval) << agg[i][4];
+    if (agg[i][4].find("_cm/") != std::string::npos || agg[i][4].find("position_m/") != std::string::npos) {
+      EXPECT_GE(std::stod(agg[i][7]), 0.0) << agg[i][4];
+    }
+  }
 }
 
 TEST(Sweep, ScenarioEntriesCarryTheirOwnParametersAndLocalizers) {
