@@ -10,7 +10,18 @@ Checks, each printed with its result:
   - the file is under --max-mb megabytes (default 3: the report embeds its pictures);
   - no raw markdown in the rendered text (**, backticks, "](" of a link): markdown is rendered;
   - no absolute paths (/home/..., /work/..., /tmp/..., the repository's own folder) in the text;
-  - the scorecard is the first section (the first <h2> after the title).
+  - the scorecard is the first section (the first <h2> after the title);
+  - no negative bound of an interval of a non-negative quantity (an error, a count) in the report,
+    nor in an aggregate.csv beside it (negative_bounds(); `--aggregate CSV` checks a sweep's alone);
+  - a headline (id "headline") is the first thing after the title;
+  - reader's language: no issue numbers ("issue 29") and no raw identifiers with underscores
+    (JSON keys, claim ids, metric names) in the text a reader reads; <code>, <pre> and an
+    experiment's own notes (class "quoted") are quoted material and exempt, and so are file names,
+    paths and the names a reader types (scenarios, sweeps, experiments, localizers, noise profiles,
+    fields: read from the repository) and the abbreviations E_k, N_th, N_eff;
+  - no section heading (an <h2> or <h3> of the report's own) twice;
+  - a bibliography ("References", the last section) lists the papers, each with a year, and every
+    citation [n] in the text names one of its entries.
 --self-test builds a report of a small synthetic sweep (the fixtures of tests/report_test.py, with
 an outlying seed) with scripts/report.py in a temporary folder and checks that one; ctest runs it
 (report_html). Exit 0: all pass; 1: a check failed; 77: Chromium is missing (the check skips with a
@@ -18,6 +29,7 @@ message; scripts/install-deps.sh --report-check installs Debian's chromium).
 """
 import argparse
 import html
+import html.parser
 import pathlib
 import re
 import shutil
@@ -57,6 +69,140 @@ def visible_text(dom):
     return html.unescape(re.sub(r"<[^>]+>", " ", dom))
 
 
+# Issue 38: an error, a count or a fraction cannot be negative, so neither can a bound of its interval
+# (omniloc_results.interval clips the t interval at 0; the seeds' range of non-negative values is too).
+# The report prints intervals of such quantities only; aggregate.csv also holds signed ones, told by name.
+REPORT_INTERVAL = re.compile(r"(-?\d+(?:\.\d+)?) (?:\[(-?\d+(?:\.\d+)?), -?\d+(?:\.\d+)?\]|\(seeds' range (-?\d+(?:\.\d+)?) to )")
+NON_NEGATIVE_METRIC = re.compile(r"(^|/)(x_cm|y_cm|theta_rad|position_m|line_points|recovery|after_recovery)(/|$)|"
+                                 r"(^|/)(frames|valid_fraction|coasting_frames|relocalisations|wrong_frames|mirrored_frames|excluded_s)$")
+
+
+def negative_bounds(text, aggregate_csv=None):
+    """The intervals with a negative lower bound for a non-negative quantity: in the report's text
+    ("m [lo, hi]" and "m (seeds' range lo to hi"), and in an aggregate.csv's rows of non-negative
+    metrics (by name: errors, counts, fractions). [] when there are none."""
+    import csv
+    bad = [m.group(0) for m in REPORT_INTERVAL.finditer(text) if float(m.group(2) or m.group(3)) < 0]
+    if aggregate_csv is not None:
+        with pathlib.Path(aggregate_csv).open(newline="") as fh:
+            for row in csv.DictReader(fh):
+                try:
+                    low = float(row.get("ci95_low") or "nan")
+                except ValueError:
+                    continue
+                if low < 0 and NON_NEGATIVE_METRIC.search(row.get("metric", "")):
+                    bad.append(f"aggregate.csv {row.get('scenario')} / {row.get('localizer')} / {row['metric']}: {row.get('mean')} [{low}, {row.get('ci95_high')}]")
+    return bad
+
+
+class ReaderText(html.parser.HTMLParser):
+    """The text a reader reads as prose: what visible_text keeps, less <code>, <pre>, <style>,
+    <script> and elements of class "quoted" (an experiment's own output, quoted as written)."""
+    EXEMPT = {"code", "pre", "style", "script"}
+    VOID = {"img", "br", "hr", "meta", "link", "input", "source", "wbr"}
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.parts, self.stack = [], []  # (tag, exempt) of the open elements
+
+    def handle_starttag(self, tag, attrs):
+        if tag in self.VOID:
+            return
+        cls = dict(attrs).get("class") or ""
+        exempt = tag in self.EXEMPT or "quoted" in cls.split() or bool(self.stack and self.stack[-1][1])
+        self.stack.append((tag, exempt))
+
+    def handle_endtag(self, tag):
+        for k in range(len(self.stack) - 1, -1, -1):  # tolerant of unclosed tags
+            if self.stack[k][0] == tag:
+                del self.stack[k:]
+                break
+
+    def handle_data(self, data):
+        if not (self.stack and self.stack[-1][1]):
+            self.parts.append(data)
+
+
+def reader_text(dom):
+    p = ReaderText()
+    p.feed(re.sub(r"data:image/[a-z]+;base64,[A-Za-z0-9+/=]+", "", dom))
+    return " ".join(p.parts)
+
+
+ISSUE = re.compile(r"\b[Ii]ssues? #?\d+\b")
+# An identifier with underscores that is not part of a path or a file name (docs/error_budget.md,
+# paper_suite.json, frames.csv stay: a reader opens them).
+SNAKE = re.compile(r"(?<![\w/.#=-])([A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)+)(?![\w/-]|\.[A-Za-z])")
+ABBREVIATIONS_WITH_UNDERSCORE = {"E_k", "N_th", "N_eff"}
+
+
+def reader_names():
+    """Names a reader types or picks (scenario, sweep, experiment, localizer, noise profile and
+    field names), read from the repository: allowed in the text."""
+    import json
+    names = set(ABBREVIATIONS_WITH_UNDERSCORE) | {"field_robot", "x86_64"}  # x86_64: the machine's architecture
+    for pattern in ("scenarios/**/*.json", "experiments/*.hpp", "localization/*.hpp", "data/fields/*.json"):
+        names |= {p.stem for p in ROOT.glob(pattern)}
+    try:
+        names |= {p["name"] for p in json.loads((ROOT / "data" / "noise_profiles.json").read_text()).get("profiles", [])}
+    except (OSError, ValueError, AttributeError, KeyError, TypeError):
+        pass
+    return names
+
+
+def check_no_issue_numbers(dom):
+    """(ok, detail): no 'issue 29' in the text a reader reads (the tracker is the developers')."""
+    text = reader_text(dom)
+    hits = sorted({m.group(0) for m in ISSUE.finditer(text)})
+    where = [text[max(0, text.find(h) - 40):text.find(h) + 40].replace("\n", " ") for h in hits[:1]]
+    return not hits, "none" if not hits else f"{', '.join(hits)} e.g. ...{where[0]}..."
+
+
+def check_no_raw_keys(dom, allowed=None):
+    """(ok, detail): no identifier with underscores (a JSON key, claim id or metric name) in the
+    text a reader reads, outside code and quoted output, other than reader_names()."""
+    allowed = reader_names() if allowed is None else allowed
+    text = reader_text(dom)
+    hits = {}
+    for m in SNAKE.finditer(text):
+        if m.group(1) not in allowed:
+            hits.setdefault(m.group(1), text[max(0, m.start() - 40):m.end() + 40].replace("\n", " "))
+    return not hits, "none" if not hits else f"{len(hits)}: {', '.join(sorted(hits)[:8])}; e.g. ...{next(iter(hits.values()))}..."
+
+
+def check_headline(dom):
+    """(ok, detail): the element right after the title is the headline (id "headline"), with text."""
+    m = re.search(r"</h1>\s*<([a-z0-9]+)\b([^>]*)>(.*?)</\1>", dom, re.S)
+    ok = bool(m) and re.search(r"\bid=[\"']headline[\"']", m.group(2)) is not None
+    text = html.unescape(re.sub(r"<[^>]+>", "", m.group(3))).strip() if ok else ""
+    return ok and len(text) >= 60, (f"{len(text)} characters: {text[:90]}..." if ok else "no element with id \"headline\" right after the title")
+
+
+def check_unique_headings(dom):
+    """(ok, detail): no section heading of the report (<h2>/<h3> with an id) twice."""
+    seen, twice = set(), []
+    for m in re.finditer(r"<h([23])\b[^>]*\bid=[\"'][^\"']*[\"'][^>]*>(.*?)</h\1>", dom, re.S):
+        t = " ".join(html.unescape(re.sub(r"<[^>]+>", "", m.group(2))).split())
+        (twice.append(t) if t in seen else seen.add(t))
+    return not twice, "every heading once" if not twice else "twice: " + "; ".join(sorted(set(twice))[:5])
+
+
+def check_bibliography(dom):
+    """(ok, detail): a "References" section last, listing entries with a year, and every citation
+    'Author 2013 [n]' of the text naming one of them."""
+    h2 = re.findall(r"<h2\b[^>]*\bid=[\"']([^\"']*)[\"']", dom)
+    m = re.search(r"<ol\b[^>]*\bid=[\"']bibliography[\"'][^>]*>(.*?)</ol>", dom, re.S)
+    if not h2 or h2[-1] != "references" or not m:
+        return False, "no bibliography (ol id=bibliography)" if not m else f"References is not the last section (last: {h2[-1] if h2 else 'none'})"
+    entries = re.findall(r"<li\b[^>]*>(.*?)</li>", m.group(1), re.S)
+    no_year = [k + 1 for k, e in enumerate(entries) if not re.search(r"\b(19|20)\d\d\b", e)]
+    cited = {int(n) for n in re.findall(r"(?<=\d{4} \[)(\d+)(?=\])", reader_text(dom))}
+    dangling = sorted(n for n in cited if not 1 <= n <= len(entries))
+    ok = len(entries) >= 5 and not no_year and not dangling
+    return ok, (f"{len(entries)} entries, citations {sorted(cited) or 'none'}" + (f"; without a year: {no_year}" if no_year else "")
+                + (f"; citations without an entry: {dangling}" if dangling else ""))
+
+
 def check(page, max_mb, browser):
     """[(name, ok, detail)] for one report."""
     results = []
@@ -77,6 +223,13 @@ def check(page, max_mb, browser):
     first = re.search(r"<h2\b[^>]*>", dom)
     first_id = re.search(r"id=\"([^\"]*)\"", first.group(0)).group(1) if first and "id=" in first.group(0) else None
     results.append(("scorecard first", first_id == "scorecard", f"first section: {first_id or 'none'}"))
+    neg = negative_bounds(text, next((p for p in (page.parent / "aggregate.csv",) if p.exists()), None))
+    results.append(("no negative bound", not neg, "no interval of a non-negative quantity below 0" if not neg else "; ".join(neg[:3])))
+    results.append(("headline", *check_headline(dom)))
+    results.append(("no issue numbers", *check_no_issue_numbers(dom)))
+    results.append(("no raw keys", *check_no_raw_keys(dom)))
+    results.append(("headings once", *check_unique_headings(dom)))
+    results.append(("bibliography", *check_bibliography(dom)))
     return results
 
 
@@ -100,7 +253,12 @@ def main():
     ap.add_argument("report", nargs="?", default="results/report/report.html")
     ap.add_argument("--max-mb", type=float, default=3.0)
     ap.add_argument("--self-test", action="store_true", help="check a report made here from synthetic results")
+    ap.add_argument("--aggregate", metavar="CSV", help="check only an aggregate.csv for negative bounds of non-negative metrics (no browser)")
     a = ap.parse_args()
+    if a.aggregate:
+        neg = negative_bounds("", a.aggregate)
+        print(f"check_report_html: {'ok  ' if not neg else 'FAIL'} no negative bound: " + ("; ".join(neg[:5]) if neg else a.aggregate))
+        return 1 if neg else 0
     browser = find_chromium()
     if browser is None:
         print("check_report_html: SKIPPED: no Chromium here (Debian: scripts/install-deps.sh --report-check installs it)")

@@ -17,22 +17,21 @@ condition may be run under two names, e.g. the 50 % row as occlusion_002 or as t
 swept occlusion; taking one avoids counting a seed twice). Where a run comes from (which sweep, its
 position in it) never matters.
 
-Statistics for few seeds (stats()): the mean, the median and every seed's value; a 95 % interval
-only where n >= 2, chosen to respect the quantity: for non-negative quantities (errors, counts) the
-bootstrap percentile interval of the mean (exact over all n^n resamples up to n = 6, 4000 seeded
-resamples above), which never leaves [min, max] of the seeds; for signed quantities Student's t.
-Each result names its method. outliers() flags a seed whose error lies far above the others.
+Statistics for few seeds (stats()): the mean, the median and every seed's value, and interval():
+THE interval rule of omniloc, the same as batch/aggregate.cpp's mean_ci95 (docs/results.md
+"Intervals", measured by scripts/interval_coverage.py): n >= 5, the 95 % Student t interval of the
+mean, its lower bound clipped at 0 when no seed is negative ("t95"); 2 <= n <= 4, no reliable
+interval exists, so the seeds' range min..max is given instead and says so ("range"); n = 1, none.
+Each result names its kind. outliers() flags a seed whose error lies far above the others.
 Welch's t-test for two result sets. No SciPy: Debian's python3 and python3-matplotlib are the only
 dependencies.
 """
 import contextlib
 import csv
-import itertools
 import json
 import math
 import os
 import pathlib
-import random
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAPERS = ROOT / "results" / "reference" / "papers.json"
@@ -305,8 +304,13 @@ def describe_key(key):
 
 # ---- statistics -----------------------------------------------------------------------------
 
-BOOTSTRAP = "bootstrap"  # method names, printed beside every interval
-STUDENT_T = "Student t"
+# The interval rule (one for every tool; batch/aggregate.cpp applies the same in C++): the kind
+# names printed beside every interval, and aggregate.csv's "interval" column.
+T95 = "t95"      # 95 % Student t interval of the mean, clipped at 0 for a non-negative sample (n >= 5)
+RANGE = "range"  # the seeds' min..max: NOT a confidence interval (2 <= n <= 4: none is reliable)
+NO_INTERVAL = "none"  # one seed
+MIN_T_SEEDS = 5  # below this no candidate covered the mean reliably (scripts/interval_coverage.py)
+STUDENT_T = T95  # old name
 
 
 def percentile(sorted_vals, q):
@@ -318,40 +322,80 @@ def percentile(sorted_vals, q):
     return sorted_vals[k] + (pos - k) * (sorted_vals[k + 1] - sorted_vals[k])
 
 
-def bootstrap_interval(v, level=0.95, resamples=4000):
-    """Percentile bootstrap interval of the mean of v. Exact (every ordered resample once) for
-    n <= 6, so the same seeds always give the same interval; seeded resampling above."""
+def interval(values):
+    """The interval of the mean of a few seeds' values, by omniloc's one rule (docs/results.md
+    "Intervals"): {"n", "mean", "lo", "hi", "kind"}.
+      n >= 5: kind T95, the 95 % Student t interval; a sample without negative values (an error, a
+              count) never gets a negative bound: the lower one is clipped at 0.
+      2..4:   kind RANGE, lo / hi the seeds' minimum and maximum: with so few seeds no interval is
+              reliable (the bootstrap covers the mean 57-80 % of the time on skewed errors; t nears
+              95 % only with a lower bound below 0 in up to 84 % of samples), so none is claimed.
+      1:      kind NO_INTERVAL, lo = hi = the value.   0: everything None.
+    None and NaN values are left out."""
+    v = [float(x) for x in values if x is not None and not (isinstance(x, float) and math.isnan(x))]
     n = len(v)
-    if n <= 6:
-        means = sorted(sum(c) / n for c in itertools.product(v, repeat=n))
-    else:
-        rng = random.Random(12345)  # fixed: a report must not change between two builds of it
-        means = sorted(sum(rng.choice(v) for _ in range(n)) / n for _ in range(resamples))
-    a = (1 - level) / 2
-    return percentile(means, a), percentile(means, 1 - a)
+    if n == 0:
+        return {"n": 0, "mean": None, "lo": None, "hi": None, "kind": None}
+    m = sum(v) / n
+    if n == 1:
+        return {"n": 1, "mean": m, "lo": m, "hi": m, "kind": NO_INTERVAL}
+    if n < MIN_T_SEEDS:
+        return {"n": n, "mean": m, "lo": min(v), "hi": max(v), "kind": RANGE}
+    sd = math.sqrt(sum((x - m) ** 2 for x in v) / (n - 1))
+    half = t_quantile_975(n - 1) * sd / math.sqrt(n)
+    lo = m - half
+    if min(v) >= 0:
+        lo = max(lo, 0.0)
+    return {"n": n, "mean": m, "lo": lo, "hi": m + half, "kind": T95}
+
+
+def interval_text(iv, digits=3):
+    """How every tool prints an interval (stats() or interval() output):
+    'mean [lo, hi] (n=5, t95)', "mean (seeds' range lo to hi, n=3)", 'mean (n=1, no interval)', '-'."""
+    if not iv or not iv["n"]:
+        return "-"
+    m = fnum(iv["mean"], digits)
+    kind = iv.get("kind", iv.get("method"))
+    if iv["n"] == 1 or kind == NO_INTERVAL:
+        return f"{m} (n=1, no interval)"
+    if kind == RANGE:
+        return f"{m} (seeds' range {fnum(iv['lo'], digits)} to {fnum(iv['hi'], digits)}, n={iv['n']})"
+    return f"{m} [{fnum(iv['lo'], digits)}, {fnum(iv['hi'], digits)}] (n={iv['n']}, {kind})"
+
+
+INTERVAL_RULE_TEXT = ("intervals: n >= 5 seeds, the 95 % Student t interval of the mean, never below 0 for a non-negative quantity (t95); "
+                      "2 to 4 seeds, no reliable interval exists, so the seeds' range (min to max) is shown instead, marked as such; "
+                      "1 seed, none (docs/results.md \"Intervals\")")
+
+
+def aggregate_interval(metric):
+    """(lo, hi, kind) of one metric of an aggregate.json group ({"n", "mean", "ci95", "interval"}).
+    Aggregates written before the rule have no "interval" and hold an unclipped Student t interval
+    for every n >= 2: the kind returned is then "t95 (old aggregate)" for n >= 2, so a reader never
+    takes it for the current rule's."""
+    ci = metric.get("ci95") or [None, None]
+    kind = metric.get("interval")
+    if kind is None:
+        kind = NO_INTERVAL if metric.get("n", 0) < 2 else "t95 (old aggregate)"
+    return ci[0], ci[1], kind
 
 
 def stats(values, method=None):
-    """{"n", "mean", "median", "sd", "lo", "hi", "values", "method"} over the seeds' values.
-    lo / hi: a 95 % interval of the mean, None where n < 2. method: BOOTSTRAP (the default for
-    non-negative values: the interval cannot run below zero) or STUDENT_T (signed values)."""
+    """{"n", "mean", "median", "sd", "lo", "hi", "values", "method"} over the seeds' values: lo / hi /
+    method are interval()'s lo / hi / kind (the one rule; None where n < 2). `method` is accepted for
+    old callers and ignored: every tool uses the same rule."""
     v = [x for x in values if x is not None and not (isinstance(x, float) and math.isnan(x))]
     n = len(v)
     out = {"n": n, "mean": None, "median": None, "sd": None, "lo": None, "hi": None, "values": v, "method": None}
     if n == 0:
         return out
-    out["mean"] = m = sum(v) / n
+    iv = interval(v)
+    out["mean"] = iv["mean"]
     out["median"] = percentile(sorted(v), 0.5)
     if n < 2:
         return out
-    out["sd"] = sd = math.sqrt(sum((x - m) ** 2 for x in v) / (n - 1))
-    method = method or (BOOTSTRAP if min(v) >= 0 else STUDENT_T)
-    if method == BOOTSTRAP:
-        out["lo"], out["hi"] = bootstrap_interval(v)
-    else:
-        half = t_quantile_975(n - 1) * sd / math.sqrt(n)
-        out["lo"], out["hi"] = m - half, m + half
-    out["method"] = method
+    out["sd"] = math.sqrt(sum((x - iv["mean"]) ** 2 for x in v) / (n - 1))
+    out["lo"], out["hi"], out["method"] = iv["lo"], iv["hi"], iv["kind"]
     return out
 
 
@@ -454,9 +498,6 @@ def fnum(v, digits=3):
 
 
 def fstat(s, digits=3):
-    """'mean [lo, hi] (n=3, bootstrap)', or 'mean (n = 1: no interval)'."""
-    if s["n"] == 0:
-        return "-"
-    if s["lo"] is None:
-        return f"{fnum(s['mean'], digits)} (n = 1: no interval)"
-    return f"{fnum(s['mean'], digits)} [{fnum(s['lo'], digits)}, {fnum(s['hi'], digits)}] (n={s['n']}, {s['method']})"
+    """interval_text of a stats() result: 'mean [lo, hi] (n=5, t95)', "mean (seeds' range lo to hi,
+    n=3)", 'mean (n=1, no interval)'."""
+    return interval_text(s, digits)

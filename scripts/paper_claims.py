@@ -11,6 +11,7 @@
 import json
 import math
 import pathlib
+import re
 import statistics
 
 import global_start as G
@@ -260,6 +261,39 @@ def quantity(q, ctx):
     raise ValueError(f"unknown quantity {q}")
 
 
+def evidence_seeds(q, ctx):
+    """How many runs (seeds) or trials the value of selector `q` rests on: for a row, a global-start
+    row or a timing, the matched runs; for an experiment, its JSON's "seeds" (or "trials") where it
+    records one; for ratios and formulas the fewest of their parts. None when unknown (an experiment
+    that does not say) or nothing is measured."""
+    if not isinstance(q, dict):
+        return None
+    parts = list(q.get("ratio") or q.get("fraction") or []) + [v for v in (q.get("vars") or {}).values() if isinstance(v, dict)]
+    if parts:
+        counts = [n for n in (evidence_seeds(x, ctx) for x in parts) if n is not None]
+        return min(counts) if counts else None
+    if "row" in q or "global_start" in q:
+        sel, _ = _row_runs(ctx, q.get("row") or q["global_start"])
+        return len(sel) or None
+    if "timing" in q:
+        _, _, sel = timing_ms(ctx.papers, q["timing"][1], ctx.runs)
+        return len(sel) or None
+    if "experiment" in q:
+        j = ctx.experiment_json(q["experiment"], q["file"])
+        n = (j or {}).get("seeds", (j or {}).get("trials")) if isinstance(j, dict) else None
+        return n if isinstance(n, int) and not isinstance(n, bool) and n > 0 else None
+    return None
+
+
+WEAK_TEXT = "(1 seed: weak evidence)"
+
+
+def verdict_text(c):
+    """A claim's verdict as printed: "holds", or "holds (1 seed: weak evidence)" when the verdict
+    rests on one run or trial (evaluate_claims' "weak")."""
+    return c["verdict"] + (f" {WEAK_TEXT}" if c.get("weak") else "")
+
+
 def judge(value, rule, published=None):
     if rule is None:
         return "n/a"
@@ -407,7 +441,7 @@ def evaluate_claims(ctx):
                 verdicts.append(verdict)
                 ratio = v / pub if v is not None and pub else None
                 row["checks"].append({"label": ch["label"], "ours": v, "note": note, "verdict": verdict, "ratio": ratio,
-                                      "published": ch.get("published")})
+                                      "published": ch.get("published"), "seeds": evidence_seeds(ch["ours"], ctx)})
             row["verdict"] = _combine(verdicts)
             row["ours"] = None
             row["ours_text"] = "; ".join(f"{ch['label']}: {R.fnum(ch['ours'], 3)}" + (f" ({R.fnum(ch['ratio'], 2)}x the paper's)" if ch["ratio"] is not None else "")
@@ -423,6 +457,12 @@ def evaluate_claims(ctx):
             if isinstance(c.get("published"), (int, float)) and v is not None and c["published"]:
                 row["ratio"] = v / c["published"]
             row["verdict"] = judge(v, c.get("rule"), c.get("published") if isinstance(c.get("published"), (int, float)) else None)
+            row["seeds"] = evidence_seeds(c.get("ours"), ctx)
+        if row["checks"]:
+            counts = [ch["seeds"] for ch in row["checks"] if ch["seeds"] is not None]
+            row["seeds"] = min(counts) if counts else None
+        # A verdict that rests on one seed or trial is weak evidence, and says so (issue 38).
+        row["weak"] = row["verdict"] in ("holds", "partly", "does not") and row["seeds"] == 1
         out.append(row)
     return out
 
@@ -474,10 +514,10 @@ def explain(claims, ctx, profile="robot"):
             continue
         causes = [k for k in by_id.get(c["id"], {}).get("causes", []) if _applies(k, c["verdict"], profile)]
         row = {"id": c["id"], "paper": c["paper"], "claim": c["claim"], "verdict": c["verdict"], "profile": profile,
-               "status": UNEXPLAINED, "text": "", "doc": "", "evidence": []}
+               "status": UNEXPLAINED, "text": "", "summary": "", "doc": "", "evidence": []}
         if causes:
             k = causes[0]
-            row["text"], row["doc"] = k["text"], k.get("doc", "")
+            row["text"], row["doc"], row["summary"] = k["text"], k.get("doc", ""), cause_summary(k)
             for ev in k.get("evidence", []):
                 v, note = quantity(ev["ours"], ctx)
                 lo, hi = ev.get("expect", [-math.inf, math.inf])
@@ -510,3 +550,137 @@ def evidence_text(e):
               f" (argument needs at least {_sig(lo)})" if hi >= 1e11 else f" (argument needs at most {_sig(hi)})"
     mark = "" if e["ok"] else " — CONTRADICTS"
     return f"{e['label']}: {_sig(e['value'])}{(' ' + e['unit']) if e['unit'] else ''}{rng}{mark}"
+
+
+# ---- reader's language: citations, readable labels, abbreviations (issue 38) -----------------------
+# The report speaks to a researcher: papers by authors and year with a bibliography, claims and
+# published tables by what they are (never their papers.json keys), abbreviations spelled out.
+
+# The five papers, numbered as the report's bibliography numbers them. Venue and year as printed on
+# the papers; where a paper's text does not print them, "note" says where they come from.
+BIBLIOGRAPHY = [
+    {"paper": "000", "short": "Xiong et al. 2012", "authors": "Dan Xiong, Huimin Lu, Zhiqiang Zheng",
+     "title": "A self-localization method based on omnidirectional vision and MTi for soccer robots",
+     "venue": "Proceedings of the 10th World Congress on Intelligent Control and Automation (WCICA), Beijing", "year": 2012,
+     "note": "National University of Defense Technology, Changsha; bilingual (English and Chinese). The text prints neither venue nor year "
+             "(its latest reference is from 2010): venue and year as we know them, not verified against the paper."},
+    {"paper": "001", "short": "Xu et al. 2012", "authors": "Jiaming Xu, Lun Xie, Zhiliang Wang, Shanchao Ni",
+     "title": "Target localization algorithm for cooperative multi-soccer robots based on Hough space",
+     "venue": "Journal of Image and Graphics (Zhongguo Tuxiang Tuxing Xuebao) 17(6): 687-695", "year": 2012,
+     "note": "University of Science and Technology Beijing; in Chinese."},
+    {"paper": "002", "short": "Lu et al. 2013", "authors": "Huimin Lu, Xun Li, Hui Zhang, Mei Hu, Zhiqiang Zheng",
+     "title": "Robust and real-time self-localization based on omnidirectional vision for soccer robots",
+     "venue": "Advanced Robotics (doi:10.1080/01691864.2013.785473)", "year": 2013,
+     "note": "National University of Defense Technology, Changsha (the NuBot team)."},
+    {"paper": "003", "short": "Zhuang and Cao 2009", "authors": "Huimin Zhuang, Qixin Cao",
+     "title": "Global localization of explorer based on visible landmarks",
+     "venue": "Journal of Shanghai Jiao Tong University, no. 6, pp. 871-874", "year": 2009,
+     "note": "Research Institute of Robotics, Shanghai Jiao Tong University; in Chinese."},
+    {"paper": "004", "short": "Luo et al. 2012", "authors": "Jia-Ning Luo, Shu-Ying Chiang, Dong-Liang Li, Ching-Yi Chen, Kun-Yu Chen",
+     "title": "Design of a positioning system module for omni-direction soccer robot",
+     "venue": "conference paper, Department of Information and Telecommunications Engineering, Ming Chuan University (Taiwan)", "year": 2012,
+     "note": "In Chinese. The text prints neither venue nor year: 2012 is inferred from its references (consulted in May 2012); "
+             "author names romanised from the Chinese."},
+]
+_BIB = {b["paper"]: (k + 1, b) for k, b in enumerate(BIBLIOGRAPHY)}
+
+
+def cite(paper):
+    """'Lu et al. 2013 [3]' for a paper number ('002'); the number itself when unknown."""
+    if paper not in _BIB:
+        return f"paper {paper}"
+    n, b = _BIB[paper]
+    return f"{b['short']} [{n}]"
+
+
+def cite_field(field):
+    """A claim's "paper" field ('002 / 000', '002 refs [7], [8]') with each paper cited."""
+    out = re.sub(r"\b(00[0-4])\b", lambda m: cite(m.group(1)), str(field))
+    return out.replace("] refs [", "], its refs [")
+
+
+_AUTHORS = r"[A-Z][a-z]+(?:(?:, | and | & )[A-Z][a-z]+)*(?: et al\.)?(?: \d{4})?"
+
+
+def cite_text(text):
+    """Prose with every 'paper 00N' (and 'Lu et al. 2013 (paper 002)', 'papers 002 and 000') made
+    a citation of the bibliography."""
+    text = str(text)
+    if "aper" not in text:
+        return text
+    text = re.sub(_AUTHORS + r" \([Pp]aper (00[0-4])\)", lambda m: cite(m.group(1)), text)
+    text = re.sub(r"\b[Pp]aper (00[0-4]) \(" + _AUTHORS + r"\)", lambda m: cite(m.group(1)), text)
+    text = re.sub(r"\b[Pp]apers (00[0-4]) and (00[0-4])\b", lambda m: f"{cite(m.group(1))} and {cite(m.group(2))}", text)
+    return re.sub(r"\b[Pp]aper (00[0-4])\b", lambda m: cite(m.group(1)), text)
+
+
+# Each claim of papers.json by what it says (the report never shows its id).
+CLAIM_LABELS = {
+    "tracking_accuracy": "Tracking accuracy", "occlusion_mild": "Mild degradation under 50 % occlusion",
+    "lighting_autoadjust": "Lighting: camera auto-adjustment", "kidnap_002": "Kidnap recovery (2 kidnaps)",
+    "kidnap_000": "Kidnap recovery (5 kidnaps)", "mcl_alone": "MCL alone against matching",
+    "weights_1_over_L": "1/L weights beat equal weights", "robots_flatten": "Error flattens at 3-5 robots",
+    "mfbpf_vs_fbpf": "MFBPF below FBPF", "three_point_bounded": "Three-point stays bounded where two-circle explodes",
+    "voting_bounded": "Voting keeps the error within 1 m", "entropy_peak": "Entropy peak moves in sun",
+    "timing_mcl": "MCL time per cycle", "timing_matching": "Matching time per cycle", "timing_global": "Global localization time per frame",
+    "timing_tracking": "Tracking time per frame", "real_cooperative": "Cooperation on real robots",
+}
+
+
+def claim_label(cid):
+    return CLAIM_LABELS.get(cid, str(cid).replace("_", " "))
+
+
+# The published tables and figures of papers.json (paper, what), for headings and captions.
+TABLE_LABELS = {
+    "002_table1_occlusion": ("002", "table 1: tracking error under occlusion"),
+    "002_table2_lighting": ("002", "table 2: tracking error under changing light"),
+    "000_tracking": ("000", "tracking error table"),
+    "002_kidnapping": ("002", "kidnapping"), "000_kidnapping": ("000", "kidnapping"),
+    "timings_ms": ("002 000", "time per cycle or frame"),
+    "mcl_only_mean_position_error_cm": ("002", "other teams' MCL-only mean position error (its refs [7], [8])"),
+    "001_cooperative_mean_error_mm": ("001", "cooperative ball localization: mean error, equal and 1/L weights"),
+    "001_simulation_setup": ("001", "simulation set-up and error against the number of robots (fig. 10)"),
+    "001_real_mean_error_cm": ("001", "real-robot ball error with and without cooperation"),
+    "001_growth_model": ("001", "FBPF and MFBPF on the growth model"),
+    "004_table1_cm": ("004", "table 1: two-circle and three-point fixes"),
+    "003_simulation": ("003", "simulation with landmark groups and voting"),
+}
+
+
+def table_label(key):
+    """'Lu et al. 2013 [3], table 1: tracking error under occlusion' for a papers.json key."""
+    if key not in TABLE_LABELS:
+        return str(key).replace("_", " ")
+    papers, what = TABLE_LABELS[key]
+    return " and ".join(cite(p) for p in papers.split()) + f", {what}"
+
+
+# Rows of papers.json's "timings_ms" by what they time.
+TIMING_LABELS = {"002_mcl": ("002", "MCL part per cycle"), "002_matching": ("002", "matching part per cycle"),
+                 "000_global_per_frame": ("000", "global localization per frame"), "000_tracking_per_frame": ("000", "tracking per frame")}
+
+
+def timing_label(row):
+    paper, what = TIMING_LABELS.get(row, ("", str(row).replace("_", " ")))
+    return f"{what} ({cite(paper)})" if paper else what
+
+
+# Abbreviations the report uses, spelled out at their first use (Report.expand).
+ABBREVIATIONS = {
+    "MCL": "Monte Carlo localization", "RPROP": "resilient propagation, a gradient-sign optimiser",
+    "MFBPF": "modified fission bootstrap particle filter", "FBPF": "fission bootstrap particle filter",
+    "BPF": "bootstrap particle filter", "RMSE": "root mean square error", "MSL": "RoboCup Middle Size League",
+    "MTi": "XSens inertial heading sensor", "E_k": "mean matching error of grid sample k",
+    "N_th": "resampling threshold on the effective sample size", "N_eff": "effective sample size",
+    "CDF": "cumulative distribution function",
+}
+
+
+def cause_summary(cause):
+    """One sentence for the why-table: the cause's "summary" (causes.json), else its first sentence."""
+    if cause.get("summary"):
+        return cause["summary"]
+    text = cause.get("text", "")
+    m = re.match(r"(.+?[.;])(\s|$)", text)
+    return m.group(1) if m else text

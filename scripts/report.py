@@ -7,6 +7,8 @@ RESULTS are folders: a run (summary.json), a sweep (aggregate.json with runs/ in
 experiment (PNG / JSON / markdown files written by `omniloc experiment`), or any folder holding
 such folders (searched recursively). The report is laid out for a reader with ten minutes
 (issue 30; docs/results.md), in this order:
+  - a headline of two or three sentences, computed from the results: what reproduces and what does
+    not, our error against the papers' (median ratio), the main gap and its measured cause;
   - the reproduction scorecard: every claim of results/reference/papers.json with our figure, the
     paper's, the ratio and the verdict computed by the rule written next to the claim, counted
     apart by kind (accuracy / robustness / timing), judged on every axis a published row states,
@@ -16,7 +18,7 @@ such folders (searched recursively). The report is laid out for a reader with te
   - every published table beside the runs that reproduce it, paired BY KEY (scenario, localizer,
     configuration values; scripts/omniloc_results.py), never by position; a row whose runs are
     missing says "not run" and prints the command that runs it; below each, every seed beside the
-    mean (bootstrap intervals, n = 1 marked), a strip plot of the seeds, and each outlying seed
+    mean (intervals by the one rule of docs/results.md "Intervals": t95 for n >= 5, the seeds' range below), a strip plot of the seeds, and each outlying seed
     plotted with its cause read from its frames.csv and events.jsonl;
   - with --baseline: our metrics against another result set (e.g. another commit), per metric
     with the difference and Welch's t-test over seeds (scripts/compare.py);
@@ -24,7 +26,10 @@ such folders (searched recursively). The report is laid out for a reader with te
     CDFs, timing per stage;
   - every experiment's pictures and notes (tables a section above shows are not repeated);
   - on a page of its own (history.html, linked), for developers: instruction counts and benchmark
-    wall times per workload over the commits (--history DIR, default results/history).
+    wall times per workload over the commits (--history DIR, default results/history);
+  - the references: the five papers, cited in the text as 'Lu et al. 2013 [3]' (paper_claims.BIBLIOGRAPHY).
+The text speaks to a reader: claims and tables by readable labels, never papers.json keys or issue
+numbers, abbreviations spelled out at first use (paper_claims.py; scripts/check_report_html.py checks).
 Pictures are embedded, compressed (palette PNG, JPEG for camera frames) so that report.html stays
 under 3 MB; no absolute path reaches the report (Report.clean).
 Everything except the published numbers is read from the result files. Needs Python 3 and
@@ -72,17 +77,29 @@ def numeric_class(cell):
     return " class='num'" if NUMERIC_CELL.match(str(cell).strip()) else ""
 
 
+# Where the repository's docs/ lies seen from the report's folder (results/report/ by default);
+# Report sets it for its own folder. A doc named in the text (docs/x.md#anchor) becomes a link.
+DOCS_HREF = "../../docs/"
+
+
+def md_links(text):
+    """report.md's text with each doc of the repository (docs/x.md#anchor) as a markdown link."""
+    return re.sub(r"(?<![\w/.\[`-])docs/([\w/.-]+?\.md)(#[\w-]+(?:\.[\w-]+)*)?", lambda m: f"[docs/{m.group(1)}]({DOCS_HREF}{m.group(1)}{m.group(2) or ''})", text)
+
+
 def inline_markdown(text):
-    """HTML of one line of markdown: `code`, **bold** and *italic*; everything else escaped. The
-    report's own text and the experiments' markdown use these three, and a reader must never see
-    the raw markers in the HTML."""
+    """HTML of one line of markdown: `code`, **bold** and *italic*, and a doc of the repository
+    (docs/x.md, optionally #anchor) as a link; everything else escaped. The report's own text and
+    the experiments' markdown use these, and a reader must never see the raw markers in the HTML."""
     out, pos = [], 0
-    for m in re.finditer(r"`([^`]+)`|\*\*([^*]+)\*\*|(?<![\w*])\*([^*\s][^*]*?)\*(?![\w*])", text):
+    for m in re.finditer(r"`([^`]+)`|\*\*([^*]+)\*\*|(?<![\w*])\*([^*\s][^*]*?)\*(?![\w*])|(?<![\w/.-])docs/([\w/.-]+?\.md)(#[\w-]+(?:\.[\w-]+)*)?", text):
         out.append(html.escape(text[pos:m.start()]))
         if m.group(1) is not None:
             out.append(f"<code>{html.escape(m.group(1))}</code>")
         elif m.group(2) is not None:
             out.append(f"<b>{html.escape(m.group(2))}</b>")
+        elif m.group(4) is not None:
+            out.append(f"<a href='{html.escape(DOCS_HREF + m.group(4) + (m.group(5) or ''))}'>docs/{html.escape(m.group(4))}</a>")
         else:
             out.append(f"<i>{html.escape(m.group(3))}</i>")
         pos = m.end()
@@ -95,6 +112,8 @@ def slug(text):
 
 
 TOC_MARK = "<!--toc-->"
+# A command of omniloc in running text, shown as code: `build/omniloc sweep scenarios/sweeps/x.json -j 2`.
+COMMAND = re.compile(r"(?<![`\w/])(build/omniloc (?:sweep|experiment|run)(?: [\w./=-]+)+)")
 # The part before a repository folder of an absolute path (/any/checkout/scenarios/x.json -> scenarios/x.json).
 REPO_PATH = re.compile(r"(?<![\w.~-])/(?:[\w.+-]+/)+?(?=(?:scenarios|results|build|docs|scripts|data|experiments|tests)/)")
 
@@ -122,6 +141,10 @@ class Report:
         # is shown relative to the working folder, or by its last two parts when outside it.
         self.roots = sorted({str(p) for p in (pathlib.Path.cwd(), R.ROOT, pathlib.Path.home(), pathlib.Path(tempfile.gettempdir()),
                                               self.out.resolve())}, key=len, reverse=True)
+        self.expanded = set()  # abbreviations already spelled out (expand)
+        global DOCS_HREF
+        out = self.out.resolve()
+        DOCS_HREF = (os.path.relpath(R.ROOT / "docs", out).replace(os.sep, "/") + "/") if out.is_relative_to(R.ROOT) else "../../docs/"
 
     def add_root(self, path):
         p = str(pathlib.Path(path).resolve())
@@ -129,7 +152,7 @@ class Report:
 
     def clean(self, text):
         """text with every absolute path under a known root made relative (see __init__)."""
-        text = str(text)
+        text = C.cite_text(text)  # 'paper 002' -> 'Lu et al. 2013 [3]' (the bibliography at the end)
         if "/" not in text:
             return text
         cwd = pathlib.Path.cwd()
@@ -145,8 +168,23 @@ class Report:
                 # The root as a whole folder name: /root must not eat the start of /rootfs.
                 text = re.sub(re.escape(root) + r"(?![\w.-])(/[^\s'\"<>,;:()\[\]]*)?", rel, text)
         # A path of another checkout (an experiment records the description file it read, with the
-        # folder omniloc was built in): from the repository's own folder on.
-        return REPO_PATH.sub("", text)
+        # folder omniloc was built in): from the repository's own folder on. Commands as code.
+        return COMMAND.sub(r"`\1`", REPO_PATH.sub("", text))
+
+    def expand(self, text):
+        """The text with each abbreviation of C.ABBREVIATIONS spelled out at its first use in the
+        report (outside `code`): 'MCL (Monte Carlo localization)'. Headings are left as they are."""
+        text = str(text)
+        for abbr, full in C.ABBREVIATIONS.items():
+            if abbr in self.expanded or abbr not in text:
+                continue
+            for m in re.finditer(r"(?<![\w/.-])" + re.escape(abbr) + r"(?![\w-])", text):
+                if text.count("`", 0, m.start()) % 2:  # inside `code`
+                    continue
+                self.expanded.add(abbr)
+                text = text[:m.end()] + f" ({full})" + text[m.end():]
+                break
+        return text
 
     def heading(self, text, level=2, anchor=None):
         text = self.clean(text)
@@ -158,13 +196,13 @@ class Report:
         if level == 2:
             self.toc.append((anchor, text))
         self.md += ["#" * level + " " + text, ""]
-        self.html.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(text)}</h{level}>')
+        self.html.append(f'<h{level} id="{html.escape(anchor)}">{inline_markdown(text)}</h{level}>')  # `code` in a run's parameters
         return anchor
 
-    def para(self, text, cls=None):
-        text = self.clean(text)
-        self.md += [text, ""]
-        c = f' class="{cls}"' if cls else ""
+    def para(self, text, cls=None, ident=None):
+        text = self.expand(self.clean(text))
+        self.md += [md_links(text), ""]
+        c = (f' class="{cls}"' if cls else "") + (f' id="{ident}"' if ident else "")
         self.html.append(f"<p{c}>{inline_markdown(text)}</p>")
 
     def raw_html(self, fragment, md=None):
@@ -187,13 +225,13 @@ class Report:
         A cell that is a verdict (holds, partly, ...) is coloured by itself."""
         if caption:
             self.para(caption, "caption")
-        header = [self.clean(c) for c in header]
-        rows = [[self.clean(c) for c in r] for r in rows]
+        header = [self.expand(self.clean(c)) for c in header]
+        rows = [[self.expand(self.clean(c)) for c in r] for r in rows]
         self.md.append("| " + " | ".join(header) + " |")
         # The first column labels the row (even "50 %"): left; the others by their cells.
         self.md.append("|" + "|".join("---:" if i and rows and numeric_class(rows[0][i]) else "---" for i in range(len(header))) + "|")
         for k, r in enumerate(rows):
-            cells = [str(c).replace("|", "\\|") for c in r]
+            cells = [md_links(str(c).replace("|", "\\|")) for c in r]
             if row_classes and row_classes[k] == "paper":
                 cells = [f"*{c}*" if c not in ("", "-") else c for c in cells]
             self.md.append("| " + " | ".join(cells) + " |")
@@ -213,7 +251,7 @@ class Report:
         """An experiment's markdown: headings, paragraphs and pipe tables as real HTML. skip: pairs
         (heading text, anchor): a table under a heading containing that text is left out, with a
         link to the section that shows it from the experiment's JSON (one copy of each table)."""
-        text = self.clean(text)
+        text = self.expand(self.clean(text))
         lines = text.splitlines()
         i, para, kept = 0, [], []
         current = ""
@@ -287,7 +325,7 @@ class Report:
         self._embed(compress_png(dst), caption)
 
     def _embed(self, path, caption):
-        caption = self.clean(caption)
+        caption = self.expand(self.clean(caption))
         rel = path.relative_to(self.out)
         self.md += [f"![{caption}]({rel.as_posix()})", "", f"*{caption}*", ""]
         b64 = base64.b64encode(path.read_bytes()).decode()
@@ -295,7 +333,7 @@ class Report:
         self.html.append(f'<figure><img src="data:{mime};base64,{b64}" alt="{html.escape(caption)}"><figcaption>{inline_markdown(caption)}</figcaption></figure>')
 
     def toc_html(self):
-        items = "".join(f'<li><a href="#{html.escape(a)}">{html.escape(t)}</a></li>' for a, t in self.toc)
+        items = "".join(f'<li><a href="#{html.escape(a)}">{inline_markdown(t)}</a></li>' for a, t in self.toc)
         return f'<nav id="contents"><h2>Contents</h2><ol>{items}</ol></nav>'
 
     def write(self):
@@ -473,11 +511,10 @@ def field_robot_runs(runs):
     return [r for r in runs if profile_of(r) == "field_robot"]
 
 
-def scorecard(rep, ctx):
-    """The papers' claims with our verdicts, counted apart by kind (accuracy / robustness / timing),
-    for the robot profile and, in a column of their own by the same rules, the field_robot runs.
-    Returns (claims, field_claims or None, totals text) for the summary and the terminal."""
-    rep.heading("Reproduction scorecard", 2, "scorecard")
+def judge_claims(ctx):
+    """(claims, field_claims by id or None, causes): the verdicts for the robot profile and, where
+    there are field_robot runs, for those by the same rules; with the causes of every verdict other
+    than holds, each profile's evidence read from its own runs."""
     claims = C.evaluate_claims(ctx)
     field = field_robot_runs(ctx.runs)
     field_claims, fctx = None, None
@@ -486,6 +523,20 @@ def scorecard(rep, ctx):
             fctx = C.Context(ctx.papers, field, [])
             fctx.experiments = ctx.experiments
             field_claims = {c["id"]: c for c in C.evaluate_claims(fctx)}
+    causes = C.explain(claims, ctx, "robot")
+    if field_claims:
+        with R.pairing_profile("field_robot"):  # the evidence of the field_robot verdicts is read from its own runs
+            causes += C.explain([field_claims[c["id"]] for c in claims if c["uses_runs"]], fctx, "field_robot")
+    return claims, field_claims, causes
+
+
+def scorecard(rep, ctx, judged=None):
+    """The papers' claims with our verdicts, counted apart by kind (accuracy / robustness / timing),
+    for the robot profile and, in a column of their own by the same rules, the field_robot runs.
+    judged: judge_claims(ctx) when the caller has it. Returns (claims, field_claims or None, totals
+    text) for the summary and the terminal."""
+    claims, field_claims, causes = judged or judge_claims(ctx)
+    rep.heading("Reproduction scorecard", 2, "scorecard")
     totals = C.totals_text(C.totals(claims))
     ftotals = C.totals_text(C.totals([field_claims[c["id"]] for c in claims if c["uses_runs"]])) if field_claims else None
     rep.para(f"**Robot profile** — {totals}." + (f" **field_robot profile** (claims judged from runs) — {ftotals}." if ftotals else ""), "totals")
@@ -501,11 +552,11 @@ def scorecard(rep, ctx):
         for c in mine:
             pub = c["published"]
             pub_text = (fnum(pub, 3) + ("" if c["unit"] in ("x", "", "recovered") else f" {c['unit']}")) if isinstance(pub, (int, float)) else (pub or "-")
-            row = [c["paper"], c["claim"], c["ours_text"] + ("" if not c["notes"] else " (" + "; ".join(c["notes"]) + ")"), pub_text,
-                   fnum(c["ratio"], 2) if c["ratio"] is not None else "-", c["verdict"]]
+            row = [C.cite_field(c["paper"]), c["claim"], c["ours_text"] + ("" if not c["notes"] else " (" + "; ".join(c["notes"]) + ")"), pub_text,
+                   fnum(c["ratio"], 2) if c["ratio"] is not None else "-", C.verdict_text(c)]
             if field_claims is not None:
                 f = field_claims[c["id"]]
-                row += [f["ours_text"].replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json"), f["verdict"]] \
+                row += [f["ours_text"].replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json"), C.verdict_text(f)] \
                     if c["uses_runs"] else ["same as robot (experiment)", "-"]
             rows.append(row + [c["rule_text"]])
         header = ["paper", "claim", "ours (robot profile)", "paper's", "ours / paper", "verdict"]
@@ -515,11 +566,7 @@ def scorecard(rep, ctx):
         if kind == "timing":
             cap += f" Ours: median wall time on {machine_text()}."
         rep.table(header + ["rule"], rows, cap)
-    causes = C.explain(claims, ctx, "robot")
-    if field_claims:
-        with R.pairing_profile("field_robot"):  # the evidence of the field_robot verdicts is read from its own runs
-            causes += C.explain([field_claims[c["id"]] for c in claims if c["uses_runs"]], fctx, "field_robot")
-    causes_section(rep, causes)
+    causes_section(rep, claims, field_claims, causes)
     ctext = causes_totals(causes)
     return claims, field_claims, totals + (f" | field_robot: {ftotals}" if ftotals else "") + (f" | {ctext}" if ctext else "")
 
@@ -535,23 +582,156 @@ def causes_totals(causes):
     return f"{len(causes)} verdicts other than holds: " + ", ".join(f"{counts[k]} {k}" for k in order if counts.get(k))
 
 
-def causes_section(rep, causes):
-    """Why each claim that does not hold does not: the cause written next to the claim in papers.json,
-    with its evidence read from these results (issue 29). A verdict without a cause, or whose evidence
-    now says otherwise, is shown as such, never hidden."""
+def ratio_text(c):
+    """ours / paper of one claim, short: one ratio per axis the paper states ('x 0.34x, heading
+    0.23x'), or the claim's ratio, or our figures; '-' when nothing was measured."""
+    if c is None:
+        return "-"
+    rs = [(ch["label"], ch["ratio"]) for ch in c["checks"] if ch["ratio"] is not None]
+    if rs:
+        return ", ".join(f"{re.sub(r'^mean ', '', l)} {fnum(r, 2)}x" for l, r in rs)
+    if c["ratio"] is not None and c["ours"] is not None and isinstance(c["published"], (int, float)):
+        return f"{fnum(c['ours'], 2)} / {fnum(c['published'], 2)} = {fnum(c['ratio'], 2)}x"
+    if c["checks"]:
+        return "; ".join(f"{ch['label']}: {fnum(ch['ours'], 3)}" for ch in c["checks"] if ch["ours"] is not None) or "-"
+    return fnum(c["ours"], 3) if c["ours"] is not None else "-"
+
+
+def per_profile(values):
+    """One text where both profiles agree, else 'robot: a; field_robot: b' ({profile: text})."""
+    texts = [v for v in values.values() if v]
+    if len(set(texts)) <= 1:
+        return texts[0] if texts else "-"
+    return "; ".join(f"{p}: {v}" for p, v in values.items() if v)
+
+
+def causes_section(rep, claims, field_claims, causes):
+    """Why each claim that does not hold does not, as one table: a row per claim with its verdict
+    per profile, ours / paper, and the cause in one sentence (results/reference/causes.json: written
+    once where it holds for both profiles), whether its evidence, read from these results, bears it
+    out; the full argument and the evidence collapsed below. A verdict without a cause, or whose
+    evidence now says otherwise, is shown as such, never hidden."""
     if not causes:
         return
     rep.heading("Why a claim does not hold", 3, "causes")
-    rep.para(causes_totals(causes) + ". Each cause is an argument resting on measurements: the evidence below is read from the "
-             "results this report was made from, and the cause counts as explained only when every item is measured and inside the "
-             "range the argument needs (written next to the claim in results/reference/papers.json). No model was tuned to turn a verdict.")
+    rep.para(causes_totals(causes) + ". A cause counts as explained only when every measurement it rests on is in these results and "
+             "inside the range the argument needs (written next to the claim in results/reference/causes.json); the measurements are "
+             "collapsed under the table. No model was tuned to turn a verdict.")
+    by_claim = {}
+    for k in causes:
+        by_claim.setdefault(k["id"], {})[k["profile"]] = k
+    profiles = ["robot"] + (["field_robot"] if field_claims else [])
+    header = ["claim", "paper"] + [f"verdict: {p}" for p in profiles] + ["ours / paper", "cause", "cause borne out by these results"]
     rows, classes = [], []
-    for c in causes:
-        ev = "; ".join(C.evidence_text(e) for e in c["evidence"]) or "-"
-        rows.append([c["paper"], c["id"], c["profile"], c["verdict"], c["text"] or "-", ev, c["status"], c["doc"] or "-"])
-        classes.append("" if c["status"] == C.EXPLAINED else "outlier")
-    rep.table(["paper", "claim", "profile", "verdict", "cause", "evidence (measured in these results)", "status", "details"], rows,
-              "Claims whose verdict is not 'holds', per profile.", classes)
+    for c in claims:
+        ks = by_claim.get(c["id"])
+        if not ks:
+            continue
+        judged = {"robot": c}
+        if field_claims and c["uses_runs"]:
+            judged["field_robot"] = field_claims[c["id"]]
+        verdicts = [C.verdict_text(judged[p]) if p in judged else "same as robot (experiment)" for p in profiles]
+        ratio = per_profile({p: ratio_text(judged[p]) for p in judged if judged[p]["verdict"] not in ("not run", "n/a")})
+        cause = per_profile({p: k["summary"] or "no cause recorded" for p, k in ks.items()})
+        status = per_profile({p: k["status"] for p, k in ks.items()})
+        rows.append([C.claim_label(c["id"]), C.cite_field(c["paper"])] + verdicts + [ratio, cause, status])
+        classes.append("" if all(k["status"] == C.EXPLAINED for k in ks.values()) else "outlier")
+    rep.table(header, rows, "Claims whose verdict is not 'holds': one row per claim, its verdict under each noise profile.", classes)
+    rep.details("The argument behind each cause and the measurements it rests on")
+    for c in claims:
+        ks = by_claim.get(c["id"])
+        if not ks:
+            continue
+        texts = {p: k["text"] for p, k in ks.items() if k["text"]}
+        docs = sorted({k["doc"] for k in ks.values() if k["doc"]})
+        argument = per_profile(texts) if texts else "No cause recorded."
+        rep.para(f"**{C.claim_label(c['id'])}** ({C.cite_field(c['paper'])}). {argument}" + (f" Details: {', '.join(docs)}." if docs else ""))
+        ev = [[p, C.evidence_text(e)] for p, k in ks.items() for e in k["evidence"]]
+        if ev:
+            rep.table(["profile", "measured in these results (and the range the argument needs)"], ev)
+    rep.end_details()
+
+
+# The claim the headline names as the main gap: the first of these that does not hold, else the
+# first accuracy claim that does not.
+MAIN_GAP = ("tracking_accuracy", "occlusion_mild", "mcl_alone", "lighting_autoadjust", "kidnap_002", "kidnap_000")
+
+
+def error_ratios(papers, runs):
+    """Ours / paper over the published error-table rows these runs reproduce (each set of runs
+    once): (median over mean x and mean y, median over mean heading, rows)."""
+    pos, head, seen = [], [], set()
+    keys = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
+    for table in ("002_table1_occlusion", "002_table2_lighting", "000_tracking"):
+        for p in C.pair_table(papers, table, runs, include_extra=False):
+            ident = tuple(sorted(str(r.folder) for r in p["runs"]))
+            if not p["runs"] or not p["published"] or ident in seen:
+                continue
+            seen.add(ident)
+            pub = dict(zip(keys, p["published"]))
+            for m, bucket in (("x_cm/mean", pos), ("y_cm/mean", pos), ("theta_rad/mean", head)):
+                v = p["stats"][m]["mean"]
+                if v is not None and pub.get(m):
+                    bucket.append(v / pub[m])
+    med = lambda v: statistics.median(v) if v else None
+    return med(pos), med(head), len(seen)
+
+
+def lower_first(label):
+    return label if label[:2].isupper() or not label[:1].isalpha() else label[0].lower() + label[1:]
+
+
+def headline(rep, ctx, claims, field_claims, causes):
+    """Two or three sentences a researcher can quote, first after the title, all computed from the
+    results: what reproduces and what does not, how our error compares with the papers', and the
+    main gap with its measured cause."""
+    judged = [c for c in claims if c["verdict"] in ("holds", "partly", "does not")]
+    names = lambda cs: ", ".join(lower_first(C.claim_label(c["id"])) for c in cs)
+    parts = []
+    if not judged:
+        parts.append(f"None of the {len(claims)} published claims can be judged from these results: each needs runs or experiments "
+                     "that are not among them (the scorecard names the command for each).")
+    else:
+        by = {v: [c for c in judged if c["verdict"] == v] for v in ("holds", "partly", "does not")}
+        verb = {"holds": ("holds", "hold"), "partly": ("holds partly", "hold partly"), "does not": ("does not", "do not")}
+        said = [f"{len(by[v])} {verb[v][len(by[v]) != 1]} ({names(by[v])})" for v in ("holds", "partly", "does not") if by[v]]
+        rest = len(claims) - len(judged)
+        s = (f"Of the {len(judged)} published claims these results judge (robot profile), " + (", ".join(said[:-1]) + " and " if len(said) > 1 else "")
+             + said[-1] + (f"; {rest} more need runs or experiments not included here" if rest else "") + ".")
+        if field_claims:
+            fj = [f for f in field_claims.values() if f["verdict"] in ("holds", "partly", "does not")]
+            if fj:
+                cnt = {v: sum(f["verdict"] == v for f in fj) for v in ("holds", "partly", "does not")}
+                s += (f" Under the field_robot profile (the camera blurred, defocused and tilted, its mirror decentred) {cnt['holds']} of "
+                      f"{len(fj)} hold, {cnt['partly']} partly, {cnt['does not']} do not.")
+        parts.append(s)
+    pos, head, n = error_ratios(ctx.papers, ctx.runs)
+    if pos is not None and head is not None:
+        s = (f"Our simulated tracking error is about {fnum(pos, 2)}x the papers' in position and {fnum(head, 2)}x in heading "
+             f"(median of ours / paper over the {n} published error-table row{'s' if n != 1 else ''} we ran, robot profile")
+        field = field_robot_runs(ctx.runs)
+        if field:
+            with R.pairing_profile("field_robot"):
+                fp, fh, fn = error_ratios(ctx.papers, field)
+            if fp is not None and fh is not None:
+                s += f"; field_robot: {fnum(fp, 2)}x and {fnum(fh, 2)}x over {fn} row{'s' if fn != 1 else ''}"
+        parts.append(s + ").")
+    failing = {c["id"]: c for c in judged if c["verdict"] != "holds"}
+    gap = next((failing[i] for i in MAIN_GAP if i in failing), None) or next((c for c in judged if c["verdict"] != "holds" and c["kind"] == "accuracy"), None)
+    if gap:
+        k = next((k for k in causes if k["id"] == gap["id"] and k["profile"] == "robot"), None)
+        s = f"The main gap is {lower_first(C.claim_label(gap['id']))} ({gap['verdict']}; ours / paper: {ratio_text(gap)}). "
+        if k and k["summary"]:
+            measured = next((e for e in k["evidence"] if e["value"] is not None), None)
+            s += "Cause: " + k["summary"].rstrip(".") + "." + (f" Measured here: {C.evidence_text(measured)}." if measured else "")
+            if k["status"] != C.EXPLAINED:
+                s += f" (Cause status: {k['status']}.)"
+        else:
+            s += "no cause is recorded for it yet."
+        parts.append(s)
+    elif judged:
+        parts.append("Every claim these results judge holds.")
+    rep.para("**In short.** " + " ".join(parts), "headline", "headline")
 
 
 # ---- few seeds: every seed's value, intervals that say their method, outliers with their cause ----
@@ -565,12 +745,9 @@ def seed_values_text(sel, values, flagged, digits):
 
 
 def interval_text(st, digits):
-    """'mean [lo, hi]' with the method, 'n = 1' marked, for one metric over seeds."""
-    if st["n"] == 0:
-        return "-"
-    if st["n"] == 1:
-        return f"{fnum(st['mean'], digits)} (n = 1: one seed, no interval)"
-    return f"{fnum(st['mean'], digits)} [{fnum(st['lo'], digits)}, {fnum(st['hi'], digits)}]"
+    """One metric over seeds as every tool prints it (R.interval_text: t95 for n >= 5, the seeds'
+    range below, n = 1 marked)."""
+    return R.interval_text(st, digits)
 
 
 def flag_outliers(sel, metric="x_cm/mean", phase="tracking"):
@@ -617,10 +794,34 @@ def outlier_cause(run, wrong_m=0.5):
             return (f"converged to a wrong pose at t = {sure[0][0]:.1f} s: {typical}, mode '{sure[0][2]}' in {share:.0f} % of the frames "
                     f"{since} to the end; " + (f"never within {wrong_m} m" if k == 0 else f"not within {wrong_m} m again"))
         return f"lost {since}: {typical}, no confident estimate (mode '{stretch[-1][2]}') to the end"
-    worst = max(err, key=lambda x: -1 if math.isnan(x[1]) else x[1])
-    before = [e for e in events if e["t"] <= worst[0]]
-    return (f"error peaked at {fnum(worst[1], 2)} m at t = {worst[0]:.1f} s"
-            + (f" after the {before[-1]['type']} at t = {before[-1]['t']:.1f} s" if before else "") + f", below {wrong_m} m at the end")
+    # Right at the end: what made the seed's mean large is the time it spent on a wrong pose, not a
+    # momentary "peak" (a seed 8.8 m off for 37 s of 60 is a failure of 37 s): say how long, when and how far.
+    times = [t for t, _, _ in err]
+    steps = [b - a for a, b in zip(times, times[1:])]
+    dt = statistics.median(steps) if steps else 0.0
+    dur = lambda k: (times[k + 1] - times[k]) if k + 1 < len(times) else dt  # a frame lasts to the next one
+    total = times[-1] - times[0] + dt
+    wrong = [k for k, (_, e, _) in enumerate(err) if not math.isnan(e) and e > wrong_m]
+    if not wrong:
+        worst = max(err, key=lambda x: -1 if math.isnan(x[1]) else x[1])
+        return f"never on a wrong pose (> {wrong_m} m off): at most {fnum(worst[1], 2)} m at t = {worst[0]:.1f} s"
+    # The longest stretch of consecutive wrong frames: from its first frame to the next right one.
+    stretches, cur = [], [wrong[0]]
+    for k in wrong[1:]:
+        if k == cur[-1] + 1:
+            cur.append(k)
+        else:
+            stretches.append(cur)
+            cur = [k]
+    stretches.append(cur)
+    longest = max(stretches, key=lambda st: sum(dur(k) for k in st))
+    a, b = times[longest[0]], times[longest[-1]] + dur(longest[-1])
+    before = [e for e in events if e["t"] <= a + 0.5]
+    off = statistics.median(err[k][1] for k in longest)
+    return (f"on a wrong pose (> {wrong_m} m off) for {sum(dur(k) for k in wrong):.1f} s of {total:.1f} s"
+            + (", longest" if len(stretches) > 1 else ",") + f" from t = {a:.1f} to {b:.1f} s"
+            + (f" (after the {before[-1]['type']} at t = {before[-1]['t']:.1f} s)" if before else "")
+            + f", {fnum(off, 2)} m off (median); within {wrong_m} m at the end")
 
 
 def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
@@ -628,6 +829,7 @@ def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
     with its method, and the outlying seeds with their cause. rows_runs: [(label, runs sorted by
     seed)]. Returns the outlying runs, which the caller plots."""
     rows, classes, flagged_runs, methods = [], [], [], set()
+    rep.__dict__.setdefault("seeded", set()).update(r.folder for _, sel in rows_runs for r in sel)  # shown once (report_sweep)
     for label, sel in rows_runs:
         if not sel:
             continue
@@ -650,9 +852,8 @@ def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
         return []
     header = ["row", "n"] + [name for _, name, _ in SEED_METRICS]
     rep.table(header + ["outlying seeds and cause"], rows,
-              "Every seed beside the mean: mean [95 % interval of the mean]; median; each seed's value. The interval: "
-              + ("bootstrap percentile (exact over all resamples for n <= 6; it stays within the seeds' range and never below zero)" if R.BOOTSTRAP in methods
-                 else "none (n = 1)") + "; n = 1 is marked and has no interval. A seed is flagged as an outlier when its mean x error lies above 3x "
+              "Every seed beside the mean: mean with its interval; median; each seed's value. The "
+              + R.INTERVAL_RULE_TEXT + ". A seed is flagged as an outlier when its mean x error lies above 3x "
               "the median of the other seeds and further from it than 3x their range; its cause is read from its frames.csv and events.jsonl."
               + caption_extra, classes)
     return flagged_runs
@@ -721,8 +922,8 @@ def command(cmd):
 
 def error_table(rep, papers, table, runs):
     t = papers[table]
-    rep.heading(f"{t.get('source', table)}", 3, table)
-    rep.para(f"papers.json key: {table}. Ours: mean over seeds of each run's statistic (robot 0), with n; "
+    rep.heading(C.table_label(table) + profile_suffix(), 3, table)
+    rep.para(f"Published: {t.get('source', table)} (results/reference/papers.json); th: heading. Ours: mean over seeds of each run's statistic (robot 0), with n; "
              "runs with kidnaps or covers use their tracking phase (see docs/results.md). Paper rows in italics, then ours / paper.")
     header = ["row", "source"] + R.TABLE_COLS + ["line points / frame", "seeds"]
     rows, classes = [], []
@@ -763,8 +964,14 @@ def error_table(rep, papers, table, runs):
         plot_run(rep, run, f"outlying seed: {run_title(run)}: {outlier_cause(run)}")
 
 
+def profile_suffix():
+    """' (field_robot profile)' in a heading of a table paired under another profile than the
+    scenarios' own: each section heading once in the report."""
+    return "" if R.DEFAULT_PROFILE == R.SCENARIO_DEFAULT_PROFILE else f" ({R.DEFAULT_PROFILE} profile)"
+
+
 def kidnap_table(rep, papers, runs):
-    rep.heading("Kidnap recovery (papers 002 and 000)", 3, "kidnapping")
+    rep.heading("Kidnap recovery (papers 002 and 000)" + profile_suffix(), 3, "kidnapping")
     rows, classes = [], []
     for table in ("002_kidnapping", "000_kidnapping"):
         t = papers[table]
@@ -780,13 +987,13 @@ def kidnap_table(rep, papers, runs):
                 allf = R.stats([r.metric("x_cm/mean", "all") for r in sel])
                 per_seed = ", ".join(f"s{r.seed}\u00a0{r.metric('recovery/recovered', 'all') or 0:.0f}/{r.metric('recovery/episodes', 'all') or 0:.0f}"
                                      f"\u00a0{fnum(r.metric('x_cm/mean', 'tracking'), 2)}" for r in sel)
-                rows.append([f"{table}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}", fnum(med["mean"], 2), fnum(after["mean"], 2),
+                rows.append([f"{C.table_label(table)}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}", fnum(med["mean"], 2), fnum(after["mean"], 2),
                              fnum(phase["mean"], 2), fnum(allf["mean"], 1), per_seed, len(sel)])
                 classes.append("")
             else:
-                rows.append([f"{table}: {label}", "not run", "-", "-", "-", "-", "-", "-", "-", 0])
+                rows.append([f"{C.table_label(table)}: {label}", "not run", "-", "-", "-", "-", "-", "-", "-", 0])
                 classes.append("missing")
-            rows.append([f"{table}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-", "-"])
+            rows.append([f"{C.table_label(table)}: {label}", "paper", f"{t['recovered']} / {t['kidnaps']}", "-", "-", "-", "-", "-", "-", "-"])
             classes.append("paper")
     rep.table(["case", "source", "recovered / kidnaps", "false recoveries", "median recovery s", "after recovery: mean x cm",
                "tracking phase: mean x cm", "all frames: mean x cm", "per seed: recovered, tracking-phase mean x cm", "seeds"], rows,
@@ -801,9 +1008,9 @@ def timing_table(rep, papers, runs):
     for row, key in t["reproduced_by"]["rows"].items():
         med, frames, sel = C.timing_ms(papers, row, runs)
         lo, hi = t[row]
-        rows.append([row, key["what"], fnum(med, 2) if med is not None else "not run", f"{lo}-{hi}", fnum(med / hi, 2) if med is not None else "-", frames])
+        rows.append([C.timing_label(row), key["what"], fnum(med, 2) if med is not None else "not run", f"{lo}-{hi}", fnum(med / hi, 2) if med is not None else "-", frames])
         classes.append("" if med is not None else "missing")
-    rep.table(["papers.json row", "what", "ours: median ms", "paper ms", "ours / paper's upper bound", "frames"], rows,
+    rep.table(["published figure", "what", "ours: median ms", "paper ms", "ours / paper's upper bound", "frames"], rows,
               f"Ours: wall time on {machine_text()}, runs of a sweep share the cores; paper: {t['cpu']}.", classes)
 
 
@@ -828,7 +1035,7 @@ def experiment_tables(rep, papers, ctx):
                 ["paper", fnum(t["equal_weights"], 1), fnum(t["weighted"], 1), fnum(t["weighted"] / t["equal_weights"], 3), "-"],
                 ["ours / paper", fnum(eq / t["equal_weights"], 2), fnum(w / t["weighted"], 2), "", ""]]
         rep.table(["source", "equal weights mm", "1/L weights mm", "1/L / equal", "trials"], rows,
-                  "papers.json key 001_cooperative_mean_error_mm; ours from results/experiments/cooperative_001/cooperative_001.json (headline).",
+                  "Published: results/reference/papers.json; ours from results/experiments/cooperative_001/cooperative_001.json (headline).",
                   ["", "paper", "ratio"])
     g = (j or {}).get("growth_model") or {}
     rep.heading("Paper 001: FBPF vs MFBPF on the growth model", 3, "001_growth_model")
@@ -857,7 +1064,7 @@ def experiment_tables(rep, papers, ctx):
         rep.figure(fig, "robots_vs_error", "paper 001 fig. 10 reproduced: mean ball error against the number of robots (all subsets)")
     else:
         rep.para(f"Not run: {papers['001_simulation_setup']['reproduced_by']['command']}")
-    rep.para("Paper 001's real-robot result (001_real_mean_error_cm: 8.6 -> 4.5 cm) needs real robots and is not reproduced.")
+    rep.para(f"{C.table_label('001_real_mean_error_cm')} (8.6 -> 4.5 cm) needs real robots and is not reproduced.")
 
     # 004 table 1.
     t, j = experiment_section(rep, ctx, "004_table1_cm", "Paper 004 table 1: two-circle and three-point fixes (cm)")
@@ -905,7 +1112,7 @@ def field_robot_tables(rep, papers, runs):
     if not field:
         return
     rep.heading("Published tables under the field_robot profile", 2, "field_robot")
-    rep.para("The same keyed rows from runs under noise_profile field_robot: the robot profile plus defocus, motion blur, tilt "
+    rep.para("The same keyed rows from runs under the field_robot noise profile: the robot profile plus defocus, motion blur, tilt "
              "from acceleration and a 9 px decentred mirror that calibration estimates (docs/camera.md). Compare with the tables "
              "above (robot profile). Nothing here is tuned to the papers' numbers; what moves is reported as measured.")
     with R.pairing_profile("field_robot"):  # the same keys, these runs
@@ -941,7 +1148,7 @@ def error_budget_section(rep, ctx):
         st = R.stats(seeds)
         if max(seeds) - min(seeds) <= 1e-9 * max(1.0, abs(st["mean"])):
             return f"{fnum(st['mean'], 2)} (= every seed)"
-        return f"{fnum(st['mean'], 2)} [{fnum(st['lo'], 2)}, {fnum(st['hi'], 2)}]"
+        return R.interval_text(st, 2)
     table = []
     for src, per in rows_by_source.items():
         line = [src]
@@ -950,7 +1157,7 @@ def error_budget_section(rep, ctx):
             line += [cell(r, "position_rmse_cm"), cell(r, "position_p50_cm"), cell(r, "heading_rmse_deg")]
         table.append(line)
     header = ["source"] + [f"{l} {m}" for l in locs for m in ("RMSE cm", "p50 cm", "heading RMSE deg")]
-    seeds_text = (f"Mean over {j['seeds']} seeds with a 95 % {R.BOOTSTRAP} interval of the mean (n = {j['seeds']}); "
+    seeds_text = (f"Mean over {j['seeds']} seeds; {R.INTERVAL_RULE_TEXT}; "
                   "'= every seed' where every seed gave the same figure (the ideal baseline has no random source for "
                   "matching, so a row that adds a deterministic source is a systematic difference, not noise). ") if j.get("seeds", 1) > 1 else \
                  "One seed (quick mode): no interval; `omniloc experiment error_budget` runs three. "
@@ -997,7 +1204,7 @@ def reference_error_text(rep, rows_by_source, ctx):
                f"against the papers' {pub_x} cm and {fnum(math.degrees(pub_th), 2)} deg; in quadrature (Gaussian errors, sigma = mean x sqrt(pi/2)) "
                f"the difference needs a reference that wanders by about {fnum(wx, 1)} cm and yaws by about {fnum(wt, 1)} deg per axis. "
                "Those are the magnitudes of a person pushing a 0.5 m robot along a painted line (argued, not measured: no real robot here).")
-    rep.para("**Which real-robot error is missing** (issue 29). The papers scored a robot pushed by hand along straight tracks against "
+    rep.para("**Which real-robot error is missing.** The papers scored a robot pushed by hand along straight tracks against "
              "those tracks (paper 002 sec. 6), so their reference itself errs; ours is exact. The papers' table has "
              f"{fnum(math.degrees(pub_th) / pub_x, 2)} deg of heading error per cm of position error; the most any row above gives with "
              f"matching is {fnum(top, 2)} deg/cm (`{top_src}`). Every simulated source moves heading and position together, so none of them, "
@@ -1011,8 +1218,9 @@ def published_tables(rep, papers, ctx):
         error_table(rep, papers, table, ctx.runs)
     kidnap_table(rep, papers, ctx.runs)
     timing_table(rep, papers, ctx.runs)
-    rep.para(f"mcl_only_mean_position_error_cm: MCL-only teams' {papers['mcl_only_mean_position_error_cm']} cm, beside our MCL-alone row of the "
-             "000_tracking table above and the scorecard's mcl_alone claim.")
+    lo, hi = papers["mcl_only_mean_position_error_cm"]
+    rep.para(f"{C.table_label('mcl_only_mean_position_error_cm')}: {lo}-{hi} cm, beside our MCL-alone row of the "
+             f"{C.table_label('000_tracking')} above and the scorecard's claim \"{C.claim_label('mcl_alone')}\".")
     experiment_tables(rep, papers, ctx)
 
 
@@ -1119,10 +1327,17 @@ def plot_run(rep, run, title):
                + (" (shaded: carried, blind or recovering, left out of the tracking phase)" if any("tracking_phase" in r for r in run.summary.get("robots", [])) else ""))
 
 
+def params_text(params):
+    """A sweep's parameters of a run ('occlusion={"fraction":0.5}') as code: configuration keys are
+    what a reader writes in a sweep file, not prose."""
+    return f"`{params}`" if params and params != "default" else (params or "")
+
+
 def run_title(run, params=None):
     s = run.summary
-    parts = [s["scenario"], s["localizer"]] + ([params] if params and params != "default" else []) + [f"seed {s['seed']}"]
-    return " / ".join(str(p) for p in parts)
+    parts = [s["scenario"], s["localizer"]] + ([params_text(params)] if params and params != "default" else []) + [f"seed {s['seed']}"]
+    prof = profile_of(run)
+    return " / ".join(str(p) for p in parts) + (f" ({prof} profile)" if prof != R.SCENARIO_DEFAULT_PROFILE else "")
 
 
 # Position error statistics of a run's table (summary.json position_m): the mean is the typical
@@ -1202,7 +1417,7 @@ def report_sweep(rep, sweep, all_runs, max_runs):
         n = m.get("r0/x_cm/mean", {}).get("n", 0)
         given = g.get("start_pose_given")
         task = " (given the start pose)" if mark and given is True else " (start pose: mixed)" if given == "mixed" else ""
-        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')}{task} / {g.get('params', '')}" + (" (tracking phase)" if phase else "")] +
+        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')}{task} / {params_text(g.get('params', ''))}" + (" (tracking phase)" if phase else "")] +
                     [fnum(val(a, s), 3) for a, s in R.TABLE_KEYS] + [fnum(val("position_m", "mean"), 3), fnum(val("position_m", "rmse"), 3)] +
                     [f"{g.get('finished', '-')}/{g.get('failed', 0)}", n])
     rep.table(["group"] + R.TABLE_COLS + ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
@@ -1211,8 +1426,16 @@ def report_sweep(rep, sweep, all_runs, max_runs):
     groups = {}
     for run, params, name in runs:
         groups.setdefault((run.scenario, name, params), []).append(run)
-    rows_runs = [(" / ".join(str(x) for x in k), sorted(v, key=lambda r: r.seed)) for k, v in groups.items()]
-    flagged = seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json keeps Student-t intervals for scripts; this report recomputes them from the runs.")
+    rows_runs = [(f"{k[0]} / {k[1]} / {params_text(k[2])}", sorted(v, key=lambda r: r.seed)) for k, v in groups.items()]
+    # Groups whose every seed a published table above already showed are not shown again.
+    seeded = rep.__dict__.get("seeded", set())
+    shown = [k for k, (_, sel) in enumerate(rows_runs) if sel and all(r.folder in seeded for r in sel)]
+    if shown:
+        rep.para(f"{len(shown)} of this sweep's {len(rows_runs)} groups have every seed in a published table above (with their outlying seeds); "
+                 "they are not repeated here.")
+    shown_flagged = [r for k in shown for r in flag_outliers(rows_runs[k][1])]
+    rows_runs = [rr for k, rr in enumerate(rows_runs) if k not in shown]
+    flagged = shown_flagged + seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json and aggregate.csv hold the same intervals by the same rule (column interval: t95 or range).")
     # Per run: its tables always; plots for the first seed of each group (every condition shown
     # once, at most max_runs) and for every outlying seed, collapsed: a reader opens what they need.
     rep.details(f"Runs of sweep {name}: {len(runs)} runs, tables and plots")
@@ -1244,53 +1467,66 @@ def tracking_errors(run):
 
 
 def cdf_and_timing(rep, runs):
-    errs, timing = {}, {}
+    """Error CDF and timing per localizer AND noise profile (issue 38): frames of robot and
+    field_robot runs are never pooled into one curve, row or bar; every row names its profile and
+    how many runs its frames come from."""
+    errs, timing, nruns = {}, {}, {}
     for run in runs:
-        loc = run.localizer
-        errs.setdefault(loc, []).extend(tracking_errors(run))
+        key = (run.localizer, profile_of(run))  # (localizer, noise profile)
+        nruns[key] = nruns.get(key, 0) + 1
+        errs.setdefault(key, []).extend(tracking_errors(run))
         for r in run.timing():
-            d = timing.setdefault(loc, {"render_ms": [], "vision_ms": [], "localize_ms": [], "compute_ms": []})
+            d = timing.setdefault(key, {"render_ms": [], "vision_ms": [], "localize_ms": [], "compute_ms": []})
             for k in d:
                 if r.get(k) not in (None, ""):  # compute_ms: only an external client that reports its own time
                     d[k].append(float(r[k]))
     errs = {k: v for k, v in errs.items() if v}
+    profiles = sorted({p for _, p in list(errs) + list(timing)})
+    name = lambda key: f"{key[0]} ({key[1]} profile)"
+    runs_text = lambda key: f"{nruns[key]} run{'s' if nruns[key] != 1 else ''}"
+    apart = (f"Per localizer and noise profile ({', '.join(profiles)}): runs of different profiles are never pooled." if len(profiles) > 1
+             else f"All runs here are of the {profiles[0]} profile." if profiles else "")
     if errs:
-        rep.heading("Error CDF per localizer (tracking phase)", 2)
+        rep.heading("Error CDF per localizer and noise profile (tracking phase)", 2)
         fig, ax = plt.subplots(figsize=(7, 4))
-        for loc, e in sorted(errs.items()):
+        styles = {p: s for p, s in zip(profiles, ["-", "--", ":", "-."] * 4)}
+        for key, e in sorted(errs.items()):
             e = sorted(max(x, 1e-4) for x in e)
-            ax.plot(e, [(i + 1) / len(e) for i in range(len(e))], label=f"{loc} ({len(e)} frames)")
+            ax.plot(e, [(i + 1) / len(e) for i in range(len(e))], styles[key[1]], label=f"{name(key)}: {len(e)} frames, {runs_text(key)}")
         log_axis(ax.xaxis, ax, "x")
         ax.set_ylim(0, 1)
         ax.set_xlabel("position error (m, log scale)")
         ax.set_ylabel("fraction of valid frames")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-        rep.figure(fig, "cdf", "position error CDF over the reported runs' tracking phases (carried periods and recoveries left out), per localizer")
-        rep.table(["localizer", "frames", "median m", "p90 m", "p99 m"],
-                  [[loc, len(e), fnum(statistics.median(e), 4), fnum(sorted(e)[int(0.9 * (len(e) - 1))], 4), fnum(sorted(e)[int(0.99 * (len(e) - 1))], 4)]
-                   for loc, e in sorted(errs.items())])
+        rep.figure(fig, "cdf", "position error CDF over the reported runs' tracking phases (carried periods and recoveries left out), "
+                   "one curve per localizer and noise profile (line style: profile). " + apart)
+        rep.table(["localizer", "profile", "runs", "frames", "median m", "p90 m", "p99 m"],
+                  [[key[0], key[1], nruns[key], len(e), fnum(statistics.median(e), 4), fnum(sorted(e)[int(0.9 * (len(e) - 1))], 4),
+                    fnum(sorted(e)[int(0.99 * (len(e) - 1))], 4)] for key, e in sorted(errs.items())],
+                  "valid tracking-phase frames pooled over the localizer's runs (seeds and scenarios) under that one profile. " + apart)
     if timing:
-        rep.heading("Timing per stage", 2)
+        rep.heading("Timing per stage, per localizer and noise profile", 2)
         rows = []
-        for loc, d in sorted(timing.items()):
-            rows.append([loc] + [fnum(statistics.median(v), 3) if v else "-" for v in d.values()] + [len(d["render_ms"])])
-        rep.table(["localizer", "render ms (median)", "vision ms", "localize ms", "client's own ms", "frames"], rows,
-                  f"wall time per frame on {machine_text()}; runs in a sweep share the cores. "
+        for key, d in sorted(timing.items()):
+            rows.append([key[0], key[1], nruns[key]] + [fnum(statistics.median(v), 3) if v else "-" for v in d.values()] + [len(d["render_ms"])])
+        rep.table(["localizer", "profile", "runs", "render ms (median)", "vision ms", "localize ms", "client's own ms", "frames"], rows,
+                  f"wall time per frame on {machine_text()}; runs in a sweep share the cores. " + apart + " "
                   "For an external localizer (docs/protocol.md) 'localize' is the protocol's round trip: frame sent to estimate read, "
                   "the client's own computation included; 'client's own ms' is the time the client reported for its computation "
                   "(estimate.compute_ms; '-' where it reports none, and for the built-in localizers, whose 'localize' is their computation)")
-        fig, ax = plt.subplots(figsize=(7, 3.5))
-        locs = sorted(timing)
-        bottom = [0.0] * len(locs)
+        fig, ax = plt.subplots(figsize=(max(7, 1.2 * len(timing)), 3.5))
+        keys = sorted(timing)
+        labels = [f"{l}\n{p}" for l, p in keys]
+        bottom = [0.0] * len(keys)
         for k in ["render_ms", "vision_ms", "localize_ms"]:
-            vals = [statistics.median(timing[l][k]) if timing[l][k] else 0 for l in locs]
-            ax.bar(locs, vals, bottom=bottom, label=k.replace("_ms", ""))
+            vals = [statistics.median(timing[key][k]) if timing[key][k] else 0 for key in keys]
+            ax.bar(labels, vals, bottom=bottom, label=k.replace("_ms", ""))
             bottom = [b + v for b, v in zip(bottom, vals)]
         ax.set_ylim(bottom=0)
         ax.set_ylabel("ms per frame (median)")
         ax.legend(fontsize=8)
-        rep.figure(fig, "timing", "median time per frame and stage")
+        rep.figure(fig, "timing", "median time per frame and stage, per localizer and noise profile (under each bar)")
 
 
 def load_jsonl(path):
@@ -1370,17 +1606,66 @@ SHOWN_ELSEWHERE = {
 }
 
 
+def identical_maps(exp):
+    """{solver: [solvers whose error map is the same cell for cell]} from an experiment's
+    maps_004.csv (landmark_maps: the exact solvers are one estimator, so their heat maps are one
+    picture under different titles). Empty without the file."""
+    rows = R.read_csv(exp / "maps_004.csv") if (exp / "maps_004.csv").exists() else []
+    cols = [k[:-len("_mean_err_cm")] for k in (rows[0] if rows else {}) if k.endswith("_mean_err_cm")]
+    groups = {}
+    for s in cols:
+        try:
+            vals = tuple(round(float(r[f"{s}_mean_err_cm"]), 3) if r[f"{s}_mean_err_cm"] != "nan" else None for r in rows)
+        except ValueError:
+            continue
+        groups.setdefault(vals, []).append(s)
+    return {g[0]: g for g in groups.values()}
+
+
+def shown_elsewhere(exp):
+    """SHOWN_ELSEWHERE, and for landmark_maps the noise level of paper 004's table 1 that the
+    published-table section shows from table1_004.json."""
+    skip = list(SHOWN_ELSEWHERE.get(exp.name, ()))
+    f = exp / "table1_004.json"
+    if f.exists():
+        try:
+            sigma = json.loads(f.read_text())["tables"][0]["bearing_sigma_deg"]
+            skip.append((f"Bearing noise N(0, {sigma:.1f} deg)", "004_table1_cm"))
+        except (ValueError, KeyError, IndexError, TypeError):
+            pass
+    return skip
+
+
 def report_experiment(rep, exp):
     rep.heading(f"Experiment {exp.name}", 2)
     pngs = sorted(exp.glob("*.png"), key=picture_order)
+    same = identical_maps(exp)
+    hidden = {f"map_{s}.png" for g in same.values() for s in g[1:]}
     for png in pngs:
-        rep.image(png, f"{exp.name}: {png.stem}")
+        if png.name in hidden:
+            continue
+        twins = next((g for g in same.values() if png.name == f"map_{g[0]}.png"), [])
+        rep.image(png, f"{exp.name}: `{png.name}`" + (
+            f"; the maps of {', '.join(f'`{s}`' for s in twins[1:])} are identical to it, cell for cell (maps_004.csv), and are not shown"
+            if len(twins) > 1 else ""))
     mds = sorted(exp.glob("*.md"))
     if mds:  # the experiment's own notes and tables, long: collapsed
         rep.details(f"{exp.name}: the experiment's notes and tables ({', '.join(m.name for m in mds)})")
+        rep.raw_html("<div class='quoted'>")  # the experiment's own output, quoted as it wrote it
         for md in mds:
-            rep.markdown(md.read_text(), skip=SHOWN_ELSEWHERE.get(exp.name, ()))
+            rep.markdown(md.read_text(), skip=shown_elsewhere(exp))
+        rep.raw_html("</div>")
         rep.end_details()
+
+
+def bibliography(rep):
+    """The five papers, numbered as the report cites them ('Lu et al. 2013 [3]')."""
+    rep.heading("References", 2, "references")
+    items = []
+    for k, b in enumerate(C.BIBLIOGRAPHY):
+        items.append(f"[{k + 1}] {b['authors']}. {b['title']}. {b['venue']}, {b['year']}. {b['note']}")
+    rep.raw_html("<ol id='bibliography'>" + "".join(f"<li id='ref-{k + 1}'>{html.escape(t.split('] ', 1)[1])}</li>" for k, t in enumerate(items))
+                 + "</ol>", "\n".join(f"{t}  " for t in items))
 
 
 def main():
@@ -1400,12 +1685,14 @@ def main():
     rep = Report(a.out, a.title)
     for x in a.results + (a.baseline or []):
         rep.add_root(x)
+    ctx = C.Context(papers, runs, experiments)
+    judged = judge_claims(ctx)
+    headline(rep, ctx, *judged)  # first after the title: what a researcher quotes
     rep.para(f"{len(sweeps)} sweep(s), {len(runs)} run(s), {len(experiments)} experiment(s). Published numbers: results/reference/papers.json; "
              f"everything else is read from the result files. The scorecard comes first, then the contents; details follow.")
     for d in R.INCOMPLETE:
         rep.para(f"**Incomplete sweep** (--accept-incomplete): {pathlib.Path(d).name} has no final aggregate; only its finished runs are reported.")
-    ctx = C.Context(papers, runs, experiments)
-    _, _, totals = scorecard(rep, ctx)
+    _, _, totals = scorecard(rep, ctx, judged)
     rep.mark_toc()
     provenance(rep, runs, sweeps)
     published_tables(rep, papers, ctx)
@@ -1443,6 +1730,7 @@ def main():
             rep.raw_html("<p>Instruction counts and benchmark times over the commits (not results of the papers' experiments): "
                          "<a href='history.html'>history.html</a> beside this report.</p>",
                          "Instruction counts and benchmark times over the commits: [history.md](history.md) beside this report.")
+    bibliography(rep)
     rep.write()
     html_path = rep.out / "report.html"
     print(f"scorecard: {totals}")

@@ -210,29 +210,70 @@ class Statistics(unittest.TestCase):
 
     def test_intervals_only_with_two_values(self):
         self.assertIsNone(R.stats([4.75])["lo"])
-        self.assertEqual(R.fstat(R.stats([4.75])), "4.750 (n = 1: no interval)")
-        s = R.stats([1.0, 2.0, 3.0, 4.0], method=R.STUDENT_T)
-        self.assertAlmostEqual(s["hi"] - s["mean"], 2.05426, places=4)  # t(3) = 3.18245 exactly
-        self.assertEqual(R.stats([-1.0, 2.0])["method"], R.STUDENT_T)  # signed values: Student t
+        self.assertEqual(R.fstat(R.stats([4.75])), "4.750 (n=1, no interval)")
+        self.assertEqual(R.interval([4.75]), {"n": 1, "mean": 4.75, "lo": 4.75, "hi": 4.75, "kind": R.NO_INTERVAL})
+        self.assertEqual(R.interval([None, float("nan")])["kind"], None)
 
-    def test_bootstrap_interval_of_a_non_negative_error_is_exact_and_never_below_zero(self):
-        # One seed at 806 cm beside two at 3 cm (the issue's MCL row): Student t gives
-        # [-881, 1422]; the exact bootstrap over the 27 resamples: 8 of mean 3, 12 of 270.67, 6 of
-        # 538.33, 1 of 806; percentiles at positions 0.65 and 25.35 of 27 sorted means.
+
+class IntervalRule(unittest.TestCase):
+    """Issue 38, item 4: one interval rule everywhere (docs/results.md "Intervals"), the same as
+    batch/aggregate.cpp's mean_ci95 (tests/sweep_test.cpp Sweep.ConfidenceInterval: same answers)."""
+
+    def test_five_or_more_seeds_get_the_t_interval(self):
+        # 1..5: mean 3, sd 1.58114, t(4) = 2.776445: half width 1.963243.
+        iv = R.interval([1.0, 2.0, 3.0, 4.0, 5.0])
+        self.assertEqual(iv["kind"], R.T95)
+        self.assertAlmostEqual(iv["hi"] - iv["mean"], 1.963243, places=5)
+        self.assertAlmostEqual(iv["mean"] - iv["lo"], 1.963243, places=5)
+        self.assertEqual(R.interval_text(iv), "3.000 [1.037, 4.963] (n=5, t95)")
+        s = R.stats([1.0, 2.0, 3.0, 4.0, 5.0])
+        self.assertEqual((s["lo"], s["hi"], s["method"]), (iv["lo"], iv["hi"], R.T95))
+
+    def test_fewer_than_five_seeds_get_their_range_marked_as_such(self):
+        # One seed at 806 cm beside two at 3 cm (the issue's MCL row): Student t gives [-881, 1422],
+        # the old bootstrap [3.0, 712] (it never leaves the seeds' range and covers the mean ~60 %).
+        iv = R.interval([806.0, 3.0, 3.0])
+        self.assertEqual((iv["lo"], iv["hi"], iv["kind"]), (3.0, 806.0, R.RANGE))
+        self.assertEqual(R.interval_text(iv, 2), "270.67 (seeds' range 3.00 to 806.00, n=3)")
+        self.assertEqual(R.interval([1.0, 2.0, 3.0, 4.0])["kind"], R.RANGE)
+        self.assertEqual(R.interval_text(R.interval([1.0, 2.0, 3.0, 4.0]), 2), "2.50 (seeds' range 1.00 to 4.00, n=4)")
         s = R.stats([806.0, 3.0, 3.0])
-        self.assertEqual(s["method"], R.BOOTSTRAP)
-        self.assertAlmostEqual(s["lo"], 3.0, places=9)
-        self.assertAlmostEqual(s["hi"], 538.0 + 1 / 3 + 0.35 * (806 - 538.0 - 1 / 3), places=6)
-        self.assertAlmostEqual(s["median"], 3.0)
+        self.assertEqual((s["lo"], s["hi"], s["method"], s["median"]), (3.0, 806.0, R.RANGE, 3.0))
         self.assertEqual(s["values"], [806.0, 3.0, 3.0])
-        t = R.stats([806.0, 3.0, 3.0], method=R.STUDENT_T)
-        self.assertLess(t["lo"], 0)  # what the report used to print
         self.assertEqual(R.stats([2.0, 2.0, 2.0])["lo"], 2.0)
-        # Seeds above 6: seeded resampling, the same interval every time, inside the range.
-        v = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
-        a, b = R.stats(v), R.stats(v)
-        self.assertEqual((a["lo"], a["hi"]), (b["lo"], b["hi"]))
-        self.assertTrue(1.0 < a["lo"] < 4.5 < a["hi"] < 8.0)
+
+    def test_a_non_negative_sample_never_gets_a_negative_bound(self):
+        # Unclipped t: mean 2.06 - 5.53 < 0; the clipped bound is 0; a signed sample keeps its t bound.
+        for v in ([0.05, 0.1, 0.1, 0.05, 10.0], [0.0, 0.0, 0.0, 0.0, 7.0], [806.0, 3.0, 3.0], [1e-3, 5.0], [0.0] * 6, [0.1] * 4 + [40.0] * 2):
+            iv = R.interval(v)
+            self.assertGreaterEqual(iv["lo"], 0.0, v)
+            self.assertLessEqual(iv["lo"], iv["mean"], v)
+            self.assertLessEqual(iv["mean"], iv["hi"], v)
+        self.assertEqual(R.interval([0.05, 0.1, 0.1, 0.05, 10.0])["lo"], 0.0)
+        self.assertLess(R.interval([-1.0, 0.05, 0.1, 0.05, 10.0])["lo"], 0.0)
+
+    def test_old_aggregates_still_read(self):
+        # aggregate.json from before the rule: no "interval", an unclipped Student t for every n >= 2.
+        self.assertEqual(R.aggregate_interval({"n": 3, "mean": 1.94, "ci95": [-6.19, 10.07]}), (-6.19, 10.07, "t95 (old aggregate)"))
+        self.assertEqual(R.aggregate_interval({"n": 1, "mean": 1.0, "ci95": [1.0, 1.0]})[2], R.NO_INTERVAL)
+        self.assertEqual(R.aggregate_interval({"n": 3, "mean": 1.0, "ci95": [0.5, 2.0], "interval": "range"}), (0.5, 2.0, R.RANGE))
+
+    def test_check_report_html_flags_negative_bounds_of_non_negative_quantities(self):
+        import check_report_html as H
+        self.assertEqual(H.negative_bounds("mean 1.94 [0.000, 10.07] (n=5, t95); 270.67 (seeds' range 3.00 to 806.00, n=3)"), [])
+        self.assertEqual(H.negative_bounds("rmse 1.94 [-6.19, 10.07] n=3"), ["1.94 [-6.19, 10.07]"])
+        with tempfile.TemporaryDirectory() as tmp:
+            f = pathlib.Path(tmp) / "aggregate.csv"
+            f.write_text("scenario,localizer,params,start_pose_given,metric,n,mean,ci95_low,ci95_high\n"
+                         "tracking,mcl,default,true,r0/position_m/rmse,3,1.94,-6.19,10.07\n"
+                         "tracking,mcl,default,true,r0/heading_bias,3,0.1,-0.2,0.4\n")  # a signed metric may
+            bad = H.negative_bounds("", f)
+            self.assertEqual(len(bad), 1)
+            self.assertIn("r0/position_m/rmse", bad[0])
+
+    def test_the_coverage_table_in_the_docs_names_the_rule(self):
+        text = (ROOT / "docs" / "results.md").read_text()
+        self.assertTrue("## Intervals" in text and "scripts/interval_coverage.py" in text, "docs/results.md has no section Intervals")
 
     def test_outlying_seed(self):
         self.assertEqual(R.outliers([806.0, 3.0, 3.0]), [0])
@@ -322,9 +363,17 @@ class ReportEndToEnd(unittest.TestCase):
             self.assertEqual(out.returncode, 0, out.stderr)
             doc = (pathlib.Path(tmp) / "rep" / "report.html").read_text()
             self.assertIn('id="scorecard"', doc)
+            # Every published table is in the report under its readable label (a section's anchor
+            # may keep the key; the text a reader reads never shows it).
+            import html as H
+            text = H.unescape(re.sub(r"<[^>]+>", " ", doc))
             for k in R.load_papers():
                 if k not in ("comment", "claims"):
-                    self.assertTrue(k in doc, f"{k} is not in the report")
+                    self.assertTrue(C.table_label(k) in text or f'id="{k}"' in doc, f"{k} is not in the report")
+            for key in ("mcl_only_mean_position_error_cm", "001_real_mean_error_cm", "tracking_accuracy", "issue 29"):
+                self.assertNotIn(key, text)
+            self.assertIn('id="headline"', doc)
+            self.assertIn('id="references"', doc)
             self.assertIn("not run", doc)
             self.assertIn("abc123", doc)  # provenance
 
@@ -365,7 +414,25 @@ class FewSeeds(unittest.TestCase):
             fine = pathlib.Path(tmp) / "fine"
             write_run(fine, "tracking", "matching", 1, {}, robot(2.0))
             write_frames(fine, [(0.0, 0.1, True, "tracking"), (1.0, 0.9, True, "tracking"), (2.0, 0.2, True, "tracking")])
-            self.assertEqual(report.outlier_cause(R.Run(fine)), "error peaked at 0.90 m at t = 1.0 s, below 0.5 m at the end")
+            self.assertEqual(report.outlier_cause(R.Run(fine)),
+                             "on a wrong pose (> 0.5 m off) for 1.0 s of 3.0 s, from t = 1.0 to 2.0 s, 0.90 m off (median); within 0.5 m at the end")
+            # Issue 38: a seed 8.8 m off from the start for 37 s of 60, right afterwards, is described by
+            # the time it spent on the wrong pose, never as an error "peak".
+            back = pathlib.Path(tmp) / "back"
+            write_run(back, "tracking", "mcl", 2, {}, robot(300.0))
+            write_frames(back, [(0.5 * k, 8.8 if k < 74 else 0.1, True, "converged") for k in range(120)])
+            cause = report.outlier_cause(R.Run(back))
+            self.assertEqual(cause, "on a wrong pose (> 0.5 m off) for 37.0 s of 60.0 s, from t = 0.0 to 37.0 s, 8.80 m off (median); within 0.5 m at the end")
+            self.assertNotIn("peak", cause)
+            twice = pathlib.Path(tmp) / "twice"
+            write_run(twice, "tracking", "mcl", 3, {}, robot(100.0))
+            write_frames(twice, [(1.0 * k, 2.0 if k in (1, 4, 5) else 0.1, k != 7, "tracking") for k in range(10)])
+            self.assertEqual(report.outlier_cause(R.Run(twice)),
+                             "on a wrong pose (> 0.5 m off) for 3.0 s of 10.0 s, longest from t = 4.0 to 6.0 s, 2.00 m off (median); within 0.5 m at the end")
+            calm = pathlib.Path(tmp) / "calm"
+            write_run(calm, "tracking", "mcl", 4, {}, robot(10.0))
+            write_frames(calm, [(0.0, 0.1, True, "tracking"), (1.0, 0.3, True, "tracking"), (2.0, 0.2, True, "tracking")])
+            self.assertEqual(report.outlier_cause(R.Run(calm)), "never on a wrong pose (> 0.5 m off): at most 0.30 m at t = 1.0 s")
 
     def test_seed_table_shows_every_seed_and_flags_the_outlier(self):
         import report
@@ -379,18 +446,44 @@ class FewSeeds(unittest.TestCase):
             md = (pathlib.Path(tmp) / "out" / "report.md").read_text()
             nb = "\u00a0"
             self.assertIn(f"s1{nb}3.00, s2{nb}806.00{nb}(outlier), s3{nb}3.10", md)
-            # Exact bootstrap over the 27 resamples of (3.0, 806.0, 3.1): the 2.5 % point lies 0.65 of
-            # the way from 3.0 (all three 3.0) to 3.033 (two 3.0, one 3.1); the 97.5 % point 0.35 of
-            # the way from 538.37 (two 806, one 3.1) to 806. Student t would give [-881, 1422].
-            lo, top2 = 3.0 + 0.65 * 0.1 / 3, (2 * 806.0 + 3.1) / 3
-            self.assertIn(f"270.70 [{lo:.2f}, {top2 + 0.35 * (806.0 - top2):.2f}]", md)
+            # Three seeds: no reliable interval, the seeds' range instead (Student t would give [-881, 1422]).
+            self.assertIn("270.70 (seeds' range 3.00 to 806.00, n=3)", md)
             self.assertIn(f"s1{nb}1.00, s2{nb}1.00, s3{nb}1.00", md)  # the flag marks the metric it is about (mean x)
             self.assertIn("s2: converged to a wrong pose at t = 0.5 s", md)
-            self.assertIn("bootstrap percentile", md)
+            self.assertIn("2 to 4 seeds, no reliable interval exists", md)
+            self.assertNotIn("bootstrap", md)
             one = report.Report(pathlib.Path(tmp) / "one", "t")
             report.seed_table(one, [("one seed", runs[:1])])
             one.write()
-            self.assertIn("(n = 1: one seed, no interval)", (pathlib.Path(tmp) / "one" / "report.md").read_text())
+            self.assertIn("(n=1, no interval)", (pathlib.Path(tmp) / "one" / "report.md").read_text())
+
+
+class ProfilesApart(unittest.TestCase):
+    """Issue 38: the error CDF and the timing never pool robot and field_robot runs."""
+
+    def test_cdf_and_timing_are_per_profile(self):
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            for prof, err, ms in (("robot", 0.05, 1.0), ("field_robot", 0.5, 3.0)):
+                for seed in (1, 2):
+                    d = tmp / "runs" / f"{prof}_s{seed}"
+                    write_run(d, "tracking", "matching", seed, {} if prof == "robot" else {"noise_profile": prof}, robot(3.0))
+                    write_frames(d, [(0.1 * k, err, True, "tracking") for k in range(10)])
+                    (d / "timing.csv").write_text("render_ms,vision_ms,localize_ms\n" + "".join(f"{ms},{ms},{ms}\n" for _ in range(10)))
+            runs, _, _ = R.discover([tmp / "runs"])
+            rep = report.Report(tmp / "out", "t")
+            report.cdf_and_timing(rep, runs)
+            rep.write()
+            md = (tmp / "out" / "report.md").read_text()
+            self.assertIn("Error CDF per localizer and noise profile", md)
+            self.assertIn("| matching | robot | 2 | 20 | 0.0500 |", md)
+            self.assertIn("| matching | field_robot | 2 | 20 | 0.5000 |", md)
+            self.assertIn("Timing per stage, per localizer and noise profile", md)
+            self.assertIn("| matching | robot | 2 | 1.000 | 1.000 | 1.000 | - | 20 |", md)
+            self.assertIn("| matching | field_robot | 2 | 3.000 | 3.000 | 3.000 | - | 20 |", md)
+            self.assertIn("runs of different profiles are never pooled", md)
+            self.assertNotIn("| matching | 40 |", md)  # the pooled row of before
 
 
 class ExternalPeers(unittest.TestCase):
@@ -410,7 +503,7 @@ class ExternalPeers(unittest.TestCase):
             md = (tmp / "rep" / "report.md").read_text()
             self.assertIn("| 0 % | external: perl_client | 4.500 |", md)
             # Two seeds: the 4 resamples have means 4, 4.5, 4.5, 5; the 2.5 % point lies 0.075 of the way from 4 to 4.5.
-            self.assertIn("| 0 % (external: perl_client) | 2 | mean 4.50 [4.04, 4.96]; median 4.50; seeds: s1\u00a04.00, s2\u00a05.00 |", md)
+            self.assertIn("| 0 % (external: perl_client) | 2 | mean 4.50 (seeds' range 4.00 to 5.00, n=2); median 4.50; seeds: s1\u00a04.00, s2\u00a05.00 |", md)
             table = subprocess.run([PY, str(ROOT / "scripts/paper_table.py"), str(tmp / "results"), "--paper", "002_table1_occlusion", "--rows", "0 %"],
                                    capture_output=True, text=True).stdout
             self.assertIn("external: perl_client", table)
@@ -438,6 +531,26 @@ class Verdicts(unittest.TestCase):
                              [("mean x", "holds"), ("mean y", "holds"), ("mean heading", "does not")])
             self.assertAlmostEqual(c["checks"][2]["ratio"], 0.15, places=9)
             self.assertEqual(c["verdict"], "partly")
+            self.assertEqual(c["seeds"], 3)
+            self.assertFalse(c["weak"])
+            self.assertEqual(C.verdict_text(c), "partly")
+
+    def test_a_verdict_on_one_seed_is_marked_weak_evidence(self):
+        # Issue 38: a verdict that rests on one seed says so, in the scorecard's verdict column.
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run(pathlib.Path(tmp) / "t1", "tracking", "matching", 1, {}, robot(5.9, 5.9, 0.044))
+            runs, _, _ = R.discover([tmp])
+            c = [c for c in C.evaluate_claims(C.Context(R.load_papers(), runs, [])) if c["id"] == "tracking_accuracy"][0]
+            self.assertEqual((c["verdict"], c["seeds"], c["weak"]), ("holds", 1, True))
+            self.assertEqual(C.verdict_text(c), "holds (1 seed: weak evidence)")
+            occ = [c for c in C.evaluate_claims(C.Context(R.load_papers(), runs, [])) if c["id"] == "occlusion_mild"][0]
+            self.assertEqual(occ["verdict"], "not run")
+            self.assertFalse(occ["weak"])  # nothing judged: nothing to call weak
+            rep = report.Report(pathlib.Path(tmp) / "out", "t")
+            report.scorecard(rep, C.Context(R.load_papers(), runs, []))
+            rep.write()
+            self.assertIn("| holds (1 seed: weak evidence) |", (pathlib.Path(tmp) / "out" / "report.md").read_text())
 
     def test_field_robot_rows_are_judged_in_their_own_column(self):
         import report
@@ -464,7 +577,8 @@ class ReaderReport(unittest.TestCase):
         import report
         self.assertEqual(report.numeric_class("50 % occlusion degrades the mean error only mildly"), "")
         self.assertEqual(report.numeric_class("002 / 000"), "")  # a paper's number is a name
-        for cell in ("50 %", "2.42 [2.36, 2.48]", "3 / 3", "0.296 ms", "-1.5", "4.750 (n = 1: no interval)"):
+        for cell in ("50 %", "2.42 [2.36, 2.48]", "3 / 3", "0.296 ms", "-1.5", "4.750 (n=1, no interval)",
+                     "4.50 (seeds' range 4.00 to 5.00, n=3)", "3.000 [1.037, 4.963] (n=5, t95)"):
             self.assertEqual(report.numeric_class(cell), " class='num'", cell)
         self.assertEqual(report.inline_markdown("run `omniloc x` for **all** <rows> *now*, 5 * 3"),
                          "run <code>omniloc x</code> for <b>all</b> &lt;rows&gt; <i>now</i>, 5 * 3")
@@ -847,7 +961,76 @@ class Causes(unittest.TestCase):
             md = (pathlib.Path(tmp) / "out" / "report.md").read_text()
             self.assertIn("Why a claim does not hold", md)
             self.assertIn("pushed by hand", md)
-            self.assertIn("not measured (not run: build/omniloc experiment error_budget)", md)
+            self.assertIn("not measured (not run: `build/omniloc experiment error_budget`)", md)
+
+    def test_the_why_table_writes_a_cause_shared_by_both_profiles_once(self):
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            for seed in (1, 2, 3):
+                write_run(pathlib.Path(tmp) / f"t{seed}", "tracking", "matching", seed, {}, robot(2.5, 2.6, 0.0066))
+                write_run(pathlib.Path(tmp) / f"f{seed}", "tracking", "matching", seed, {"noise_profile": "field_robot"}, robot(3.5, 3.6, 0.008))
+            runs, _, _ = R.discover([tmp])
+            ctx = C.Context(R.load_papers(), runs, [])
+            rep = report.Report(pathlib.Path(tmp) / "out", "t")
+            judged = report.judge_claims(ctx)
+            report.headline(rep, ctx, *judged)
+            report.scorecard(rep, ctx, judged)
+            rep.write()
+            md = (pathlib.Path(tmp) / "out" / "report.md").read_text()
+            why = md.split("### Why a claim does not hold")[1].split("\n## ")[0]
+            row = [l for l in why.splitlines() if l.startswith("| Tracking accuracy |")]
+            self.assertEqual(len(row), 1, why)  # one row for both profiles
+            self.assertIn("| partly | partly |", row[0])
+            self.assertIn("robot: x 0.42x", row[0])  # ours / paper per profile where they differ
+            self.assertEqual(why.count("pushed by hand along straight tracks"), 1)  # the argument once
+            self.assertNotIn("tracking_accuracy", md)
+            # The headline: first after the title, computed from the results.
+            first = md.split("\n\n")[1]
+            self.assertTrue(first.startswith("**In short.**"), first)
+            self.assertIn("about 0.43x the papers' in position and 0.15x in heading", first)  # median of 2.5/5.907, 2.6/5.967; 0.0066/0.044
+            self.assertIn("The main gap is tracking accuracy", first)
+
+
+class ReaderLanguage(unittest.TestCase):
+    """Issue 38: papers cited with a bibliography, no ids or issue numbers, abbreviations spelled out."""
+
+    def test_citations(self):
+        self.assertEqual(C.cite_text("Lu et al. 2013 (paper 002), Table 1"), "Lu et al. 2013 [3], Table 1")
+        self.assertEqual(C.cite_text("Xiong, Lu, Zheng (paper 000), tracking"), "Xiong et al. 2012 [1], tracking")
+        self.assertEqual(C.cite_text("Kidnap recovery (papers 002 and 000)"), "Kidnap recovery (Lu et al. 2013 [3] and Xiong et al. 2012 [1])")
+        self.assertEqual(C.cite_field("002 refs [7], [8]"), "Lu et al. 2013 [3], its refs [7], [8]")
+        self.assertEqual(len(C.BIBLIOGRAPHY), 5)
+        self.assertTrue(all(b["year"] and b["title"] and b["authors"] for b in C.BIBLIOGRAPHY))
+        for c in R.load_papers()["claims"]:
+            self.assertIn(c["id"], C.CLAIM_LABELS)
+
+    def test_abbreviations_are_spelled_out_once(self):
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            rep = report.Report(tmp, "t")
+            rep.para("MCL alone, then MCL again; `MCL` in code")
+            rep.para("MCL and RMSE")
+            self.assertEqual(rep.md[2], "MCL (Monte Carlo localization) alone, then MCL again; `MCL` in code")
+            self.assertEqual(rep.md[4], "MCL and RMSE (root mean square error)")
+            rep.para("see docs/results.md#intervals")
+            self.assertIn("<a href='", rep.html[-1])
+            self.assertIn("docs/results.md#intervals'>docs/results.md</a>", rep.html[-1])
+
+    def test_the_html_checks_catch_what_they_name(self):
+        sys.path.insert(0, str(ROOT / "scripts"))
+        import check_report_html as K
+        good = ("<html><body><h1>t</h1><p id=\"headline\">In short: " + "x" * 80 + "</p><h2 id=\"scorecard\">Scorecard</h2>"
+                "<p>Lu et al. 2013 [3] and <code>tracking_accuracy</code> and occlusion_002.json and field_robot</p>"
+                "<div class=\"quoted\"><p>total_like</p></div><h2 id=\"references\">References</h2>"
+                "<ol id=\"bibliography\">" + "".join(f"<li>A. {2000 + k}</li>" for k in range(5)) + "</ol></body></html>")
+        for f in (K.check_headline, K.check_no_issue_numbers, K.check_no_raw_keys, K.check_unique_headings, K.check_bibliography):
+            self.assertTrue(f(good)[0], (f.__name__, f(good)))
+        self.assertFalse(K.check_no_issue_numbers(good.replace("Scorecard</h2>", "Scorecard</h2><p>see issue 29</p>"))[0])
+        self.assertFalse(K.check_no_raw_keys(good.replace("and field_robot", "and mcl_only_mean_position_error_cm"))[0])
+        self.assertFalse(K.check_unique_headings(good.replace("<h2 id=\"references\">", "<h3 id=\"x\">Scorecard</h3><h2 id=\"references\">"))[0])
+        self.assertFalse(K.check_bibliography(good.replace("2013 [3]", "2013 [9]"))[0])
+        self.assertFalse(K.check_bibliography(good.replace("<h2 id=\"references\">References</h2>", ""))[0])
+        self.assertFalse(K.check_headline(good.replace(" id=\"headline\"", ""))[0])
 
 
 class ErrorBudgetSeeds(unittest.TestCase):
@@ -871,6 +1054,6 @@ class ErrorBudgetSeeds(unittest.TestCase):
             rep.write()
             md = (pathlib.Path(tmp) / "out" / "report.md").read_text()
             self.assertIn("| none (baseline) | 0.60 (= every seed) | 0.30 (= every seed) | 0.10 (= every seed) |", md)
-            self.assertIn("| vibration | 4.50 [4.11, 4.89] |", md)  # exact bootstrap enumeration over the three seeds
-            self.assertIn("Mean over 3 seeds with a 95 % bootstrap interval", md)
+            self.assertIn("| vibration | 4.50 (seeds' range 4.00 to 5.00, n=3) |", md)  # three seeds: their range, no interval
+            self.assertIn("Mean over 3 seeds; intervals: n >= 5 seeds", md)
             self.assertIn("Which real-robot error is missing", md)
