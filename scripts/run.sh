@@ -11,6 +11,7 @@
 #                                  and off and the full-resolution experiments (a few hours on 2 cores)
 #        scripts/run.sh FILE.json  one scenario, its error table printed
 set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 # A header per phase, so a reader of the terminal knows where the run is and how long each took.
 t_start=$SECONDS
@@ -27,6 +28,9 @@ if [ $# -ge 1 ] && [ "$1" != "--full" ]; then
 fi
 full=0; [ "${1:-}" = "--full" ] && full=1
 
+# How many runs a sweep file makes (scenarios x localizers x parameter sets x seeds), from omniloc itself.
+runs_of() { ./build/omniloc validate "$1" 2>/dev/null | sed -n 's/.*, \([0-9]*\) run(s)).*/\1/p' | head -1; }
+
 # A copy of sweep SPEC with COUNT seeds, written to OUT (scenario paths made relative to results/suites/).
 with_seeds() {
   mkdir -p results/suites
@@ -36,6 +40,22 @@ j["scenarios"]=[({**s,"file":base+s["file"]} if isinstance(s,dict) else base+s) 
 open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$1" "$3" "$2"
 }
 
+# The report of what has landed so far, rewritten after each part (the scorecard's totals and the
+# report's path are what report.py prints last). $1: what is still to come ("" at the end).
+report() {
+  "$PY" scripts/report.py "${results[@]}" -o results/report --title "omniloc paper suite" >results/logs/report.log 2>&1 ||
+    { cat results/logs/report.log; exit 1; }
+  # The whole report is in report.html / report.md (and results/logs/report.log); the terminal gets its
+  # totals and where it is.
+  grep -E '^(scorecard|report): ' results/logs/report.log
+  if [ -n "$1" ]; then
+    echo "still running: $1; the report is rewritten when each part lands (total so far $(( (SECONDS - t_start) / 60 )) min)"
+  else
+    echo "open: $(pwd)/results/report/report.html (total $(( (SECONDS - t_start) / 60 )) min)"
+  fi
+}
+mkdir -p results/report results/logs
+
 # The paper suite: scenarios/sweeps/paper_suite.json holds every paper scenario and the variants the
 # published tables need (three seeds per row); --full runs it with five seeds.
 spec=scenarios/sweeps/paper_suite.json
@@ -43,40 +63,43 @@ if [ $full -eq 1 ]; then
   with_seeds "$spec" 5 results/suites/paper_suite.json
   spec=results/suites/paper_suite.json
 fi
-phase "2/6 paper suite: $spec"
+phase "2/6 paper suite ($(runs_of "$spec") runs, robot profile)"
 ./build/omniloc sweep "$spec" -j "$jobs"
 results=(results/sweeps/paper_suite)
-# The same published rows under the field_robot profile (issue 17), shown beside them in the report;
-# one seed by default, three with --full (issue 29: a profile contradiction needs seed-to-seed spread).
+# The first answer: the scorecard of the robot profile, before the slower parts below.
+phase "3/6 first scorecard and report (robot profile)"
+report "the field_robot suite, then the experiments"
+
+# The same published rows under the field_robot profile, shown beside them in the report; one seed by
+# default, three with --full (a contradiction between the profiles needs seed-to-seed spread).
 fr_spec=scenarios/sweeps/paper_suite_field_robot.json
 if [ $full -eq 1 ]; then
   with_seeds "$fr_spec" 3 results/suites/paper_suite_field_robot.json
   fr_spec=results/suites/paper_suite_field_robot.json
 fi
-phase "3/6 paper suite under the field_robot profile"
+phase "4/6 paper suite under the field_robot profile ($(runs_of "$fr_spec") runs)"
 ./build/omniloc sweep "$fr_spec" -j "$jobs"
 results+=(results/sweeps/paper_suite_field_robot)
 if [ $full -eq 1 ]; then
-  # global_tracking: global start judged per run over 20 seeds (issue 29; the report's "Global start" section).
+  # global_tracking: global start judged per run over 20 seeds (the report's "Global start" section).
   for s in kidnap_random global_tracking; do
     ./build/omniloc sweep "scenarios/sweeps/$s.json" -j "$jobs" --resume
     results+=("results/sweeps/$s")
   done
 fi
+report "the experiments"
 
-# The figures' experiments (quick versions by default).
-phase "4/6 experiments (the papers' figures)"
+# The figures' experiments (quick versions by default). Their tables go to the report, not the
+# terminal: each one's own output is kept in results/experiments/<name>.log.
+phase "5/6 experiments (the papers' figures)"
 quick=--quick; [ $full -eq 1 ] && quick=
+mkdir -p results/experiments
 for e in $(./build/omniloc list | sed -n '/^experiments:/,/^$/p' | awk 'NR>1 && NF {print $1}'); do
-  echo "--- experiment $e"
-  ./build/omniloc experiment "$e" $quick
+  t0=$SECONDS
+  ./build/omniloc experiment "$e" $quick >"results/experiments/$e.log" 2>&1 || { cat "results/experiments/$e.log"; exit 1; }
+  echo "experiment $e: done in $(( SECONDS - t0 )) s (output: results/experiments/$e.log)"
   results+=("results/experiments/$e")
 done
 
-phase "5/6 report"
-"$PY" scripts/paper_table.py results/sweeps/paper_suite --paper 002_table1_occlusion
-# report.py prints the scorecard's totals (accuracy, robustness and timing apart) and the report's
-# path last, so they are what the terminal shows at the end.
-phase "6/6 scorecard and report"
-"$PY" scripts/report.py "${results[@]}" -o results/report --title "omniloc paper suite"
-echo "open: $(pwd)/results/report/report.html (total $(( (SECONDS - t_start) / 60 )) min)"
+phase "6/6 final scorecard and report"
+report ""
