@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 # A header per phase, so a reader of the terminal knows where the run is and how long each took.
 t_start=$SECONDS
 phase() { echo; echo "=== $1 (at $(( (SECONDS - t_start) / 60 )) min)"; }
-phase "1/6 dependencies and build"
+phase "1/7 dependencies and build"
 scripts/install-deps.sh
 # Only the program it runs: the test and benchmark programs took 157 s of a fresh 9-minute build.
 OMNILOC_BUILD_TARGETS=omniloc scripts/build.sh
@@ -57,17 +57,24 @@ report() {
 mkdir -p results/report results/logs
 
 # The paper suite: scenarios/sweeps/paper_suite.json holds every paper scenario and the variants the
-# published tables need (three seeds per row); --full runs it with five seeds.
+# published tables need (three seeds per row); --full runs it with five seeds. Its first seed runs
+# alone first (a third of the work), so the first scorecard comes early; the other seeds then join
+# the same sweep folder (--resume skips the runs already there) and the report is rewritten.
 spec=scenarios/sweeps/paper_suite.json
+with_seeds "$spec" 1 results/suites/paper_suite_first_seed.json
 if [ $full -eq 1 ]; then
   with_seeds "$spec" 5 results/suites/paper_suite.json
   spec=results/suites/paper_suite.json
 fi
-phase "2/6 paper suite ($(runs_of "$spec") runs, robot profile)"
-./build/omniloc sweep "$spec" -j "$jobs"
 results=(results/sweeps/paper_suite)
-# The first answer: the scorecard of the robot profile, before the slower parts below.
-phase "3/6 first scorecard and report (robot profile)"
+phase "2/7 paper suite, first seed ($(runs_of results/suites/paper_suite_first_seed.json) runs, robot profile)"
+./build/omniloc sweep results/suites/paper_suite_first_seed.json -j "$jobs"
+# The first answer: the robot profile's scorecard from one seed (its verdicts say they rest on one).
+phase "3/7 first scorecard and report (robot profile, one seed)"
+report "the other seeds of the paper suite, the field_robot suite, then the experiments"
+
+phase "4/7 paper suite, the other seeds ($(runs_of "$spec") runs in all)"
+./build/omniloc sweep "$spec" -j "$jobs" --resume
 report "the field_robot suite, then the experiments"
 
 # The same published rows under the field_robot profile, shown beside them in the report; one seed by
@@ -77,7 +84,7 @@ if [ $full -eq 1 ]; then
   with_seeds "$fr_spec" 3 results/suites/paper_suite_field_robot.json
   fr_spec=results/suites/paper_suite_field_robot.json
 fi
-phase "4/6 paper suite under the field_robot profile ($(runs_of "$fr_spec") runs)"
+phase "5/7 paper suite under the field_robot profile ($(runs_of "$fr_spec") runs)"
 ./build/omniloc sweep "$fr_spec" -j "$jobs"
 results+=(results/sweeps/paper_suite_field_robot)
 if [ $full -eq 1 ]; then
@@ -91,7 +98,7 @@ report "the experiments"
 
 # The figures' experiments (quick versions by default). Their tables go to the report, not the
 # terminal: each one's own output is kept in results/experiments/<name>.log.
-phase "5/6 experiments (the papers' figures)"
+phase "6/7 experiments (the papers' figures)"
 quick=--quick; [ $full -eq 1 ] && quick=
 mkdir -p results/experiments
 for e in $(./build/omniloc list | sed -n '/^experiments:/,/^$/p' | awk 'NR>1 && NF {print $1}'); do
@@ -101,5 +108,5 @@ for e in $(./build/omniloc list | sed -n '/^experiments:/,/^$/p' | awk 'NR>1 && 
   results+=("results/experiments/$e")
 done
 
-phase "6/6 final scorecard and report"
+phase "7/7 final scorecard and report"
 report ""
