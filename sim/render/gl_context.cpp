@@ -114,6 +114,14 @@ void GlContext::read_rgba16(std::vector<std::uint16_t>& out) const {
   if (err != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + backend_ + "\": glReadPixels failed (error 0x" + std::to_string(err) + ")");
 }
 
+void GlContext::read_depth(std::vector<float>& out) const {
+  out.resize(static_cast<std::size_t>(fb_w_) * fb_h_);
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.ReadPixels(0, 0, fb_w_, fb_h_, GL_DEPTH_COMPONENT, GL_FLOAT, out.data());
+  const GLenum err = gl_.GetError();
+  if (err != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + backend_ + "\": glReadPixels (depth) failed (error 0x" + std::to_string(err) + ")");
+}
+
 namespace {
 
 void* open_library(const std::string& backend, const char* lib) {

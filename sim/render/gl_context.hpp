@@ -98,6 +98,8 @@ class GlContext {
   void read_rgba(std::vector<unsigned char>& out) const;
   /// The same at the framebuffer's 16 bits per channel.
   void read_rgba16(std::vector<std::uint16_t>& out) const;
+  /// The depth buffer as floats in [0, 1] (GL order; 1 where nothing that writes depth was drawn).
+  void read_depth(std::vector<float>& out) const;
   bool has_extension(const std::string& name) const;
   /// Compiles and links a program of one GLSL fragment shader (the vertex stage stays fixed
   /// function). Throws RuntimeFailure with the compiler's log, naming the back-end and `what`.

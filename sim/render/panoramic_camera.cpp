@@ -168,9 +168,27 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
   // exact polar smear of omega * T below.
   const double exposure_s = cfg_.motion_blur ? 1e-3 * st.exposure_ms : 0.0;
   const int subframes = m.photometry.subframes(me->velocity.norm(), exposure_s);
+  // Does anything but this robot move in the image over the exposure (half a millimetre)?
+  bool others_still = world.ball.velocity.norm() * exposure_s <= 5e-4;
+  for (const auto& r : world.robots)
+    if (r.id != robot_id && r.velocity.norm() * exposure_s > 5e-4) others_still = false;
   if (subframes == 1) {
     draw_scene(m, cfg_, mirror_, centre(), world, *me, R, false);
     m.ctx->read_rgba16(m.photometry.radiance());
+  } else if (others_still) {
+    // Only this robot moves: the scene once at mid-exposure, and the sub-frames (the same times as
+    // below) resampled from it along each pixel's image motion (issue 38: the re-renders were most
+    // of a field_robot frame's cost).
+    const double mid = 0.5 * exposure_s;
+    WorldState w = world;
+    for (auto& r : w.robots) r.pose = Pose2(r.pose.x - mid * r.velocity.x(), r.pose.y - mid * r.velocity.y(), r.pose.theta);
+    w.ball.position -= mid * w.ball.velocity;
+    draw_scene(m, cfg_, mirror_, centre(), w, *w.robot(robot_id), R, false);
+    m.ctx->read_rgba16(m.photometry.radiance());
+    m.ctx->read_depth(m.photometry.depth());
+    std::vector<double> taus(static_cast<std::size_t>(subframes));
+    for (int k = 0; k < subframes; ++k) taus[static_cast<std::size_t>(k)] = mid - exposure_s * (1.0 - (k + 0.5) / subframes);
+    m.photometry.translation_blur(Pose2(0, 0, me->pose.theta).inverse_transform(me->velocity), taus);
   } else {
     m.photometry.clear_sum();
     for (int k = 0; k < subframes; ++k) {

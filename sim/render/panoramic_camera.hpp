@@ -52,7 +52,7 @@ class PanoramicCamera {
  public:
   /// Changes whenever the rendered pixels change (photometry, noise, how the scene is drawn): part
   /// of the cache key of the colour tables and calibration maps learned from rendered images.
-  static constexpr int kPhotometryVersion = 4;
+  static constexpr int kPhotometryVersion = 5;  // 5: field_robot's defocus and motion blur computed anew
   /// Throws ConfigError for a bad configuration, RuntimeFailure when the GL back-end fails.
   PanoramicCamera(const CameraConfig& config, const Field& field);
   ~PanoramicCamera();

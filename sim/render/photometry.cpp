@@ -53,7 +53,10 @@ Photometry::Photometry(const CameraConfig& cfg, const MirrorProfile& mirror, int
     }
     defocus_ = std::make_unique<RadialDefocus>(W_, H_, centre_ * ss_, rim * ss_, sigma);
   }
-  if (cfg_.motion_blur) smear_ = std::make_unique<RotationSmear>(W_, H_, centre_ * ss_, mirror.rim() * ss_);
+  if (cfg_.motion_blur) {
+    smear_ = std::make_unique<RotationSmear>(W_, H_, centre_ * ss_, mirror.rim() * ss_);
+    translation_ = std::make_unique<TranslationBlur>(W_, H_, ss_, centre_, mirror, cfg_.mount_height);
+  }
   // The floor's finest sampling sets how many sub-frames an exposure of a moving robot needs.
   finest_floor_m_per_px_ = 1e9;
   for (double r = mirror.body_radius(); r + 1.0 <= mirror.rim(); r += 1.0) {
@@ -85,13 +88,24 @@ int Photometry::subframes(double speed, double exposure_s) const {
 void Photometry::clear_sum() { accumulate_.assign(static_cast<std::size_t>(W_) * H_ * 4, 0u); }
 
 void Photometry::add_subframe() {
-  for (std::size_t i = 0; i < subframe_.size(); ++i) accumulate_[i] += subframe_[i];
+  std::uint32_t* a = accumulate_.data();
+  const std::uint16_t* s = subframe_.data();
+  for (std::size_t i = 0; i < subframe_.size(); ++i) a[i] += s[i];
 }
 
+// The mean rounded half up: (sum + n / 2) / n for n = 2 and 3, as a vectorised multiply (the
+// integer division per value cost 3 ms a frame).
 void Photometry::average(int subframes) {
   readback16_.resize(accumulate_.size());
-  for (std::size_t i = 0; i < accumulate_.size(); ++i)
-    readback16_[i] = static_cast<std::uint16_t>((accumulate_[i] + static_cast<std::uint32_t>(subframes / 2)) / static_cast<std::uint32_t>(subframes));
+  const float inv = 1.0f / static_cast<float>(subframes);
+  const std::uint32_t* a = accumulate_.data();
+  std::uint16_t* o = readback16_.data();
+  for (std::size_t i = 0; i < accumulate_.size(); ++i) o[i] = static_cast<std::uint16_t>(static_cast<float>(a[i]) * inv + 0.5f);
+}
+
+void Photometry::translation_blur(const Eigen::Vector2d& velocity, const std::vector<double>& taus) {
+  if (!translation_) return;
+  translation_->apply(Rgba16View{readback16_.data(), W_, H_}, depth_, velocity, taus);
 }
 
 void Photometry::apply_optics(double turn) {

@@ -49,6 +49,11 @@ class Photometry {
   std::vector<std::uint16_t>& subframe() { return subframe_; }
   void add_subframe();
   void average(int subframes);
+  /// The depth buffer of radiance()'s render (read it when translation_blur() is to follow).
+  std::vector<float>& depth() { return depth_; }
+  /// Motion blur of a static scene from one render at mid-exposure (image_blur.hpp TranslationBlur):
+  /// `velocity` the robot's in its own frame (m/s), `taus` the sub-frames' times after the render (s).
+  void translation_blur(const Eigen::Vector2d& velocity, const std::vector<double>& taus);
 
   /// Rotation smear over `turn` radians (when motion blur is on), then defocus (when on).
   void apply_optics(double turn);
@@ -66,6 +71,8 @@ class Photometry {
   std::vector<std::uint32_t> accumulate_;  // the sum of the sub-frames
   std::unique_ptr<RadialDefocus> defocus_;  // null: sharp
   std::unique_ptr<RotationSmear> smear_;    // null: no motion blur
+  std::unique_ptr<TranslationBlur> translation_;  // null: no motion blur
+  std::vector<float> depth_;
   double finest_floor_m_per_px_ = 0.0;      // the smallest floor extent of an image pixel (at the body's edge)
   std::vector<std::uint8_t> noise_;         // standard normals in steps of kNoiseStep, drawn once from the first render's Rng
   std::vector<float> row_radiance_;         // one row's linear values
