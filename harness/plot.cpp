@@ -21,12 +21,41 @@ std::string num(double v) {
 void text(cv::Mat& m, const std::string& s, cv::Point p, double scale = 0.45, cv::Scalar c = {20, 20, 20}) {
   cv::putText(m, s, p, cv::FONT_HERSHEY_SIMPLEX, scale, c, 1, cv::LINE_AA);
 }
+
+// A title at most `max_px` wide: the font shrinks (down to 0.35) rather than the text being clipped
+// at the image's edge.
+void title_text(cv::Mat& m, const std::string& s, cv::Point p, int max_px) {
+  double scale = 0.55;
+  int base = 0;
+  while (scale > 0.35 && cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &base).width > max_px) scale -= 0.025;
+  std::string t = s;  // still too long at the smallest size: cut with an ellipsis, never off the edge
+  while (t.size() > 4 && cv::getTextSize(t, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &base).width > max_px) t = t.substr(0, t.size() - 4) + "...";
+  text(m, t, p, scale);
+}
 }  // namespace
+
+std::vector<double> nice_ticks(double lo, double hi, int max_ticks, bool integer) {
+  if (!(hi > lo)) hi = lo + 1;
+  max_ticks = std::max(1, max_ticks);
+  const double raw = (hi - lo) / max_ticks;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10 * mag;
+  for (double f : {1.0, 2.0, 5.0})
+    if (f * mag >= raw * (1 - 1e-9)) {
+      step = f * mag;
+      break;
+    }
+  if (integer) step = std::max(1.0, std::round(step));
+  const double first = std::floor(lo / step + 1e-9) * step, last = std::ceil(hi / step - 1e-9) * step;
+  std::vector<double> t;
+  for (int k = 0; first + k * step <= last + 1e-9 * step; ++k) t.push_back(std::fabs(first + k * step) < 1e-12 * step ? 0.0 : first + k * step);
+  return t;
+}
 
 cv::Mat line_plot(const std::vector<Series>& series, const std::string& title, const std::string& xlabel, const std::string& ylabel, bool log_y,
                   int width, int height) {
   cv::Mat m(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const int l = 70, r = width - 170, t = 52, b = height - 50;
+  const int l = 70, r = width - 170, t = 60, b = height - 50;
   double xmin = std::numeric_limits<double>::max(), xmax = -xmin, ymin = xmin, ymax = -xmin;
   auto ty = [&](double y) { return log_y ? std::log10(std::max(y, 1e-12)) : y; };
   for (const auto& s : series)
@@ -37,35 +66,37 @@ cv::Mat line_plot(const std::vector<Series>& series, const std::string& title, c
       ymax = std::max(ymax, ty(s.y[i]));
     }
   if (xmin > xmax) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
-  // Integer data (robot counts, iterations) get integer ticks: at most 5 divisions of a whole step.
+  // Integer data (robot counts, iterations) get integer ticks; every axis gets round ones.
   bool integer_x = true;
   for (const auto& s : series)
     for (double x : s.x) integer_x = integer_x && std::fabs(x - std::round(x)) < 1e-9;
-  int x_divisions = 5;
-  if (integer_x) {
-    const double step = std::max(1.0, std::ceil((xmax - xmin) / 5.0));
-    x_divisions = std::max(1, static_cast<int>(std::ceil((xmax - xmin) / step)));
-    xmax = xmin + x_divisions * step;
-  }
   if (xmax - xmin < 1e-12) xmax = xmin + 1;
   if (ymax - ymin < 1e-12) ymax = ymin + 1;
-  const double pad = 0.05 * (ymax - ymin);
-  // Quantities that cannot be negative (errors, entropy, counts) start at zero, never below it.
-  ymin = (!log_y && ymin >= 0.0) ? 0.0 : ymin - pad;
-  ymax += pad;
+  const std::vector<double> xt = nice_ticks(xmin, xmax, 6, integer_x);
+  xmin = xt.front();
+  xmax = xt.back();
+  // Quantities that cannot be negative (errors, entropy, counts) start at zero, never below it; a
+  // log axis gets its ticks at whole decades.
+  std::vector<double> yt;
+  if (log_y) {
+    for (double d = std::floor(ymin); d <= std::ceil(ymax) + 1e-9; d += 1.0) yt.push_back(d);
+    if (yt.size() < 2) yt.push_back(yt.front() + 1);
+  } else {
+    yt = nice_ticks(ymin >= 0.0 ? 0.0 : ymin, ymax, 5);
+  }
+  ymin = yt.front();
+  ymax = yt.back();
   auto P = [&](double x, double y) {
     return cv::Point(static_cast<int>(l + (x - xmin) / (xmax - xmin) * (r - l)), static_cast<int>(b - (ty(y) - ymin) / (ymax - ymin) * (b - t)));
   };
   cv::rectangle(m, {l, t}, {r, b}, {0, 0, 0}, 1);
-  for (int k = 0; k <= x_divisions; ++k) {
-    const double xv = xmin + k * (xmax - xmin) / x_divisions;
-    const int xp = l + k * (r - l) / x_divisions;
+  for (double xv : xt) {
+    const int xp = static_cast<int>(l + (xv - xmin) / (xmax - xmin) * (r - l));
     cv::line(m, {xp, b}, {xp, b + 4}, {0, 0, 0});
     text(m, num(xv), {xp - 12, b + 18});
   }
-  for (int k = 0; k <= 5; ++k) {
-    const double yv = ymin + k * (ymax - ymin) / 5;
-    const int yp = b - k * (b - t) / 5;
+  for (double yv : yt) {
+    const int yp = static_cast<int>(b - (yv - ymin) / (ymax - ymin) * (b - t));
     cv::line(m, {l - 4, yp}, {l, yp}, {0, 0, 0});
     cv::line(m, {l, yp}, {r, yp}, {230, 230, 230});
     text(m, num(log_y ? std::pow(10.0, yv) : yv), {4, yp + 4});
@@ -79,9 +110,9 @@ cv::Mat line_plot(const std::vector<Series>& series, const std::string& title, c
     cv::line(m, {r + 10, ly}, {r + 30, ly}, c, 2);
     text(m, s.label, {r + 36, ly + 5}, 0.42);
   }
-  text(m, title, {l, 22}, 0.55);
+  title_text(m, title, {8, 24}, width - 16);
   text(m, xlabel, {(l + r) / 2 - 40, height - 12});
-  text(m, ylabel + (log_y ? " (log)" : ""), {4, t - 8}, 0.42);
+  text(m, ylabel + (log_y ? " (log)" : ""), {4, t - 16}, 0.42);
   return m;
 }
 
@@ -115,7 +146,7 @@ cv::Mat heat_map(const std::vector<double>& v, int cols, int rows, double x0, do
   for (int k = 0; k < h; ++k) cv::line(m, {l + w + 20, t + k}, {l + w + 40, t + k}, colour(hi - (hi - lo) * k / std::max(1, h - 1)));
   text(m, num(hi), {l + w + 44, t + 10});
   text(m, num(lo), {l + w + 44, t + h});
-  text(m, title, {l, 22}, 0.55);
+  title_text(m, title, {8, 22}, m.cols - 16);
   text(m, xlabel, {l + w / 2 - 30, t + h + 38});
   text(m, ylabel, {4, t - 8}, 0.42);
   return m;

@@ -13,6 +13,11 @@ struct Series {
   std::vector<double> x, y;
 };
 
+/// Round tick values covering [lo, hi]: steps of 1, 2 or 5 times a power of ten, at most
+/// `max_ticks` + 1 ticks, the first at or below lo and the last at or above hi (e.g. 440..734 ->
+/// 400, 500, ..., 800). `integer`: steps of at least 1.
+std::vector<double> nice_ticks(double lo, double hi, int max_ticks = 6, bool integer = false);
+
 /// Line plot with axes, ticks and a legend. `log_y`: logarithmic y axis (values must be > 0).
 cv::Mat line_plot(const std::vector<Series>& series, const std::string& title, const std::string& xlabel, const std::string& ylabel,
                   bool log_y = false, int width = 720, int height = 440);
