@@ -143,6 +143,21 @@ def reader_names():
     names = set(ABBREVIATIONS_WITH_UNDERSCORE) | {"field_robot", "x86_64"}  # x86_64: the machine's architecture
     for pattern in ("scenarios/**/*.json", "experiments/*.hpp", "localization/*.hpp", "data/fields/*.json"):
         names |= {p.stem for p in ROOT.glob(pattern)}
+
+    def values(j):  # the string values a user writes in a scenario or experiment file (presets: "nubot_tan")
+        if isinstance(j, dict):
+            for v in j.values():
+                yield from values(v)
+        elif isinstance(j, list):
+            for v in j:
+                yield from values(v)
+        elif isinstance(j, str) and re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", j):
+            yield j
+    for p in ROOT.glob("scenarios/**/*.json"):
+        try:
+            names |= set(values(json.loads(p.read_text())))
+        except (OSError, ValueError):
+            pass
     try:
         names |= {p["name"] for p in json.loads((ROOT / "data" / "noise_profiles.json").read_text()).get("profiles", [])}
     except (OSError, ValueError, AttributeError, KeyError, TypeError):

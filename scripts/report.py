@@ -1095,7 +1095,7 @@ def experiment_tables(rep, papers, ctx):
         for case, v in j.items():
             s = v.get("all_paths") if isinstance(v, dict) else None
             if s:
-                rows.append([case, s.get("frames"), s.get("group_fixes"), fnum(s.get("fixes_max_m"), 2), fnum(s.get("no_voting_mean_m"), 3),
+                rows.append([case.replace("_", " "), s.get("frames"), s.get("group_fixes"), fnum(s.get("fixes_max_m"), 2), fnum(s.get("no_voting_mean_m"), 3),
                              fnum(s.get("no_voting_max_m"), 2), fnum(s.get("voting_mean_m"), 3), fnum(s.get("voting_max_m"), 2)])
         rep.table(["case", "frames", "group fixes", "worst fix m", "no voting: mean m", "max m", "voting: mean m", "max m"], rows,
                   f"paper: {t['source']}; max error after voting about {t['max_error_m_after_voting']} m")
