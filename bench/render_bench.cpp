@@ -37,17 +37,22 @@ WorldState scene() {
   return w;
 }
 
+// The camera of `cfg` on the MSL field, or null with the benchmark skipped (no GL back-end here).
+std::unique_ptr<PanoramicCamera> make_camera(benchmark::State& state, const CameraConfig& cfg) {
+  try {
+    return std::make_unique<PanoramicCamera>(cfg, Field::preset("msl2012"));
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return nullptr;
+  }
+}
+
 void BM_RenderFrame(benchmark::State& state, const char* backend, const char* quality) {
   CameraConfig cfg;
   cfg.backend = backend;
   cfg.quality = quality;
-  std::unique_ptr<PanoramicCamera> cam;
-  try {
-    cam = std::make_unique<PanoramicCamera>(cfg, Field::preset("msl2012"));
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
+  const std::unique_ptr<PanoramicCamera> cam = make_camera(state, cfg);
+  if (!cam) return;
   WorldState w = scene();
   Rng rng(1);
   cam->render(w, 0, cfg.initial, rng);  // warm-up: lazy GL set-up (mipmaps, shader variants) is not per frame
@@ -78,13 +83,8 @@ CameraConfig profile_camera(Effects e) {
 // `omega` rad/s; each iteration is the next frame at 30 Hz.
 void BM_RenderProfile(benchmark::State& state, Effects e, double omega) {
   const CameraConfig cfg = profile_camera(e);
-  std::unique_ptr<PanoramicCamera> cam;
-  try {
-    cam = std::make_unique<PanoramicCamera>(cfg, Field::preset("msl2012"));
-  } catch (const std::exception& ex) {
-    state.SkipWithError(ex.what());
-    return;
-  }
+  const std::unique_ptr<PanoramicCamera> cam = make_camera(state, cfg);
+  if (!cam) return;
   WorldState w = scene();
   auto step = [&](double dt) {
     RobotState& me = w.robots[0];
@@ -110,13 +110,8 @@ enum class Piece { kDefocus, kSmear, kSubframes, kTranslation, kExpose };
 
 void BM_Optics(benchmark::State& state, Piece piece) {
   CameraConfig cfg = profile_camera(Effects::kFieldRobot);
-  std::unique_ptr<PanoramicCamera> cam;
-  try {
-    cam = std::make_unique<PanoramicCamera>(cfg, Field::preset("msl2012"));
-  } catch (const std::exception& ex) {
-    state.SkipWithError(ex.what());
-    return;
-  }
+  const std::unique_ptr<PanoramicCamera> cam = make_camera(state, cfg);
+  if (!cam) return;
   const MirrorProfile mirror = MirrorProfile::preset(cfg.mirror, cfg.rim_px(), cfg.mount_height);
   CameraConfig only = cfg;
   only.optical_blur_px = piece == Piece::kDefocus ? cfg.optical_blur_px : 0.0;

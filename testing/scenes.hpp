@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "core/field.hpp"
+#include "core/messages.hpp"
 #include "core/pose2.hpp"
 #include "core/rng.hpp"
 #include "localization/landmarks/landmark_fix.hpp"
@@ -69,5 +70,11 @@ inline constexpr std::size_t kLandmarkConfigs = 1024;
 /// landmark, from the circle through the first three and from the lines through landmarks 0-1 and
 /// 1-2 (so every closed-form solver has a fix).
 const std::vector<std::vector<landmarks::BearingObs>>& landmark_configs(int n, double sigma);
+
+// ---- Images ----
+
+/// Mean absolute difference of two images over the pixels whose centres lie from r_min to r_max
+/// pixels of `c` (all three channels), DN.
+double mean_abs_diff(const Image& a, const Image& b, const Eigen::Vector2d& c, double r_min, double r_max);
 
 }  // namespace omniloc::scenes

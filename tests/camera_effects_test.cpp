@@ -15,25 +15,8 @@
 using namespace omniloc;
 using namespace omniloc::sim;
 using scenes::one_robot;
+using scenes::mean_abs_diff;
 using scenes::quiet_camera;
-
-namespace {
-
-// Mean absolute difference of two images over the pixels within `rim` of `c` (all channels).
-double mean_abs_diff(const Image& a, const Image& b, const Eigen::Vector2d& c, double r_min, double r_max) {
-  double sum = 0;
-  long n = 0;
-  for (int v = 0; v < a.height; ++v)
-    for (int u = 0; u < a.width; ++u) {
-      const double r = (Eigen::Vector2d(u + 0.5, v + 0.5) - c).norm();
-      if (r < r_min || r > r_max) continue;
-      for (int ch = 0; ch < 3; ++ch) sum += std::abs(static_cast<int>(a.row(v)[3 * u + ch]) - static_cast<int>(b.row(v)[3 * u + ch]));
-      n += 3;
-    }
-  return sum / static_cast<double>(n);
-}
-
-}  // namespace
 
 TEST(MirrorPresets, NubotTanFollowsTheMeasuredLaw) {
   CameraConfig cfg = quiet_camera();
