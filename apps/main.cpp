@@ -1,5 +1,6 @@
 // omniloc command line: validate, run, list, experiment (and more as capabilities land).
 // Exit codes: 0 success, 1 runtime failure, 2 bad input (scenario, arguments) — nothing written.
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -18,6 +19,7 @@
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "core/field.hpp"
+#include "core/install_paths.hpp"
 #include "core/version.hpp"
 #include "experiments/experiment.hpp"
 #include "harness/localizer_registry.hpp"
@@ -68,7 +70,8 @@ commands:
   schema [--sweep | --markdown] [-o FILE]
                          the JSON Schema of scenario files (for editors), or the parameter
                          reference docs/localizers.md generated from the same lists
-  sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [--draw-each] [-o DIR]
+  sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [--draw-each]
+        [--localizer JSON|FILE]... [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and interval (docs/results.md "Intervals": t95 from 5 seeds,
                          else the seeds' range) in results/sweeps/<name>/aggregate.{csv,json}
@@ -86,6 +89,11 @@ commands:
                          two result sets (runs, sweeps or folders of them, e.g. two commits) side by
                          side per metric: difference and whether it exceeds the seed-to-seed spread
                          (Welch's t); runs scripts/compare.py
+  gate RESULTS --rules FILE [--baseline DIR] [--alpha P] [--junit FILE] [--benchmark-json FILE]
+                         pass or fail results against limits and a baseline (docs/ci.md): exit 0 all
+                         hold, 1 a rule or regression failed, 2 bad input; runs scripts/gate.py
+  report RESULTS... -o DIR [--baseline RESULTS] [--title TEXT]
+                         report.md and a self-contained report.html; runs scripts/report.py
   COMMAND --help         that command's options
   --version              the build: git describe, compiler, build type (also in every summary.json)
 )";
@@ -161,6 +169,8 @@ const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                            {"--draw-each", "", "simulate and render every run itself (by default runs that differ only in a built-in\n"
                                                "vision localizer share one recording of their world: docs/recording.md)"},
                            {"--stop-after", "N", "run at most N runs (integer >= 0; 0: all)"},
+                           {"--localizer", "JSON|FILE", "run these localizers instead of the file's (repeatable; inline JSON or a file holding\n"
+                                                        "one localizer object or an array of them; give it again with --resume)"},
                            {"-o", "DIR", "sweep folder (default results/sweeps/<name>)"},
                            {"--slurm", "", "submit as a Slurm job array of --tasks shards plus a merge job (docs/cluster.md)"},
                            {"--tasks", "N", "Slurm array tasks (shards), integer in [1, 100000]"},
@@ -385,7 +395,28 @@ int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
   return 0;
 }
 
+// --localizer of sweep (repeatable): each an object or an array of them, inline or in a file; null
+// when not given (the sweep file's own localizers).
+Json sweep_localizers(const cli::Args& a) {
+  Json all = Json();
+  for (const auto& [k, v] : a.values) {
+    if (k != "--localizer") continue;
+    if (all.is_null()) all = Json::array();
+    const auto first = v.find_first_not_of(" \t\n");
+    if (first == std::string::npos) throw UsageError("--localizer needs inline JSON or a file (e.g. --localizer '{\"type\": \"matching\"}')");
+    Json j = v[first] == '{' || v[first] == '[' ? parse_json_strict(v, "--localizer") : read_json_strict(v, "--localizer");
+    for (Json& l : j.is_array() ? j : Json::array({j})) {
+      if (!l.is_object()) throw ConfigError("--localizer", json_brief(l), "a localizer object {\"type\": ...} (or an array of them)");
+      external::anchor_external_paths(l);
+      all.push_back(l);
+    }
+  }
+  return all;
+}
+
 int cmd_sweep(const cli::Args& a) {
+  if ((a.has("--slurm") || a.has("--status")) && a.has("--localizer"))
+    throw UsageError("--localizer does not reach Slurm's shards: write the localizers into the sweep file's \"localizers\"");
   if (a.has("--slurm") || a.has("--status")) return cmd_sweep_slurm(a, batch::load_sweep(a.positional[0]));
   for (const char* o : {"--tasks", "--partition", "--time", "--cpus-per-task", "--gpus-per-task", "--sbatch-arg", "--dry-run", "--resubmit-missing"})
     if (a.has(o)) throw UsageError(std::string(o) + " needs --slurm");
@@ -406,7 +437,7 @@ int cmd_sweep(const cli::Args& a) {
   o.share_worlds = !a.has("--draw-each");
   o.stop_after = static_cast<std::size_t>(a.integer("--stop-after", 0, 0, 1000000000));
   o.out_dir = a.value("-o");
-  const auto spec = batch::load_sweep(a.positional[0]);
+  const auto spec = batch::load_sweep(a.positional[0], sweep_localizers(a));
   o.progress = &std::cerr;
   std::cerr << "sweep " << spec.name << ": " << spec.runs.size() << " runs, " << o.jobs << " worker(s)"
             << (o.shard_count > 1 ? ", shard " + shard : std::string()) << "\n";
@@ -503,21 +534,42 @@ int cmd_list() {
   for (const auto& l : harness::localizers()) std::cout << "  " << l.type << " - " << l.description << "\n";
   std::cout << "experiments:\n";
   for (const auto& e : experiments::all()) std::cout << "  " << e.name << " - " << e.description << "\n";
+  // Where the lists above came from (an installed package's share/omniloc or the source tree).
+  std::cout << "shared files: " << share_dir().string() << "\n" << "data: " << data_dir() << "\n";
   return 0;
 }
 
-// The comparison is statistics over result files, written in Python beside the report
-// (scripts/compare.py); the CLI only forwards, so both entry points give the same table.
-int cmd_compare(int argc, char** argv) {
-  const std::string script = std::string(OMNILOC_SOURCE_DIR) + "/scripts/compare.py";
+// Commands written in Python (compare; gate) live in share_dir()/scripts, beside the report: the CLI
+// only forwards, so both entry points behave the same. `prog` ("omniloc compare") goes to the script
+// in OMNILOC_<NAME>_PROG so its --help and errors name the command the user typed. Returns only when
+// the interpreter cannot be started.
+int exec_python_script(const std::string& script_name, const std::string& prog, int argc, char** argv) {
+  const std::string script = (share_dir() / "scripts" / script_name).string();
   const char* py = ::access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
   std::vector<char*> args{const_cast<char*>(py), const_cast<char*>(script.c_str())};
   for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
   args.push_back(nullptr);
-  ::setenv("OMNILOC_COMPARE_PROG", "omniloc compare", 1);  // its --help and errors name the command the user typed
+  std::string var = script_name.substr(0, script_name.rfind('.'));  // "compare.py" -> OMNILOC_COMPARE_PROG
+  for (char& c : var) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  ::setenv(("OMNILOC_" + var + "_PROG").c_str(), prog.c_str(), 1);
   ::execvp(py, args.data());
   std::cerr << "failed: cannot run " << py << " " << script << "\n";
   return 1;
+}
+
+// A relative input file that is not there from the working directory but is a shipped one
+// (share_dir()/scenarios/...) is taken from there, so `omniloc run scenarios/quickstart.json` works
+// from any folder once the package is installed. Said on stderr: a file of the same name in the
+// working directory would otherwise silently win or lose.
+std::string shipped_or_given(const std::string& file) {
+  namespace fs = std::filesystem;
+  const fs::path p(file);
+  std::error_code ec;
+  if (p.empty() || p.is_absolute() || fs::exists(p, ec)) return file;
+  const fs::path shipped = (share_dir() / p).lexically_normal();
+  if (!fs::is_regular_file(shipped, ec)) return file;
+  std::cerr << "omniloc: using " << shipped.string() << "\n";
+  return shipped.string();
 }
 
 int cmd_experiment(const cli::Args& a) {
@@ -546,7 +598,9 @@ int main(int argc, char** argv) {
     std::cout << version_line() << "\n";
     return 0;
   }
-  if (cmd == "compare") return cmd_compare(argc, argv);
+  if (cmd == "compare") return exec_python_script("compare.py", "omniloc compare", argc, argv);
+  if (cmd == "gate") return exec_python_script("gate.py", "omniloc gate", argc, argv);
+  if (cmd == "report") return exec_python_script("report.py", "omniloc report", argc, argv);
   struct Entry {
     const cli::Command* spec;
     int (*run)(const cli::Args&);
@@ -566,11 +620,14 @@ int main(int argc, char** argv) {
   try {
     for (const auto& c : commands) {
       if (c.spec->name != cmd) continue;
-      const cli::Args a = cli::parse(*c.spec, argc, argv, 2);
+      cli::Args a = cli::parse(*c.spec, argc, argv, 2);
       if (a.help) {
         std::cout << cli::help_text(*c.spec);
         return 0;
       }
+      // The one place input files of these commands are named: shipped ones are found from anywhere.
+      if (c.spec == &kRun || c.spec == &kValidate || c.spec == &kRecord || c.spec == &kSweep)
+        for (auto& file : a.positional) file = shipped_or_given(file);
       return c.run(a);
     }
     std::cerr << "error: unknown command \"" << cmd << "\"\n" << kUsage;

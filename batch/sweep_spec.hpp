@@ -36,7 +36,9 @@ struct SweepSpec {
 /// Runs that differ only in a built-in localizer that needs vision get a shared `world` (external
 /// clients and localizers without vision run live: a client may want images, and a localizer without
 /// a camera sees a world no exposure search paused).
-SweepSpec load_sweep(const std::string& path);
+/// `localizers`: null, or an array of localizer objects that replaces the file's "localizers" and
+/// every entry's (omniloc sweep --localizer); its errors name "--localizer/<i>".
+SweepSpec load_sweep(const std::string& path, const Json& localizers = Json());
 
 /// JSON Schema (draft 2020-12) of sweep files (`omniloc schema --sweep`): every key load_sweep reads,
 /// a localizer entry as in a scenario (docs/localizers.md) plus its row "label".

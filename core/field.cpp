@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/angles.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc {
 
@@ -215,7 +216,7 @@ Field Field::from_json(const Json& j, const std::string& path) {
 
 std::string data_dir() {
   if (const char* env = std::getenv("OMNILOC_DATA_DIR")) return env;
-  return std::string(OMNILOC_SOURCE_DIR) + "/data";
+  return (share_dir() / "data").string();
 }
 
 std::vector<std::string> Field::preset_names() {

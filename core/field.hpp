@@ -93,7 +93,8 @@ class Field {
 double distance_to_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b);
 double distance_to_arc(const Eigen::Vector2d& p, const ArcMarking& arc);
 
-/// Directory holding data files (field presets...): $OMNILOC_DATA_DIR or <source>/data.
+/// Directory holding data files (field presets, noise profiles...): $OMNILOC_DATA_DIR, else
+/// share_dir()/data (core/install_paths.hpp: an installed package's share/omniloc or the source tree).
 std::string data_dir();
 
 }  // namespace omniloc

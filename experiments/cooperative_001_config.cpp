@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "harness/localizer_registry.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc::experiments {
 
@@ -222,7 +223,7 @@ Cooperative001Config load_cooperative_001(const std::string& file) {
   return parse_cooperative_001(read_json_strict(file, file));
 }
 
-std::string cooperative_001_default_file() { return std::string(OMNILOC_SOURCE_DIR) + "/scenarios/experiments/cooperative_001.json"; }
+std::string cooperative_001_default_file() { return (share_dir() / "scenarios/experiments/cooperative_001.json").string(); }
 
 void validate_cooperative_001(const std::string& file) { (void)load_cooperative_001(file); }
 

@@ -17,6 +17,7 @@
 #include "localization/vision/entropy.hpp"
 #include "localization/vision/exposure_control.hpp"
 #include "sim/render/panoramic_camera.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc::experiments {
 
@@ -36,7 +37,7 @@ using harness::world_at;
 int EntropyMapsConfig::grid_size() const { return static_cast<int>(std::floor((hi - lo) / step + 1e-9)) + 1; }
 
 EntropyMapsConfig EntropyMapsConfig::from_args(const ExperimentArgs& args) {
-  const std::string dir = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/";
+  const std::string dir = (share_dir() / "scenarios/paper").string() + "/";
   EntropyMapsConfig c;
   c.cases = {{"normal", dir + "lighting_002.json"}, {"sun", dir + "lighting_002_sun.json"}};
   c.step = args.quick ? 6.0 : 2.0;

@@ -16,6 +16,7 @@
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
 #include "batch/sweep.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc::experiments {
 
@@ -31,7 +32,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string default_file() { return std::string(OMNILOC_SOURCE_DIR) + "/scenarios/experiments/error_budget.json"; }
+std::string default_file() { return (share_dir() / "scenarios/experiments/error_budget.json").string(); }
 
 std::string slug(const std::string& name) {
   std::string s;

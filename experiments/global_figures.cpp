@@ -15,6 +15,7 @@
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
 #include "localization/mcl.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc::experiments {
 
@@ -35,7 +36,7 @@ using harness::world_at;
 
 GlobalFiguresConfig GlobalFiguresConfig::from_args(const ExperimentArgs& args) {
   GlobalFiguresConfig c;
-  c.scenario_file = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/kidnap_000.json";
+  c.scenario_file = (share_dir() / "scenarios/paper/kidnap_000.json").string();
   c.seed = args.seed;
   return c;
 }

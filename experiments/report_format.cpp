@@ -7,6 +7,7 @@
 
 #include "core/angles.hpp"
 #include "core/atomic_file.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc::experiments {
 
@@ -97,7 +98,7 @@ double RunningStat::sd() const { return n > 1 ? std::sqrt(m2 / (n - 1)) : 0.0; }
 
 double RunningStat::se() const { return n > 1 ? sd() / std::sqrt(n) : 0.0; }
 
-std::string papers_json_file() { return std::string(OMNILOC_SOURCE_DIR) + "/results/reference/papers.json"; }
+std::string papers_json_file() { return (share_dir() / "results/reference/papers.json").string(); }
 
 Json read_published(std::string* error) {
   try {

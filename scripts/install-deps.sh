@@ -25,6 +25,8 @@ PKGS=(
   libssl-dev zlib1g-dev
   python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
+  dpkg-dev file  # scripts/package.sh: dpkg-shlibdeps computes the .deb's Depends; cpack tests ELF files with file
+  libxml2-utils python3-yaml  # tests: xmllint validates omniloc gate's JUnit XML; the CI recipe test reads docs/ci.md's YAML
 )
 # --report-check: also Debian's chromium, for the headless check of report.html
 # (scripts/check_report_html.py; .ci/run). Not needed to build, test or run the suite.

@@ -1669,7 +1669,7 @@ def bibliography(rep):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(prog=os.environ.get("OMNILOC_REPORT_PROG", "scripts/report.py"), description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("results", nargs="+")
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--title", default="omniloc report")

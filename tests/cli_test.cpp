@@ -128,3 +128,35 @@ TEST(Cli, NoCommandOverwritesWithoutBeingTold) {
   EXPECT_NE(omniloc::read_file(file), "mine");
   std::filesystem::remove_all(dir);
 }
+
+// Issue 39: a relative scenario or sweep path that is not there from the working directory but is a
+// shipped file (share_dir(); in a build tree the source tree) is used from there, with a note on
+// stderr; a file of that name in the working directory still wins, silently.
+TEST(Cli, ShippedInputsAreFoundFromAnyWorkingDirectory) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("omniloc_cli_cwd_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "scenarios");
+  const std::string bin = (fs::current_path() / "omniloc").string();
+  const auto in_dir = [&](const std::string& args, std::string* err) {
+    const std::string e = (dir / "err.txt").string();
+    const int st = std::system(("cd " + dir.string() + " && env -u OMNILOC_SHARE_DIR " + bin + " " + args + " >/dev/null 2>" + e).c_str());
+    *err = omniloc::read_file(e);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  };
+  const fs::path source(OMNILOC_SOURCE_DIR);
+  std::string err;
+  EXPECT_EQ(in_dir("validate scenarios/quickstart.json", &err), 0) << err;
+  EXPECT_NE(err.find("omniloc: using " + (source / "scenarios/quickstart.json").string()), std::string::npos) << err;
+  // A sweep names its scenarios relative to itself, so a shipped sweep works from anywhere too.
+  EXPECT_EQ(in_dir("validate scenarios/sweeps/odometry_drift.json", &err), 0) << err;
+  EXPECT_NE(err.find("omniloc: using " + (source / "scenarios/sweeps/odometry_drift.json").string()), std::string::npos) << err;
+  // Not shipped and not here: the usual error (exit 2), no note.
+  EXPECT_EQ(in_dir("run scenarios/no_such_scenario.json", &err), 2) << err;
+  EXPECT_EQ(err.find("omniloc: using"), std::string::npos) << err;
+  // The working directory's own file wins (here a broken one, so the exit code tells which was read).
+  omniloc::write_file_atomic((dir / "scenarios/quickstart.json").string(), "{\"duraton\": 1}");
+  EXPECT_EQ(in_dir("validate scenarios/quickstart.json", &err), 2) << err;
+  EXPECT_EQ(err.find("omniloc: using"), std::string::npos) << err;
+  fs::remove_all(dir);
+}

@@ -269,6 +269,34 @@ TEST(Sweep, ScenarioEntriesCarryTheirOwnParametersAndLocalizers) {
   EXPECT_THROW(load_sweep(bad), ConfigError);
 }
 
+// `omniloc sweep --localizer`: the given localizers replace the file's and every entry's own, so a
+// shipped suite runs any localizer unedited (docs/ci.md); their errors are named "--localizer/<i>".
+TEST(Sweep, LocalizerOverrideReplacesEveryEntrysLocalizers) {
+  fs::remove_all(test_dir());
+  make_sweep();
+  const std::string f = (test_dir() / "override.json").string();
+  write_file_atomic(f, R"({"name": "override", "localizers": [{"type": "mcl"}], "scenarios": [
+      "short.json",
+      {"file": "short.json", "parameters": {"/duration": [2.0]}, "localizers": [{"type": "odometry_only", "label": "dead_reckoning"}]}],
+    "seeds": [1]})");
+  const SweepSpec own = load_sweep(f);
+  ASSERT_EQ(own.runs.size(), 2u);
+  EXPECT_EQ(own.runs[0].localizer_label, "mcl");
+  EXPECT_EQ(own.runs[1].localizer_label, "dead_reckoning");
+  const SweepSpec over = load_sweep(f, Json::array({{{"type", "odometry_only"}, {"label", "mine"}}, {{"type", "matching"}}}));
+  ASSERT_EQ(over.runs.size(), 4u);  // 2 entries x 2 localizers
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(over.runs[i].localizer_label, i % 2 == 0 ? "mine" : "matching") << i;
+    EXPECT_EQ(over.runs[i].scenario["localizer"]["type"], i % 2 == 0 ? "odometry_only" : "matching") << i;
+  }
+  try {
+    load_sweep(f, Json::array({{{"type", "matching"}}, {{"type", 3}}}));
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "--localizer/1/type") << e.what();
+  }
+}
+
 // Shards share one results folder (Slurm array tasks): a shard starting must not delete the staging
 // folder another shard is writing, only the leftovers of its own runs.
 TEST(Sweep, ShardLeavesLiveStagingFoldersAloneAndClearsDeadOnes) {

@@ -1,0 +1,396 @@
+#!/usr/bin/env python3
+"""Pass or fail a result set against rules: limits on metrics and, with a baseline, regressions.
+
+Run as `omniloc gate RESULTS --rules FILE [--baseline DIR] [--junit FILE] [--benchmark-json FILE]
+[--alpha P]` or `scripts/gate.py ...` (the same). docs/ci.md documents the rules file and the outputs.
+
+RESULTS and DIR are sweep folders with final aggregates, run folders, or folders holding them.
+Runs group by scenario, localizer and effective configuration as in `omniloc compare`; a rule
+applies to every group its optional "scenario" / "localizer" filters select, and judges the mean
+over seeds of its metric (or "stat": median / max / min over seeds) against "max" and / or "min".
+With --baseline each group pairs with a baseline group as `omniloc compare` pairs them, and the
+metric regresses when it is worse than the baseline's beyond the rule's tolerance AND beyond the
+seed-to-seed spread (Welch's t-test over seeds, p < alpha, default 0.05; with fewer than two seeds
+on a side there is no spread, and any worsening beyond the tolerance counts).
+
+Metrics are spelled as in aggregate.csv's metric column: "r0/position_m/rmse" (robot 0's all-frames
+RMSE), "r0/tracking_phase/position_m/rmse", or a sweep-level metric; without an "r<N>/" prefix, a
+name that is not a sweep-level metric means robot 0's.
+
+Exit 0 when every rule holds, 1 when any limit or regression fails, 2 on bad input (a missing or
+incomplete result folder, bad rules, an unknown metric, a rule that selects nothing) before any
+verdict is printed.
+"""
+import argparse
+import json
+import math
+import os
+import pathlib
+import sys
+import xml.etree.ElementTree as ET
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import compare as C  # noqa: E402
+import omniloc_results as R  # noqa: E402
+
+ALPHA = 0.05
+STATS = ("mean", "median", "max", "min")
+RULE_KEYS = {"metric", "max", "min", "scenario", "localizer", "stat", "better", "tolerance", "tolerance_fraction", "name", "comment"}
+
+
+class BadInput(Exception):
+    """Input the gate cannot judge: exit 2 before any verdict."""
+
+
+# ---- rules --------------------------------------------------------------------------------------
+
+def _number(rule, key, where):
+    v = rule[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise BadInput(f"{where}/{key}: got {json.dumps(v)}, expected a finite number")
+    return float(v)
+
+
+def load_rules(path, have_baseline):
+    """The rules of `path`, checked key by key; BadInput names the JSON path, the value and what was expected."""
+    try:
+        doc = json.loads(pathlib.Path(path).read_text())
+    except OSError as e:
+        raise BadInput(f"{path}: cannot be read ({e.strerror})")
+    except ValueError as e:
+        raise BadInput(f"{path}: not JSON ({e})")
+    if not isinstance(doc, dict):
+        raise BadInput(f"{path}: /: got {json.dumps(doc)[:60]}, expected an object {{\"rules\": [...]}}")
+    extra = sorted(set(doc) - {"rules", "comment"})
+    if extra:
+        raise BadInput(f"{path}: /{extra[0]}: unknown key, expected \"rules\" (or \"comment\")")
+    rules = doc.get("rules")
+    if not isinstance(rules, list) or not rules:
+        raise BadInput(f"{path}: /rules: got {json.dumps(rules)[:60]}, expected a non-empty array of rules")
+    out = []
+    for i, rule in enumerate(rules):
+        where = f"{path}: /rules/{i}"
+        if not isinstance(rule, dict):
+            raise BadInput(f"{where}: got {json.dumps(rule)[:60]}, expected an object {{\"metric\": ..., \"max\": ...}}")
+        unknown = sorted(set(rule) - RULE_KEYS)
+        if unknown:
+            raise BadInput(f"{where}/{unknown[0]}: unknown key, expected one of {', '.join(sorted(RULE_KEYS))}")
+        m = rule.get("metric")
+        if not isinstance(m, str) or not m.strip("/"):
+            raise BadInput(f"{where}/metric: got {json.dumps(m)}, expected a metric name as in aggregate.csv (e.g. \"r0/position_m/rmse\")")
+        r = {"index": i, "metric": m.strip("/"), "name": rule.get("name")}
+        for k in ("scenario", "localizer", "name"):
+            if k in rule and (not isinstance(rule[k], str) or not rule[k]):
+                raise BadInput(f"{where}/{k}: got {json.dumps(rule[k])}, expected a non-empty string")
+            r[k] = rule.get(k)
+        r["max"] = _number(rule, "max", where) if "max" in rule else None
+        r["min"] = _number(rule, "min", where) if "min" in rule else None
+        if r["max"] is not None and r["min"] is not None and r["min"] > r["max"]:
+            raise BadInput(f"{where}/min: got {r['min']:g}, expected at most max ({r['max']:g})")
+        r["stat"] = rule.get("stat", "mean")
+        if r["stat"] not in STATS:
+            raise BadInput(f"{where}/stat: got {json.dumps(r['stat'])}, expected one of {', '.join(STATS)}")
+        better = rule.get("better", "higher" if r["min"] is not None and r["max"] is None else "lower")
+        if better not in ("lower", "higher"):
+            raise BadInput(f"{where}/better: got {json.dumps(better)}, expected \"lower\" or \"higher\"")
+        r["better"] = better
+        for k in ("tolerance", "tolerance_fraction"):
+            r[k] = _number(rule, k, where) if k in rule else 0.0
+            if r[k] < 0:
+                raise BadInput(f"{where}/{k}: got {r[k]:g}, expected a number >= 0")
+        if r["max"] is None and r["min"] is None and not have_baseline:
+            raise BadInput(f"{where}: has neither \"max\" nor \"min\", and no --baseline was given: it would judge nothing")
+        out.append(r)
+    return out
+
+
+# ---- metrics ------------------------------------------------------------------------------------
+
+def run_metrics(summary):
+    """Every number of a summary.json under its aggregate.csv name (batch/aggregate.cpp run_metrics):
+    "r<robot>/<path>" for the robots' blocks, "<path>" for the sweep-level "metrics" block."""
+    out = {}
+
+    def flat(obj, prefix):
+        if isinstance(obj, bool):
+            return
+        if isinstance(obj, (int, float)):
+            out[prefix] = float(obj)
+        elif isinstance(obj, dict):
+            for k, v in obj.items():
+                flat(v, f"{prefix}/{k}" if prefix else k)
+
+    for robot in summary.get("robots") or []:
+        block = {k: v for k, v in robot.items() if k != "robot"}
+        flat(block, f"r{robot.get('robot', 0)}")
+    flat(summary.get("metrics") or {}, "")
+    return out
+
+
+def resolve_metric(name, known):
+    """`name` as a key of `known`: itself, or "r0/" + name when it has no robot prefix."""
+    if name in known:
+        return name
+    head = name.split("/", 1)[0]
+    if not (head[:1] == "r" and head[1:].isdigit()) and "r0/" + name in known:
+        return "r0/" + name
+    return None
+
+
+def seed_values(runs, metric):
+    vals = []
+    for r in runs:
+        v = run_metrics(r.summary).get(metric)
+        if v is not None and not math.isnan(v):
+            vals.append(v)
+    return vals
+
+
+def statistic(values, stat):
+    if not values:
+        return None
+    if stat == "mean":
+        return sum(values) / len(values)
+    if stat == "median":
+        return R.percentile(sorted(values), 0.5)
+    return max(values) if stat == "max" else min(values)
+
+
+def load_runs(folder, what):
+    """The runs under `folder`; BadInput when it is missing, holds no run or an incomplete sweep."""
+    if not pathlib.Path(folder).is_dir():
+        raise BadInput(f"{what} {folder}: not a folder")
+    try:
+        runs, _, _ = R.discover([folder])
+    except SystemExit as e:
+        raise BadInput(f"{what} {e}")
+    if not runs:
+        raise BadInput(f"{what} {folder}: no finished run (summary.json) under it")
+    return runs
+
+
+# ---- judgement ----------------------------------------------------------------------------------
+
+def judge(rules, runs, base_runs, alpha):
+    """One check per rule and selected group: a dict with the values, the verdicts and the text."""
+    groups = C.groups(runs)
+    names = C.labels(set(groups))
+    pair_of, base_groups = {}, {}
+    if base_runs is not None:
+        pairs, _, _, ga, gb = C.compare_pairs(base_runs, runs)
+        base_groups = ga
+        pair_of = {kb: (ka, diffs) for ka, kb, diffs in pairs}
+    known = set()
+    for r in runs:
+        known.update(run_metrics(r.summary))
+    checks = []
+    for rule in rules:
+        metric = resolve_metric(rule["metric"], known)
+        if metric is None:
+            near = sorted(k for k in known if k.split("/")[-1] == rule["metric"].split("/")[-1])[:4]
+            raise BadInput(f"rule {rule['index']}: metric \"{rule['metric']}\" is not among the results' metrics"
+                           + (f" (did you mean {', '.join(near)}?)" if near else " (see aggregate.csv's metric column)"))
+        keys = [k for k in sorted(groups, key=C.sort_key)
+                if (rule["scenario"] is None or k[0] == rule["scenario"]) and (rule["localizer"] is None or k[1] == rule["localizer"])]
+        if not keys:
+            have = sorted({f"{k[0]} / {k[1]}" for k in groups})
+            raise BadInput(f"rule {rule['index']} (scenario {rule['scenario'] or 'any'}, localizer {rule['localizer'] or 'any'}) "
+                           f"selects no group of the results; they hold: {'; '.join(have)}")
+        paired_any = False
+        for k in keys:
+            vals = seed_values(groups[k], metric)
+            if not vals:
+                raise BadInput(f"rule {rule['index']}: no run of {names[k]} has the metric {metric}")
+            c = {"rule": rule, "metric": metric, "key": k, "label": names[k], "values": vals,
+                 "value": statistic(vals, rule["stat"]), "interval": R.interval(vals), "failures": [], "notes": []}
+            check_limits(c)
+            if base_runs is not None:
+                if k in pair_of:
+                    paired_any = True
+                    ka, diffs = pair_of[k]
+                    check_regression(c, seed_values(base_groups[ka], metric), diffs, alpha)
+                else:
+                    c["notes"].append("no baseline counterpart: regression not checked")
+                    c["regression"] = None
+            checks.append(c)
+        if base_runs is not None and not paired_any and rule["max"] is None and rule["min"] is None:
+            raise BadInput(f"rule {rule['index']} ({metric}) has only a baseline test, and no group it selects pairs with one of the baseline")
+    return checks
+
+
+def check_limits(c):
+    r, v = c["rule"], c["value"]
+    if r["max"] is not None and v > r["max"]:
+        c["failures"].append(("limit", f"{r['stat']} {v:.6g} > max {r['max']:.6g}"))
+    if r["min"] is not None and v < r["min"]:
+        c["failures"].append(("limit", f"{r['stat']} {v:.6g} < min {r['min']:.6g}"))
+
+
+def check_regression(c, base_vals, diffs, alpha):
+    r = c["rule"]
+    if not base_vals:
+        c["notes"].append("the baseline group has no value of this metric: regression not checked")
+        c["regression"] = None
+        return
+    b = statistic(base_vals, r["stat"])
+    worse = (c["value"] - b) if r["better"] == "lower" else (b - c["value"])
+    allowed = r["tolerance"] + r["tolerance_fraction"] * abs(b)
+    w = R.welch(base_vals, c["values"])
+    same = sorted(base_vals) == sorted(c["values"])
+    c["regression"] = {"baseline": b, "baseline_n": len(base_vals), "worse_by": worse, "allowed": allowed, "p": w["p"], "differs": diffs}
+    if same or worse <= allowed:
+        return
+    if w["p"] is None:
+        why = f"no spread (n < 2), worse by {worse:.6g} > tolerance {allowed:.6g}"
+    elif w["p"] < alpha:
+        why = f"worse by {worse:.6g} > tolerance {allowed:.6g}, p {w['p']:.3g} < alpha {alpha:g}"
+    else:
+        c["notes"].append(f"worse by {worse:.6g} but within the seed spread (p {w['p']:.3g} >= {alpha:g})")
+        return
+    c["failures"].append(("regression", f"{r['stat']} {c['value']:.6g} vs baseline {b:.6g} (n={len(base_vals)}): {why}"))
+
+
+def rule_text(r):
+    limits = []
+    if r["min"] is not None:
+        limits.append(f">= {r['min']:.6g}")
+    if r["max"] is not None:
+        limits.append(f"<= {r['max']:.6g}")
+    return " and ".join(limits) if limits else f"no worse than baseline ({r['better']} is better)"
+
+
+def line(c):
+    r = c["rule"]
+    verdict = "FAIL" if c["failures"] else "PASS"
+    s = f"{verdict}  {c['label']}  {c['metric']}  {r['stat']} {c['value']:.6g} (n={len(c['values'])})  limit {rule_text(r)}"
+    reg = c.get("regression")
+    if reg:
+        p = "-" if reg["p"] is None else f"{reg['p']:.3g}"
+        s += f"  baseline {reg['baseline']:.6g} (n={reg['baseline_n']}, p {p})"
+    for kind, msg in c["failures"]:
+        s += f"  [{kind}: {msg}]"
+    for n in c["notes"]:
+        s += f"  [{n}]"
+    return s
+
+
+# ---- outputs ------------------------------------------------------------------------------------
+
+def write_atomic(path, text):
+    """Temp file + rename beside the target: an interrupted gate never leaves half a report."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def junit_xml(checks, results, baseline):
+    """JUnit XML as GitHub Actions' test reporters, GitLab CI and Jenkins read it: <testsuites>, a
+    <testsuite> per scenario, a <testcase> per rule and group, a <failure> naming the metric, the
+    value, the limit or baseline and the p-value. No timestamps: the same results give the same file."""
+    root = ET.Element("testsuites", name="omniloc gate", tests=str(len(checks)),
+                      failures=str(sum(1 for c in checks if c["failures"])), errors="0", skipped="0", time="0")
+    by_scenario = {}
+    for c in checks:
+        by_scenario.setdefault(c["key"][0], []).append(c)
+    for scenario, cs in sorted(by_scenario.items()):
+        suite = ET.SubElement(root, "testsuite", name=scenario, tests=str(len(cs)),
+                              failures=str(sum(1 for c in cs if c["failures"])), errors="0", skipped="0", time="0")
+        props = ET.SubElement(suite, "properties")
+        ET.SubElement(props, "property", name="results", value=str(results))
+        if baseline:
+            ET.SubElement(props, "property", name="baseline", value=str(baseline))
+        for c in cs:
+            r = c["rule"]
+            title = r["name"] or f"{c['metric']} {rule_text(r)}"
+            case = ET.SubElement(suite, "testcase", name=f"{c['label']}: {title}",
+                                 classname=f"omniloc.{scenario}.{c['key'][1]}", time="0")
+            if c["failures"]:
+                msg = "; ".join(f"{kind}: {c['metric']} {m}" for kind, m in c["failures"])
+                fail = ET.SubElement(case, "failure", message=msg, type=" and ".join(sorted({k for k, _ in c["failures"]})))
+                fail.text = line(c) + "\nseed values: " + ", ".join(f"{v:.6g}" for v in c["values"])
+            else:
+                out = ET.SubElement(case, "system-out")
+                out.text = line(c)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+UNITS = [("_cm/", "cm"), ("_m/", "m"), ("_rad/", "rad"), ("_rad", "rad"), ("_s/", "s"), ("_s", "s")]
+
+
+def unit_of(metric):
+    m = metric + "/"
+    for tag, unit in UNITS:
+        if tag in m:
+            return unit
+    return "count" if metric.endswith(("frames", "relocalisations")) else ""
+
+
+def benchmark_json(checks):
+    """github-action-benchmark's "customSmallerIsBetter" input: [{name, unit, value, range, extra}].
+    Only rules where lower is better can be expressed; the others are left out (returned). One entry
+    per group, metric and statistic (the action keys its series by name): two rules on the same
+    number share it, with both limits in "extra"."""
+    entries, left = {}, []
+    for c in checks:
+        if c["rule"]["better"] != "lower":
+            left.append(c)
+            continue
+        name = f"{c['label']}: {c['metric']} ({c['rule']['stat']})"
+        verdict = f"limit {rule_text(c['rule'])}: " + ("FAIL" if c["failures"] else "PASS")
+        if name in entries:
+            entries[name]["extra"] += "; " + verdict
+            continue
+        iv = c["interval"]
+        e = {"name": name, "unit": unit_of(c["metric"]), "value": c["value"]}
+        if iv["kind"] in (R.T95, R.RANGE):
+            e["range"] = f"{iv['lo']:.6g} to {iv['hi']:.6g} ({'95 % t interval' if iv['kind'] == R.T95 else 'seeds range'})"
+        e["extra"] = f"n={len(c['values'])} seeds; " + verdict
+        entries[name] = e
+    return list(entries.values()), left
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog=os.environ.get("OMNILOC_GATE_PROG", "scripts/gate.py"), description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("results", help="sweep or run folder(s) with final results (the candidate)")
+    ap.add_argument("--rules", required=True, help="rules file (JSON, docs/ci.md)")
+    ap.add_argument("--baseline", help="result folder to compare with: a metric regresses when worse beyond the seed spread and the tolerance")
+    ap.add_argument("--alpha", type=float, default=ALPHA, help="significance level of the regression test (default 0.05)")
+    ap.add_argument("--junit", help="write JUnit XML here")
+    ap.add_argument("--benchmark-json", help="write github-action-benchmark's customSmallerIsBetter JSON here")
+    try:
+        a = ap.parse_args(argv)
+    except SystemExit as e:
+        return 0 if e.code == 0 else 2
+    try:
+        if not 0 < a.alpha < 1:
+            raise BadInput(f"--alpha: got {a.alpha:g}, expected a number in (0, 1)")
+        rules = load_rules(a.rules, a.baseline is not None)
+        runs = load_runs(a.results, "results")
+        base = load_runs(a.baseline, "baseline") if a.baseline else None
+        checks = judge(rules, runs, base, a.alpha)
+    except BadInput as e:
+        print(f"gate: error: {e}", file=sys.stderr)
+        return 2
+    print(f"results: {a.results}: {len(runs)} runs, omniloc {C.versions(runs)}")
+    if base is not None:
+        print(f"baseline: {a.baseline}: {len(base)} runs, omniloc {C.versions(base)}")
+    for c in checks:
+        print(line(c))
+    failed = sum(1 for c in checks if c["failures"])
+    if a.junit:
+        write_atomic(a.junit, junit_xml(checks, a.results, a.baseline))
+    if a.benchmark_json:
+        entries, left = benchmark_json(checks)
+        write_atomic(a.benchmark_json, json.dumps(entries, indent=2) + "\n")
+        if left:
+            print(f"note: {len(left)} check(s) where higher is better are not in {a.benchmark_json} (customSmallerIsBetter)")
+    print(f"gate: {len(checks) - failed} of {len(checks)} checks passed" + (f", {failed} failed" if failed else ""))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,272 @@
+"""omniloc gate (scripts/gate.py, docs/ci.md): limits, regressions against a baseline, bad input,
+JUnit XML against tests/data/junit.xsd and github-action-benchmark's JSON.
+
+The results are two sweeps of the shipped CI suite (scenarios/sweeps/ci_quick.json: ten recordings,
+no frame drawn): the built-in matching as it ships, and the same with a deliberately degraded
+distance map (cell 0.4 m instead of 0.05 m: the map's gradient is coarser than the line points'
+spread, so RPROP settles up to a cell off; position rmse about 12 cm instead of about 4 cm).
+Run with OMNILOC_BIN=build/omniloc /usr/bin/python3 -m unittest gate_test (ctest gate_py).
+"""
+import csv
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+import xml.etree.ElementTree as ET
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+BIN = os.path.abspath(os.environ.get("OMNILOC_BIN", str(ROOT / "build" / "omniloc")))
+GATE = [sys.executable, str(ROOT / "scripts" / "gate.py")]
+SUITE = ROOT / "scenarios" / "sweeps" / "ci_quick.json"
+XSD = ROOT / "tests" / "data" / "junit.xsd"
+DEGRADED = '{"type": "matching", "cell": 0.4}'
+
+
+CWD = tempfile.mkdtemp(prefix="gate_test_cwd_")  # omniloc's caches (results/cache) land here, not in the tree
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=CWD, **kw)
+
+
+class Gate(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = pathlib.Path(tempfile.mkdtemp(prefix="gate_test_"))
+        cls.good, cls.bad = cls.tmp / "good", cls.tmp / "degraded"
+        for out, loc in ((cls.good, None), (cls.bad, DEGRADED)):
+            cmd = [BIN, "sweep", str(SUITE), "-j", "2", "-o", str(out)] + (["--localizer", loc] if loc else [])
+            p = run(cmd)
+            assert p.returncode == 0, p.stdout + p.stderr
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+        shutil.rmtree(CWD, ignore_errors=True)
+
+    def rules(self, rules, name="rules.json"):
+        f = self.tmp / name
+        f.write_text(json.dumps({"rules": rules}) if not isinstance(rules, str) else rules)
+        return str(f)
+
+    def gate(self, *args):
+        return run(GATE + [str(a) for a in args])
+
+    def aggregate_mean(self, folder, scenario, metric):
+        """The mean the C++ aggregate wrote (aggregate.json, full precision)."""
+        for g in json.loads((folder / "aggregate.json").read_text())["groups"]:
+            if g["scenario"] == scenario:
+                return g["metrics"][metric]["mean"]
+        raise KeyError(scenario)
+
+    def verdicts(self, out):
+        return [ln for ln in out.splitlines() if ln.startswith(("PASS", "FAIL"))]
+
+    # ---- limits -----------------------------------------------------------------------------
+
+    def test_pass(self):
+        p = self.gate(self.good, "--rules", self.rules([{"metric": "position_m/rmse", "max": 0.08},
+                                                       {"metric": "r0/valid_fraction", "min": 0.99}]))
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        lines = self.verdicts(p.stdout)
+        self.assertEqual(len(lines), 4)  # 2 rules x 2 scenarios
+        self.assertTrue(all(ln.startswith("PASS") for ln in lines), p.stdout)
+        self.assertIn("gate: 4 of 4 checks passed", p.stdout)
+
+    def test_fail_by_limit_names_value_and_limit(self):
+        # The mean the gate judges is the one the C++ aggregate wrote (computed independently).
+        mean = self.aggregate_mean(self.good, "ci_tracking", "r0/position_m/rmse")
+        limit = round(mean * 0.9, 4)
+        p = self.gate(self.good, "--rules", self.rules([{"metric": "r0/position_m/rmse", "max": limit, "scenario": "ci_tracking"}]))
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        (line,) = self.verdicts(p.stdout)
+        self.assertTrue(line.startswith("FAIL  ci_tracking / matching  r0/position_m/rmse"), line)
+        self.assertIn(f"mean {mean:.6g} > max {limit:.6g}", line)
+
+    def test_stat_over_seeds(self):
+        with open(self.good / "runs.csv", newline="") as fh:
+            ids = [r["id"] for r in csv.DictReader(fh) if r["id"].startswith("ci_tracking")]
+        worst = max(json.loads((self.good / "runs" / i / "summary.json").read_text())["robots"][0]["position_m"]["max"] for i in ids)
+        p = self.gate(self.good, "--rules", self.rules([{"metric": "position_m/max", "stat": "max", "max": worst, "scenario": "ci_tracking"}]))
+        self.assertEqual(p.returncode, 0, p.stdout)
+        p = self.gate(self.good, "--rules", self.rules([{"metric": "position_m/max", "stat": "max", "max": worst * 0.999, "scenario": "ci_tracking"}]))
+        self.assertEqual(p.returncode, 1, p.stdout)
+
+    def test_run_folder_as_results(self):
+        run_dir = next((self.good / "runs").iterdir())
+        p = self.gate(run_dir, "--rules", self.rules([{"metric": "position_m/rmse", "max": 1.0}]))
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("(n=1)", p.stdout)
+
+    # ---- regressions ------------------------------------------------------------------------
+
+    def test_fail_by_regression_against_baseline(self):
+        rules = self.rules([{"metric": "r0/position_m/rmse", "max": 1.0}, {"metric": "r0/theta_rmse_rad", "max": 1.0}])
+        p = self.gate(self.bad, "--rules", rules, "--baseline", self.good)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        lines = self.verdicts(p.stdout)
+        self.assertEqual(len(lines), 4)
+        for ln in lines:  # every limit holds; each fails as a regression, with the baseline and p
+            self.assertTrue(ln.startswith("FAIL"), ln)
+            self.assertIn("[regression: mean", ln)
+            self.assertNotIn("[limit:", ln)
+            p_value = float(ln.split(", p ")[-1].split(" <")[0])
+            self.assertLess(p_value, 0.001, ln)
+
+    def test_improvement_and_identical_are_not_regressions(self):
+        rules = self.rules([{"metric": "r0/position_m/rmse", "max": 1.0}])
+        self.assertEqual(self.gate(self.good, "--rules", rules, "--baseline", self.bad).returncode, 0)
+        p = self.gate(self.good, "--rules", rules, "--baseline", self.good)
+        self.assertEqual(p.returncode, 0, p.stdout)
+        self.assertIn("p 1)", p.stdout)
+
+    def test_tolerance_and_baseline_only_rule(self):
+        base = self.aggregate_mean(self.good, "ci_tracking", "r0/position_m/rmse")
+        worse = self.aggregate_mean(self.bad, "ci_tracking", "r0/position_m/rmse")
+        ok = self.rules([{"metric": "r0/position_m/rmse", "scenario": "ci_tracking", "tolerance": (worse - base) * 1.01}])
+        self.assertEqual(self.gate(self.bad, "--rules", ok, "--baseline", self.good).returncode, 0)
+        tight = self.rules([{"metric": "r0/position_m/rmse", "scenario": "ci_tracking", "tolerance": (worse - base) * 0.99}])
+        self.assertEqual(self.gate(self.bad, "--rules", tight, "--baseline", self.good).returncode, 1)
+        frac = self.rules([{"metric": "r0/position_m/rmse", "scenario": "ci_tracking", "tolerance_fraction": 2.0}])
+        self.assertEqual(self.gate(self.bad, "--rules", frac, "--baseline", self.good).returncode, 0)  # 12 cm < 4 cm + 200 %
+
+    def test_higher_is_better_direction(self):
+        # valid_fraction is 1 on both sides; a rule saying higher is better on the position error
+        # treats the degraded (larger) error as an improvement.
+        r = self.rules([{"metric": "r0/position_m/rmse", "better": "higher", "scenario": "ci_tracking"}])
+        self.assertEqual(self.gate(self.bad, "--rules", r, "--baseline", self.good).returncode, 0)
+        self.assertEqual(self.gate(self.good, "--rules", r, "--baseline", self.bad).returncode, 1)
+
+    # ---- bad input: exit 2, nothing written ---------------------------------------------------
+
+    def assert_bad(self, args, fragment):
+        junit = self.tmp / "bad_junit.xml"
+        p = self.gate(*args, "--junit", junit)
+        self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+        self.assertIn(fragment, p.stderr)
+        self.assertNotIn("PASS", p.stdout + p.stderr)
+        self.assertFalse(junit.exists())
+
+    def test_bad_input(self):
+        good_rules = self.rules([{"metric": "position_m/rmse", "max": 1}], "ok.json")
+        self.assert_bad([self.tmp / "missing", "--rules", good_rules], "not a folder")
+        self.assert_bad([self.good, "--rules", self.tmp / "none.json"], "cannot be read")
+        self.assert_bad([self.good, "--rules", self.rules("{nope", "broken.json")], "not JSON")
+        self.assert_bad([self.good, "--rules", self.rules([])], "/rules: got [], expected a non-empty array")
+        self.assert_bad([self.good, "--rules", self.rules([{"metric": "position_m/rmse", "max": "5 cm"}])], '/rules/0/max: got "5 cm", expected a finite number')
+        self.assert_bad([self.good, "--rules", self.rules([{"metric": "position_m/rmse", "maximum": 1}])], "/rules/0/maximum: unknown key")
+        self.assert_bad([self.good, "--rules", self.rules([{"metric": "position_m/rmse", "max": 1, "min": 2}])], "/rules/0/min: got 2, expected at most max")
+        self.assert_bad([self.good, "--rules", self.rules([{"metric": "position_m/rmse"}])], "neither \"max\" nor \"min\", and no --baseline")
+        self.assert_bad([self.good, "--rules", self.rules([{"metric": "position_m/rmsee", "max": 1}])], "metric \"position_m/rmsee\" is not among")
+        self.assert_bad([self.good, "--rules", self.rules([{"metric": "position_m/rmse", "max": 1, "scenario": "nope"}])], "selects no group")
+        self.assert_bad([self.good, "--rules", good_rules, "--alpha", "1.5"], "--alpha")
+        self.assert_bad([self.good, "--rules", good_rules, "--baseline", self.tmp / "missing"], "baseline")
+        # An unfinished sweep: its runs are there, its final aggregate is not.
+        partial = self.tmp / "partial"
+        shutil.copytree(self.good, partial)
+        (partial / "aggregate.json").unlink()
+        self.assert_bad([partial, "--rules", good_rules], "incomplete sweep")
+        empty = self.tmp / "empty"
+        empty.mkdir(exist_ok=True)
+        self.assert_bad([empty, "--rules", good_rules], "no finished run")
+
+    # ---- outputs -----------------------------------------------------------------------------
+
+    def test_junit_against_schema(self):
+        junit = self.tmp / "out" / "junit.xml"
+        rules = self.rules([{"metric": "r0/position_m/rmse", "max": 0.08, "name": "rmse under 8 cm"},
+                            {"metric": "r0/theta_rmse_rad", "max": 1.0}])
+        p = self.gate(self.bad, "--rules", rules, "--baseline", self.good, "--junit", junit)
+        self.assertEqual(p.returncode, 1)
+        if shutil.which("xmllint"):
+            v = run(["xmllint", "--noout", "--schema", str(XSD), str(junit)])
+            self.assertEqual(v.returncode, 0, v.stderr)
+        else:
+            self.skipTest("xmllint (libxml2-utils) missing: scripts/install-deps.sh installs it")
+        root = ET.parse(junit).getroot()
+        self.assertEqual(root.tag, "testsuites")
+        suites = root.findall("testsuite")
+        self.assertEqual(sorted(s.get("name") for s in suites), ["ci_occlusion", "ci_tracking"])
+        self.assertEqual(int(root.get("tests")), 4)
+        self.assertEqual(int(root.get("failures")), 4)
+        for s in suites:
+            cases = s.findall("testcase")
+            self.assertEqual(int(s.get("tests")), len(cases))
+            self.assertEqual(int(s.get("failures")), sum(1 for c in cases if c.find("failure") is not None))
+            for c in cases:
+                f = c.find("failure")
+                self.assertIsNotNone(f)
+                msg = f.get("message")
+                self.assertIn("regression", msg)
+                self.assertIn("baseline", msg)
+                self.assertIn(", p ", msg)
+                self.assertEqual(c.get("classname"), f"omniloc.{s.get('name')}.matching")
+        names = [c.get("name") for c in root.iter("testcase")]
+        self.assertIn("ci_tracking / matching: rmse under 8 cm", names)
+        limit_msgs = [c.find("failure").get("message") for c in root.iter("testcase") if "rmse under 8 cm" in c.get("name")]
+        self.assertTrue(all("limit: r0/position_m/rmse mean" in m and "> max 0.08" in m for m in limit_msgs), limit_msgs)
+        first = junit.read_bytes()
+        self.gate(self.bad, "--rules", rules, "--baseline", self.good, "--junit", junit)
+        self.assertEqual(junit.read_bytes(), first)  # no timestamps: same results, same file
+
+    def test_junit_passing_is_valid_too(self):
+        junit = self.tmp / "pass.xml"
+        p = self.gate(self.good, "--rules", self.rules([{"metric": "r0/position_m/rmse", "max": 1.0}]), "--junit", junit)
+        self.assertEqual(p.returncode, 0)
+        root = ET.parse(junit).getroot()
+        self.assertEqual(root.get("failures"), "0")
+        self.assertEqual(len(list(root.iter("failure"))), 0)
+        self.assertEqual(len(list(root.iter("system-out"))), 2)
+
+    def test_benchmark_json_format(self):
+        out = self.tmp / "bench.json"
+        rules = self.rules([{"metric": "r0/position_m/rmse", "max": 0.08}, {"metric": "r0/position_m/rmse", "max": 0.2},
+                            {"metric": "r0/valid_fraction", "min": 0.9}])
+        p = self.gate(self.good, "--rules", rules, "--benchmark-json", out)
+        self.assertEqual(p.returncode, 0, p.stdout)
+        data = json.loads(out.read_text())
+        self.assertIsInstance(data, list)
+        self.assertEqual(len(data), 2)  # one per group and metric; valid_fraction (higher is better) left out
+        self.assertIn("2 check(s) where higher is better are not in", p.stdout)
+        names = [e["name"] for e in data]
+        self.assertEqual(len(set(names)), len(names))
+        for e in data:
+            self.assertLessEqual(set(e), {"name", "unit", "value", "range", "extra"})
+            self.assertIsInstance(e["name"], str)
+            self.assertEqual(e["unit"], "m")
+            self.assertIsInstance(e["value"], float)
+            self.assertIsInstance(e["range"], str)
+            self.assertIn("limit <= 0.08: PASS; limit <= 0.2: PASS", e["extra"])
+            scenario = e["name"].split(" / ")[0]
+            self.assertAlmostEqual(e["value"], self.aggregate_mean(self.good, scenario, "r0/position_m/rmse"), places=12)
+
+    # ---- through the omniloc binary ------------------------------------------------------------
+
+    def test_cli_forwarding(self):
+        p = run([BIN, "gate", "--help"])
+        self.assertEqual(p.returncode, 0)
+        self.assertTrue(p.stdout.startswith("usage: omniloc gate"), p.stdout[:80])
+        p = run([BIN, "gate", str(self.good), "--rules", self.rules([{"metric": "position_m/rmse", "max": 1}])])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        p = run([BIN, "gate", str(self.good)])
+        self.assertEqual(p.returncode, 2)
+
+    def test_sweep_localizer_option_errors(self):
+        p = run([BIN, "sweep", str(SUITE), "--localizer", '{"type": "nope"}', "-o", str(self.tmp / "x")])
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("--localizer/0/type", p.stderr)
+        p = run([BIN, "sweep", str(SUITE), "--localizer", "[1]", "-o", str(self.tmp / "x")])
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("a localizer object", p.stderr)
+        p = run([BIN, "sweep", str(SUITE), "--localizer", '{"type": "mcl"}', "--slurm", "--tasks", "2", "--dry-run"])
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("Slurm", p.stderr)
+        self.assertFalse((self.tmp / "x").exists())
+
+
+if __name__ == "__main__":
+    unittest.main()
