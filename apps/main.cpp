@@ -335,15 +335,24 @@ int cmd_record(const cli::Args& a) {
   return 0;
 }
 
-// --localizer: inline JSON (starting with '{') or a file holding the localizer object.
-Json localizer_argument(const std::string& v) {
-  if (v.empty()) throw UsageError("replay needs --localizer JSON|FILE (e.g. --localizer '{\"type\": \"matching\"}')");
+// One --localizer value: inline JSON (starting with '{', or '[' where `arrays`) or a file holding it;
+// the localizer objects it holds, each with its external paths made absolute.
+std::vector<Json> localizer_values(const std::string& v, const std::string& command, bool arrays) {
   const auto first = v.find_first_not_of(" \t\n");
-  Json j = first != std::string::npos && v[first] == '{' ? parse_json_strict(v, "--localizer") : read_json_strict(v, "--localizer");
-  if (!j.is_object()) throw ConfigError("--localizer", json_brief(j), "a localizer object {\"type\": ...}");
-  external::anchor_external_paths(j);
-  return j;
+  if (first == std::string::npos)
+    throw UsageError(command + " needs --localizer JSON|FILE (e.g. --localizer '{\"type\": \"matching\"}')");
+  const bool inline_json = v[first] == '{' || (arrays && v[first] == '[');
+  Json j = inline_json ? parse_json_strict(v, "--localizer") : read_json_strict(v, "--localizer");
+  std::vector<Json> out = arrays && j.is_array() ? std::vector<Json>(j.begin(), j.end()) : std::vector<Json>{j};
+  for (Json& l : out) {
+    if (!l.is_object())
+      throw ConfigError("--localizer", json_brief(l), std::string("a localizer object {\"type\": ...}") + (arrays ? " (or an array of them)" : ""));
+    external::anchor_external_paths(l);
+  }
+  return out;
 }
+
+Json localizer_argument(const std::string& v) { return localizer_values(v, "replay", false).front(); }
 
 int cmd_replay(const cli::Args& a) {
   const Json localizer = localizer_argument(a.value("--localizer"));
@@ -402,14 +411,7 @@ Json sweep_localizers(const cli::Args& a) {
   for (const auto& [k, v] : a.values) {
     if (k != "--localizer") continue;
     if (all.is_null()) all = Json::array();
-    const auto first = v.find_first_not_of(" \t\n");
-    if (first == std::string::npos) throw UsageError("--localizer needs inline JSON or a file (e.g. --localizer '{\"type\": \"matching\"}')");
-    Json j = v[first] == '{' || v[first] == '[' ? parse_json_strict(v, "--localizer") : read_json_strict(v, "--localizer");
-    for (Json& l : j.is_array() ? j : Json::array({j})) {
-      if (!l.is_object()) throw ConfigError("--localizer", json_brief(l), "a localizer object {\"type\": ...} (or an array of them)");
-      external::anchor_external_paths(l);
-      all.push_back(l);
-    }
+    for (Json& l : localizer_values(v, "sweep", true)) all.push_back(std::move(l));
   }
   return all;
 }

@@ -123,12 +123,12 @@ std::vector<Combo> parse_combos(const Json& pj, const std::string& at, const std
 // Entry `sp` of "scenarios" written {"recording": DIR, "localizers": ...}: a stored recording (omniloc
 // record, docs/recording.md) replayed into each localizer at the recording's seed; no parameters (the
 // world is fixed) and no seeds of its own.
-ScenarioEntry read_recording_entry(const Json& entry, const std::string& sp, const fs::path& base, const Localizers& locs, bool fixed_locs) {
+ScenarioEntry read_recording_entry(const Json& entry, const std::string& sp, const fs::path& base, const Localizers& locs) {
   JsonReader er(entry, sp);
   er.allow("comment");
   const std::string rel = er.string("recording", std::nullopt);
   ScenarioEntry sc{"", Json(), locs, {{}}, "", std::nullopt};
-  if (const Json* l = er.raw("localizers"); l && !fixed_locs) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
+  if (const Json* l = er.raw("localizers")) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
   er.finish();
   fs::path p = rel;
   if (p.is_relative()) p = base / p;
@@ -144,17 +144,17 @@ ScenarioEntry read_recording_entry(const Json& entry, const std::string& sp, con
 
 // Entry `sp` of "scenarios": a path, or {"file": ..., "parameters": ..., "localizers": ...}.
 ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, const fs::path& base, const Localizers& locs,
-                                  const std::vector<Combo>& combos, bool fixed_locs) {
+                                  const std::vector<Combo>& combos) {
   ScenarioEntry sc{"", Json(), locs, combos, "", std::nullopt};
   const Json* file = &entry;
   std::string fp = sp;
-  if (entry.is_object() && entry.contains("recording")) return read_recording_entry(entry, sp, base, locs, fixed_locs);
+  if (entry.is_object() && entry.contains("recording")) return read_recording_entry(entry, sp, base, locs);
   if (entry.is_object()) {
     JsonReader er(entry, sp);
     er.allow("comment");
     file = er.raw("file", true);
     fp = json_child(sp, "file");
-    if (const Json* l = er.raw("localizers"); l && !fixed_locs) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
+    if (const Json* l = er.raw("localizers")) sc.locs = parse_localizers(*l, json_child(sp, "localizers"));
     if (const Json* pj = er.raw("parameters")) sc.combos = parse_combos(*pj, json_child(sp, "parameters"), combos);
     er.finish();
   }
@@ -170,12 +170,12 @@ ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, cons
 }
 
 std::vector<ScenarioEntry> read_scenario_entries(const Json& scen, const fs::path& base, const Localizers& locs,
-                                                 const std::vector<Combo>& combos, bool fixed_locs) {
+                                                 const std::vector<Combo>& combos) {
   if (!scen.is_array() || scen.empty())
     throw ConfigError("/scenarios", json_brief(scen), "a non-empty array of scenario file paths (or {\"file\": ...} / {\"recording\": ...} entries)");
   std::vector<ScenarioEntry> scenarios;
   for (std::size_t i = 0; i < scen.size(); ++i)
-    scenarios.push_back(read_scenario_entry(scen[i], json_child("/scenarios", i), base, locs, combos, fixed_locs));
+    scenarios.push_back(read_scenario_entry(scen[i], json_child("/scenarios", i), base, locs, combos));
   return scenarios;
 }
 
@@ -356,13 +356,15 @@ SweepSpec load_sweep(const std::string& path, const Json& localizers) {
   // replaces the sweep's localizers, so one file can hold rows that vary different things (the paper suite).
   Localizers locs = {{"", Json(), ""}};
   if (const Json* l = r.raw("localizers")) locs = parse_localizers(*l, "/localizers");
-  // `omniloc sweep --localizer`: the given localizers replace the file's, its entries' too, so one
-  // shipped suite (scenarios/sweeps/ci_quick.json) runs any team's localizer unedited (docs/ci.md).
-  const bool fixed_locs = !localizers.is_null();
-  if (fixed_locs) locs = parse_localizers(localizers, "--localizer");
   std::vector<Combo> combos = {{}};
   if (const Json* pj = r.raw("parameters")) combos = parse_combos(*pj, "/parameters", combos);
-  const std::vector<ScenarioEntry> scenarios = read_scenario_entries(*r.raw("scenarios", true), fs::path(path).parent_path(), locs, combos, fixed_locs);
+  std::vector<ScenarioEntry> scenarios = read_scenario_entries(*r.raw("scenarios", true), fs::path(path).parent_path(), locs, combos);
+  // `omniloc sweep --localizer`: the given localizers replace the file's and its entries' own, so one
+  // shipped suite (scenarios/sweeps/ci_quick.json) runs any team's localizer unedited (docs/ci.md).
+  if (!localizers.is_null()) {
+    const Localizers given = parse_localizers(localizers, "--localizer");
+    for (auto& sc : scenarios) sc.locs = given;
+  }
   const std::vector<std::uint64_t> seeds = read_seeds(r.raw("seeds"));
   r.finish();
 

@@ -78,7 +78,7 @@ def load_rules(path, have_baseline):
         m = rule.get("metric")
         if not isinstance(m, str) or not m.strip("/"):
             raise BadInput(f"{where}/metric: got {json.dumps(m)}, expected a metric name as in aggregate.csv (e.g. \"r0/position_m/rmse\")")
-        r = {"index": i, "metric": m.strip("/"), "name": rule.get("name")}
+        r = {"index": i, "metric": m.strip("/")}
         for k in ("scenario", "localizer", "name"):
             if k in rule and (not isinstance(rule[k], str) or not rule[k]):
                 raise BadInput(f"{where}/{k}: got {json.dumps(rule[k])}, expected a non-empty string")
@@ -137,10 +137,17 @@ def resolve_metric(name, known):
     return None
 
 
+def metrics_of(run):
+    """run_metrics of a Run, flattened once per run (every rule reads it)."""
+    if not hasattr(run, "gate_metrics"):
+        run.gate_metrics = run_metrics(run.summary)
+    return run.gate_metrics
+
+
 def seed_values(runs, metric):
     vals = []
     for r in runs:
-        v = run_metrics(r.summary).get(metric)
+        v = metrics_of(r).get(metric)
         if v is not None and not math.isnan(v):
             vals.append(v)
     return vals
@@ -182,7 +189,7 @@ def judge(rules, runs, base_runs, alpha):
         pair_of = {kb: (ka, diffs) for ka, kb, diffs in pairs}
     known = set()
     for r in runs:
-        known.update(run_metrics(r.summary))
+        known.update(metrics_of(r))
     checks = []
     for rule in rules:
         metric = resolve_metric(rule["metric"], known)

@@ -123,4 +123,15 @@ double mean_abs_diff(const Image& a, const Image& b, const Eigen::Vector2d& c, d
   return sum / static_cast<double>(n);
 }
 
+Image mean_image(int n, const std::function<Image(int k)>& render) {
+  Image out = render(0);
+  std::vector<double> acc(out.rgb.begin(), out.rgb.end());
+  for (int k = 1; k < n; ++k) {
+    const Image s = render(k);
+    for (std::size_t i = 0; i < acc.size(); ++i) acc[i] += s.rgb[i];
+  }
+  for (std::size_t i = 0; i < acc.size(); ++i) out.rgb[i] = static_cast<std::uint8_t>(std::lround(acc[i] / n));
+  return out;
+}
+
 }  // namespace omniloc::scenes

@@ -4,6 +4,7 @@
 // that name the same scene get the same numbers. World frame, metres, radians. Only tests/ and bench/
 // use this folder (the layering test, scripts/check_layers.py, keeps it out of the libraries).
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -76,5 +77,9 @@ const std::vector<std::vector<landmarks::BearingObs>>& landmark_configs(int n, d
 /// Mean absolute difference of two images over the pixels whose centres lie from r_min to r_max
 /// pixels of `c` (all three channels), DN.
 double mean_abs_diff(const Image& a, const Image& b, const Eigen::Vector2d& c, double r_min, double r_max);
+
+/// The pixel-wise mean of `n` images render(0) .. render(n - 1), rounded to DN: the exposure integral
+/// the camera tests compare motion blur with (render(k) draws the scene at sub-instant k).
+Image mean_image(int n, const std::function<Image(int k)>& render);
 
 }  // namespace omniloc::scenes

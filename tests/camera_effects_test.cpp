@@ -16,6 +16,7 @@ using namespace omniloc;
 using namespace omniloc::sim;
 using scenes::one_robot;
 using scenes::mean_abs_diff;
+using scenes::mean_image;
 using scenes::quiet_camera;
 
 TEST(MirrorPresets, NubotTanFollowsTheMeasuredLaw) {
@@ -60,16 +61,10 @@ TEST(CameraEffects, RotationBlurIsTheExposureIntegral) {
   const Image img = blurred.render(w, 0, st, rng);
   auto integral = [&](double width) {
     const int n = 48;
-    std::vector<double> acc(img.rgb.size(), 0.0);
-    for (int k = 0; k < n; ++k) {
-      WorldState wk = one_robot(Pose2(-1.5, -1.0, theta - width * (k + 0.5) / n));
+    return mean_image(n, [&](int k) {
       Rng r(1);
-      const Image s = sharp.render(wk, 0, st, r);
-      for (std::size_t i = 0; i < acc.size(); ++i) acc[i] += s.rgb[i];
-    }
-    Image out = img;
-    for (std::size_t i = 0; i < acc.size(); ++i) out.rgb[i] = static_cast<std::uint8_t>(std::lround(acc[i] / n));
-    return out;
+      return sharp.render(one_robot(Pose2(-1.5, -1.0, theta - width * (k + 0.5) / n)), 0, st, r);
+    });
   };
   const Eigen::Vector2d c = blurred.centre();
   const double lo = blurred.body_radius_px() + 2, hi = blurred.rim_px() - 2;

@@ -23,6 +23,7 @@ using namespace omniloc;
 using namespace omniloc::sim;
 using scenes::one_robot;
 using scenes::mean_abs_diff;
+using scenes::mean_image;
 using scenes::quiet_camera;
 
 namespace {
@@ -91,16 +92,11 @@ TEST(CameraEffectsCost, TranslationBlurIsTheExposureIntegral) {
   Rng rng(1);
   const Image img = blurred.render(w, 0, st, rng);
   auto mean_of = [&](int n, double sign) {
-    std::vector<double> acc(img.rgb.size(), 0.0);
-    for (int k = 0; k < n; ++k) {
+    return mean_image(n, [&](int k) {
       const double back = sign * T * (1.0 - (k + 0.5) / n);
       Rng r(1);
-      const Image s = sharp.render(one_robot(Pose2(at_t.x - back * v.x(), at_t.y - back * v.y(), theta)), 0, st, r);
-      for (std::size_t i = 0; i < acc.size(); ++i) acc[i] += s.rgb[i];
-    }
-    Image out = img;
-    for (std::size_t i = 0; i < acc.size(); ++i) out.rgb[i] = static_cast<std::uint8_t>(std::lround(acc[i] / n));
-    return out;
+      return sharp.render(one_robot(Pose2(at_t.x - back * v.x(), at_t.y - back * v.y(), theta)), 0, st, r);
+    });
   };
   const Eigen::Vector2d c = blurred.centre();
   const double lo = blurred.body_radius_px() + 2, hi = blurred.rim_px() - 2;
