@@ -370,8 +370,7 @@ int cmd_replay(const cli::Args& a) {
   provenance["replay"] = {{"recording", std::filesystem::absolute(a.positional[0]).lexically_normal().string()},
                           {"format", source.header().format},
                           {"recorded_seed", source.header().seed},
-                          {"recorded_with", source.header().omniloc.is_object() ? source.header().omniloc.value("version", std::string("unknown"))
-                                                                                 : std::string("not omniloc")}};
+                          {"recorded_with", harness::recorded_with(source.header())}};
   const auto r = harness::run_frames(s, *o.seed, source, o, provenance);
   std::cout << "replay of " << a.positional[0] << " (scenario " << s.name << ", seed " << r.seed << "), localizer "
             << r.summary["localizer"].get<std::string>() << "\n"

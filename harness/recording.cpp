@@ -84,14 +84,43 @@ double finite(const Json& v, const std::string& at) {
   return v.get<double>();
 }
 
+// The physical limits of a recording's numbers (docs/recording.md section 7). A value outside them
+// cannot come from a robot on a field omniloc accepts, and huge ones overflow a localizer's sums
+// (a line point at -1e308 m became -inf cells in the distance map lookup).
+// - Lengths, metres: the largest field omniloc reads is 22 x 14 m with 5 m margins, a 32 x 24 m floor
+//   (40 m diagonal); nothing on it, and no robot's step between two frames, is farther than 50 m.
+// - Angles, radians: need not be wrapped; 1000 rad (159 turns) keeps a double angle to 1e-13 rad.
+// - Times, seconds from the start of the recording: at most an hour, the longest scenario omniloc
+//   runs (its duration_s, and 720,000 frames at the highest camera rate, 200 Hz).
+constexpr double kMaxLength = 50.0;
+constexpr double kMaxAngle = 1000.0;
+constexpr double kMaxTime = 3600.0;
+// Camera settings (frames.csv's columns only; the simulated camera's range is 1-60 ms and 1-60 gain
+// units by default): exposure at most 10 s, longer than any frame a moving robot uses; gain at most 1000.
+constexpr double kMaxExposureMs = 1e4;
+constexpr double kMaxGain = 1e3;
+
+double within(const Json& v, const std::string& at, double lo, double hi, const char* unit) {
+  const double x = finite(v, at);
+  if (x < lo || x > hi) {
+    char range[160];
+    std::snprintf(range, sizeof range, "a number from %g to %g %s (docs/recording.md section 7)", lo, hi, unit);
+    bad(at, v, range);
+  }
+  return x;
+}
+double length(const Json& v, const std::string& at) { return within(v, at, -kMaxLength, kMaxLength, "m"); }
+double angle(const Json& v, const std::string& at) { return within(v, at, -kMaxAngle, kMaxAngle, "rad"); }
+
 bool boolean(const Json& v, const std::string& at) {
   if (!v.is_boolean()) bad(at, v, "true or false");
   return v.get<bool>();
 }
 
+// A pose or an odometry step: [x, y, theta], metres and radians, each within the limits above.
 Pose2 pose(const Json& v, const std::string& at) {
   if (!v.is_array() || v.size() != 3) bad(at, v, "[x, y, theta]");
-  return Pose2(finite(v[0], json_child(at, std::size_t{0})), finite(v[1], json_child(at, std::size_t{1})), finite(v[2], json_child(at, std::size_t{2})));
+  return Pose2(length(v[0], json_child(at, std::size_t{0})), length(v[1], json_child(at, std::size_t{1})), angle(v[2], json_child(at, std::size_t{2})));
 }
 
 ColourClass colour_of(const Json& v, const std::string& at) {
@@ -113,12 +142,12 @@ Blob blob_from_json(const Json& j, const std::string& at) {
   Blob b;
   b.colour = colour_of(member(j, "colour", at), json_child(at, "colour"));
   b.kind = kind_of(member(j, "kind", at), json_child(at, "kind"));
-  b.bearing = finite(member(j, "bearing", at), json_child(at, "bearing"));
-  b.left_bearing = finite(member(j, "left_bearing", at), json_child(at, "left_bearing"));
-  b.right_bearing = finite(member(j, "right_bearing", at), json_child(at, "right_bearing"));
+  b.bearing = angle(member(j, "bearing", at), json_child(at, "bearing"));
+  b.left_bearing = angle(member(j, "left_bearing", at), json_child(at, "left_bearing"));
+  b.right_bearing = angle(member(j, "right_bearing", at), json_child(at, "right_bearing"));
   const Json& d = member(j, "distance", at);
   if (!d.is_null()) {
-    b.distance = finite(d, json_child(at, "distance"));
+    b.distance = within(d, json_child(at, "distance"), 0.0, kMaxLength, "m");
     b.has_distance = true;
   }
   const Json& area = member(j, "area_px", at);
@@ -139,7 +168,7 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
   r.odometry.t = t;
   r.odometry.delta = pose(member(j, "odometry", at), json_child(at, "odometry"));
   const Json& h = member(j, "heading", at);
-  if (!h.is_null()) r.heading = finite(h, json_child(at, "heading"));
+  if (!h.is_null()) r.heading = angle(h, json_child(at, "heading"));
   r.obs.t = t;
   r.obs.camera_ok = boolean(member(j, "camera_ok", at), json_child(at, "camera_ok"));
   const std::string lp_at = json_child(at, "line_points");
@@ -148,10 +177,9 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
   r.obs.line_points.reserve(lp.size());
   for (std::size_t i = 0; i < lp.size(); ++i) {
     const Json& p = lp[i];
-    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number() || !std::isfinite(p[0].get<double>()) ||
-        !std::isfinite(p[1].get<double>()))
-      bad(json_child(lp_at, i), p, "[x, y]: two finite numbers, metres, robot frame");
-    r.obs.line_points.emplace_back(p[0].get<double>(), p[1].get<double>());
+    const std::string p_at = json_child(lp_at, i);
+    if (!p.is_array() || p.size() != 2) bad(p_at, p, "[x, y]: two finite numbers, metres, robot frame");
+    r.obs.line_points.emplace_back(length(p[0], json_child(p_at, std::size_t{0})), length(p[1], json_child(p_at, std::size_t{1})));
   }
   if (const auto b = j.find("blobs"); b != j.end()) {
     if (!b->is_array()) bad(json_child(at, "blobs"), *b, "an array of blobs");
@@ -160,8 +188,9 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
   if (const auto c = j.find("covered"); c != j.end()) r.covered = boolean(*c, json_child(at, "covered"));
   if (const auto c = j.find("camera"); c != j.end() && !c->is_null()) {
     if (!c->is_object()) bad(json_child(at, "camera"), *c, "{\"exposure_ms\", \"gain\"} or null");
-    r.settings = CameraSettings{finite(member(*c, "exposure_ms", json_child(at, "camera")), json_child(json_child(at, "camera"), "exposure_ms")),
-                                finite(member(*c, "gain", json_child(at, "camera")), json_child(json_child(at, "camera"), "gain"))};
+    const std::string c_at = json_child(at, "camera");
+    r.settings = CameraSettings{within(member(*c, "exposure_ms", c_at), json_child(c_at, "exposure_ms"), 0.0, kMaxExposureMs, "ms"),
+                                within(member(*c, "gain", c_at), json_child(c_at, "gain"), 0.0, kMaxGain, "gain units")};
   }
   if (const auto s = j.find("stop_robot"); s != j.end()) r.stop_robot = boolean(*s, json_child(at, "stop_robot"));
   if (const auto e = j.find("events"); e != j.end()) {
@@ -219,7 +248,7 @@ FrameData frame_from_json(const Json& j, const std::string& at, const std::vecto
   const Json& k = member(j, "k", at);
   if (!k.is_number_integer() || k.get<long long>() < 0) bad(json_child(at, "k"), k, "the frame number");
   f.k = k.get<long long>();
-  f.t = finite(member(j, "t", at), json_child(at, "t"));
+  f.t = within(member(j, "t", at), json_child(at, "t"), 0.0, kMaxTime, "s");
   if (const auto e = j.find("events"); e != j.end()) {
     if (!e->is_array()) bad(json_child(at, "events"), *e, "an array of event objects");
     for (std::size_t i = 0; i < e->size(); ++i) {
@@ -330,8 +359,9 @@ RecordingHeader RecordingHeader::read(const std::string& dir) {
   h.field = *field;
   if (const Json* m = r.raw("field_markings")) h.field_markings = *m;
   h.field_fingerprint = r.string("field_fingerprint", std::string());
-  h.camera_rate_hz = r.positive("camera_rate_hz", std::nullopt, 1000.0);
-  h.duration_s = r.number("duration_s", std::nullopt, 0.0, 1e6);
+  // The limits of a scenario's camera_rate and duration (docs/scenario.md): a replay runs one.
+  h.camera_rate_hz = r.number("camera_rate_hz", std::nullopt, 1.0, 200.0);
+  h.duration_s = r.positive("duration_s", std::nullopt, kMaxTime);
   h.frames = r.integer("frames", std::nullopt, 1, kMaxFrames);
   const Json* robots = r.raw("robots", true);
   if (!robots->is_array() || robots->empty()) throw ConfigError(r.child_path("robots"), json_brief(*robots), "a non-empty array of robots");
@@ -360,6 +390,12 @@ RecordingHeader RecordingHeader::read(const std::string& dir) {
   return h;
 }
 
+std::string recorded_with(const RecordingHeader& h) {
+  if (!h.omniloc.is_object()) return "not omniloc";
+  const auto v = h.omniloc.find("version");
+  return v != h.omniloc.end() && v->is_string() ? v->get<std::string>() : "unknown";
+}
+
 RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(header)) {
   const std::string file = (fs::path(header_.dir) / header_.frames_file).string();
   std::string text = read_text(file, kMaxFramesBytes);
@@ -382,7 +418,7 @@ RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(hea
     const std::string at = file + " line " + std::to_string(line_no);
     if (line_no > header_.frames) throw ConfigError(at, "another frame", std::to_string(header_.frames) + " frames (recording.json)");
     const Json j = parse_json_strict(std::string_view(text).substr(a, b - a), at);
-    FrameData f = frame_from_json(j, at, header_.robots, header_.ground_truth);
+    FrameData f = frame_from_json(j, at + " ", header_.robots, header_.ground_truth);  // "frames.jsonl line 6 /robots/0/heading"
     if (f.k != line_no - 1) throw ConfigError(at + " /k", std::to_string(f.k), "frame " + std::to_string(line_no - 1) + " (frames in order from 0)");
     if (!frames_.empty() && !(f.t > frames_.back().t)) throw ConfigError(at + " /t", std::to_string(f.t), "a time after the previous frame's");
     frames_.push_back(std::move(f));

@@ -58,7 +58,7 @@ struct RecordedRobot {
 struct RecordingHeader {
   std::string dir;          ///< the recording folder
   std::string format;
-  Json omniloc;             ///< the build that wrote it
+  Json omniloc;             ///< the build that wrote it, as given: anything in other writers' recordings
   std::string name;         ///< scenario name
   std::uint64_t seed = 0;
   Json scenario;            ///< the scenario as given (localizer included), null in a log not made by omniloc
@@ -78,6 +78,11 @@ struct RecordingHeader {
 
   static RecordingHeader read(const std::string& dir);
 };
+
+/// The omniloc version that wrote a recording, for a replay's provenance: the header's `omniloc`
+/// block gives it as a string `version`; other writers may put anything there (docs/recording.md):
+/// an object without a string version reads "unknown", anything else "not omniloc".
+std::string recorded_with(const RecordingHeader& header);
 
 /// Frames read back from a recording: every line of frames.jsonl is parsed and checked (and the
 /// image files of a recording with images found) in the constructor, so a truncated or corrupted

@@ -56,11 +56,15 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
 }
 
 FieldMap::Sample FieldMap::Table::off_table(Table t, double fx, double fy, bool gradient) {
-  // Just inside the last row / column, so the cell (i, i + 1) exists (1e-6 cells = 50 nm).
-  const double cx = std::clamp(fx, 0.0, t.last_x - 0.000001), cy = std::clamp(fy, 0.0, t.last_y - 0.000001);
+  // Just inside the last row / column, so the cell (i, i + 1) exists (1e-6 cells = 50 nm). Written so
+  // that NaN lands on cell (0, 0) (std::clamp passes NaN through, which then indexed far outside the
+  // table: a point at -1e308 m made -inf cells, a NaN gradient, a NaN pose and a crash). For every
+  // other value it is std::clamp.
+  const double cx = fx > 0.0 ? std::min(fx, t.last_x - 0.000001) : 0.0, cy = fy > 0.0 ? std::min(fy, t.last_y - 0.000001) : 0.0;
   Sample s = gradient ? t.interpolate<true>(cx, cy) : t.interpolate<false>(cx, cy);
   const double dx = fx - cx, dy = fy - cy;  // cells
-  const double out = std::sqrt(dx * dx + dy * dy);  // cells: no overflow to guard against, unlike hypot's cost
+  // Cells: points read from a recording lie within 50 m (docs/recording.md), so no overflow here.
+  const double out = std::sqrt(dx * dx + dy * dy);
   if (out > 0) {
     s.d += out * t.cell;  // off the table: farther from everything
     if (gradient) {

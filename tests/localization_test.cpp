@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -65,6 +66,46 @@ TEST(FieldMap, WorldAndCellLookupsAgreeAndACopyOwnsItsTable) {
       EXPECT_NEAR((copy.distance(p + Eigen::Vector2d(0, h)) - copy.distance(p - Eigen::Vector2d(0, h))) / (2 * h), g.y(), 1e-6);
     }
   }
+}
+
+// A line point at -1e308 m made -inf cells, a NaN gradient and then a NaN pose, whose lookup
+// (std::clamp passes NaN through) indexed far outside the table: SIGSEGV in matching and grid_global.
+// Any value now lands on the table; on the table and just off it nothing changes.
+TEST(FieldMap, LookupOfAnyValueStaysOnTheTable) {
+  const Field f = Field::preset("msl2012");
+  const FieldMap m(f, 0.05);
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double x : {nan, inf, -inf, 1e308, -1e308, -0.0, 0.0, 49.0})
+    for (const double y : {nan, inf, -inf, 1e308, -1e308, 0.0, -7.0}) {
+      Eigen::Vector2d g;
+      const double d = m.distance({x, y}, &g);  // must not crash; NaN in, NaN or a distance out
+      if (std::isfinite(x) && std::isfinite(y) && std::fabs(x) < 1e300 && std::fabs(y) < 1e300) {
+        EXPECT_TRUE(std::isfinite(d)) << x << ", " << y;
+        EXPECT_GE(d, 0.0);
+      }
+    }
+  // Off the table: the border's value plus the distance to it, as before.
+  const FieldMap::Table t = m.table();
+  EXPECT_DOUBLE_EQ(m.distance({-20, 3}), t.interpolate<false>(0.0, t.cells_y(3)).d + (0.0 - t.cells_x(-20)) * t.cell);
+}
+
+TEST(Matching, PointsAtAnyValueNeverCrashTheMatcher) {
+  const Field f = Field::preset("msl2012");
+  const FieldMap map(f, 0.05);
+  Rng rng(3);
+  const Pose2 truth(1.0, 0.5, 0.2);
+  const auto good = scenes::line_points(f, truth, 80, rng);
+  for (const double bad : {-1e308, 1e308, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    auto pts = good;
+    pts[0] = Eigen::Vector2d(bad, 0.5);
+    const MatchResult r = rprop_match(map, pts, truth, MatchingParams{}, 20);  // must return, whatever it found
+    (void)r;
+  }
+  // At the reader's limit (50 m, docs/recording.md) the lookup is finite and the match unharmed.
+  auto pts = good;
+  pts[0] = Eigen::Vector2d(-50.0, 50.0);
+  const MatchResult r = rprop_match(map, pts, truth, MatchingParams{}, 20);
+  EXPECT_LT(std::hypot(r.pose.x - truth.x, r.pose.y - truth.y), 0.05);
 }
 
 TEST(Matching, PairedAndSinglePointDataTermsAgree) {

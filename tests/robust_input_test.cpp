@@ -14,6 +14,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -364,4 +366,85 @@ TEST(RobustInput, SweepChildrenDieWithTheSweep) {
   for (int i = 0; i < 100 && (alive = running()); ++i) ::usleep(50000);
   EXPECT_FALSE(alive) << "child " << child << " outlived its sweep";
   if (alive) ::kill(child, SIGKILL);
+}
+
+namespace {
+
+// The hand-written recording (a log not made by omniloc) copied to a scratch folder, with `change`
+// applied to frame 3 (or to the header when `header` is set).
+std::string handwritten(const std::string& name, const std::function<void(Json&)>& change, bool header = false) {
+  const fs::path src = fs::path(OMNILOC_SOURCE_DIR) / "tests" / "data" / "handwritten_recording";
+  const fs::path dir = scratch(name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Json head = omniloc::parse_json_strict(omniloc::read_file((src / "recording.json").string()), "recording.json");
+  std::istringstream frames(omniloc::read_file((src / "frames.jsonl").string()));
+  std::string text, line;
+  for (int k = 0; std::getline(frames, line); ++k) {
+    if (k == 3 && !header) {
+      Json f = omniloc::parse_json_strict(line, "frame");
+      change(f);
+      line = f.dump();
+    }
+    text += line + "\n";
+  }
+  if (header) change(head);
+  std::ofstream(dir / "frames.jsonl", std::ios::binary) << text;
+  std::ofstream(dir / "recording.json", std::ios::binary) << head.dump(1);
+  return dir.string();
+}
+
+}  // namespace
+
+// A single line point at -1e308 m in one frame of a recording crashed matching and grid_global
+// (SIGSEGV); every number a recording carries is now range-checked where it is read
+// (docs/recording.md section 7): exit 2 naming the file, the line and the JSON path, nothing written.
+TEST(RobustInput, RecordingNumbersOutsideTheirLimitsAreExit2) {
+  const std::vector<std::pair<std::string, Json>> cases = {
+      {"/robots/0/line_points/0/0", -1e308}, {"/robots/0/line_points/1/1", 50.5}, {"/robots/0/odometry/0", 1e20},
+      {"/robots/0/odometry/2", -1000.5},     {"/robots/0/heading", 1e300},        {"/robots/0/truth/2", 2000.0},
+      {"/robots/0/truth/0", -51.0},          {"/t", 3600.5},                      {"/t", -0.5},
+      {"/robots/0/camera", Json{{"exposure_ms", 1e9}, {"gain", 1.0}}},             {"/robots/0/camera", Json{{"exposure_ms", 10.0}, {"gain", -1.0}}},
+      {"/robots/0/blobs", Json::array({Json{{"colour", "yellow"}, {"kind", "region"}, {"bearing", 0.1}, {"left_bearing", 0.2},
+                                            {"right_bearing", 1e9}, {"distance", 3.0}, {"area_px", 40}, {"left_occluded", false},
+                                            {"right_occluded", false}}})},
+  };
+  for (const auto& [path, value] : cases) {
+    const std::string dir = handwritten("bad_value", [&](Json& f) { f[Json::json_pointer(path)] = value; });
+    for (const char* localizer : {"matching", "grid_global", "mcl"}) {
+      const fs::path out = scratch("bad_value_out");
+      fs::remove_all(out);
+      std::string err;
+      EXPECT_EQ(cli_run("replay " + dir + " --localizer '{\"type\": \"" + localizer + "\"}' -o " + out.string() + " --quiet", &err), 2)
+          << path << " = " << value.dump() << " with " << localizer << ": " << err;
+      EXPECT_NE(err.find("frames.jsonl line 4 " + path), std::string::npos)
+          << "the error names the file, line and path: " << err;
+      EXPECT_FALSE(fs::exists(out)) << "nothing written";
+    }
+  }
+  // Just inside the limits: read, and every localizer survives them.
+  const std::string dir = handwritten("edge_values", [](Json& f) {
+    f["robots"][0]["line_points"].push_back(Json::array({-50.0, 50.0}));
+    f["robots"][0]["heading"] = -1000.0;
+    f["robots"][0]["odometry"] = Json::array({50.0, -50.0, 1000.0});
+  });
+  for (const char* localizer : {"matching", "grid_global", "mcl", "hybrid", "landmarks", "odometry_only"}) {
+    std::string err;
+    EXPECT_EQ(cli_run("replay " + dir + " --localizer '{\"type\": \"" + localizer + "\"}' -o " + scratch("edge_out").string() + " --overwrite --quiet", &err), 0)
+        << localizer << ": " << err;
+  }
+}
+
+// A recording.json whose `omniloc` block held {"version": 3} ended in a raw
+// [json.exception.type_error.302] (exit 1); docs/recording.md says other writers may put anything there.
+TEST(RobustInput, AnotherWritersOmnilocBlockIsIgnored) {
+  for (const Json& block : {Json{{"version", 3}}, Json(3), Json("x"), Json::array({1}), Json(nullptr), Json{{"build", "mine"}}}) {
+    const std::string dir = handwritten("omniloc_block", [&](Json& h) { h["omniloc"] = block; }, true);
+    const fs::path out = scratch("omniloc_block_out");
+    std::string err;
+    ASSERT_EQ(cli_run("replay " + dir + " --localizer '{\"type\": \"matching\"}' -o " + out.string() + " --overwrite --quiet", &err), 0)
+        << block.dump() << ": " << err;
+    const Json summary = omniloc::parse_json_strict(omniloc::read_file((out / "summary.json").string()), "summary.json");
+    EXPECT_EQ(summary["omniloc"]["replay"]["recorded_with"], block.is_object() ? "unknown" : "not omniloc") << block.dump();
+  }
 }
