@@ -5,7 +5,8 @@
 // localizer's client (docs/protocol.md): the olp/1 framing reader and the strict readers of ready and
 // estimate, where the only acceptable failure is a ProtocolError. Inputs that start with "rec\n" are a
 // recording (docs/recording.md): recording.json's text, a blank line, frames.jsonl's text, read by
-// the recording reader as `omniloc replay` reads it (only a ConfigError is acceptable). Every finding
+// the recording reader as `omniloc replay` reads it and, when it reads, replayed through a built-in
+// localizer (only a ConfigError is acceptable). Every finding
 // becomes a test in tests/robust_input_test.cpp.
 // Built by scripts/fuzz.sh (clang-14, -fsanitize=fuzzer,address,undefined); seed corpus: scenarios/.
 #include <unistd.h>
@@ -22,6 +23,7 @@
 #include "external/external_localizer.hpp"
 #include "external/olp_framing.hpp"
 #include "harness/recording.hpp"
+#include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "batch/sweep.hpp"
 
@@ -66,6 +68,23 @@ void fuzz_olp_stream(std::string_view bytes) {
   }
 }
 
+// A recording that reads is replayed through one built-in localizer, chosen by the input's length,
+// into a scratch run folder: its values (not only its structure) reach the localizers, as with
+// `omniloc replay` (a line point at -1e308 m once crashed matching and grid_global).
+void replay_recording(const std::string& dir, std::size_t choice) {
+  static const char* const kLocalizers[] = {"matching", "grid_global", "mcl", "hybrid", "landmarks", "odometry_only"};
+  using namespace omniloc;
+  harness::RecordingHeader header = harness::RecordingHeader::read(dir);
+  const Json localizer = {{"type", kLocalizers[choice % std::size(kLocalizers)]}};
+  const harness::Scenario sc = harness::replay_scenario(header, localizer);
+  harness::RecordingSource source(std::move(header));
+  harness::RunOptions o;
+  o.out_dir = sweep_dir() + "/replay";
+  o.replay = true;
+  std::filesystem::remove_all(o.out_dir);
+  (void)harness::run_frames(sc, source.header().seed, source, o, Json::object());
+}
+
 // A recording folder written from the input, then read and every frame taken, as a replay does.
 void fuzz_recording(std::string_view bytes) {
   const std::size_t sep = bytes.find("\n\n");
@@ -74,9 +93,12 @@ void fuzz_recording(std::string_view bytes) {
   std::ofstream(dir + "/recording.json", std::ios::binary | std::ios::trunc) << bytes.substr(0, sep);
   std::ofstream(dir + "/frames.jsonl", std::ios::binary | std::ios::trunc) << (sep == std::string_view::npos ? std::string_view() : bytes.substr(sep + 2));
   try {
-    omniloc::harness::RecordingSource source(omniloc::harness::RecordingHeader::read(dir));
-    while (source.next()) {
+    {
+      omniloc::harness::RecordingSource source(omniloc::harness::RecordingHeader::read(dir));
+      while (source.next()) {
+      }
     }
+    replay_recording(dir, bytes.size());
   } catch (const omniloc::ConfigError&) {
     // The expected outcome for a bad recording: exit 2 naming the file.
   }
