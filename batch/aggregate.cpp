@@ -30,16 +30,25 @@ double t975(std::size_t df) {
          (3 * std::pow(z, 7) + 19 * std::pow(z, 5) + 17 * z * z * z - 15 * z) / (384 * d * d * d);
 }
 
-void flatten(const Json& j, const std::string& prefix, std::map<std::string, double>& out) {
+// A run's metrics: its numbers by path ("r0/position_m/rmse"), and the paths whose value is null (a
+// statistic over no frame: no estimate), which a group counts instead of averaging.
+struct RunMetrics {
+  std::map<std::string, double> values;
+  std::set<std::string> nulls;
+};
+
+void flatten(const Json& j, const std::string& prefix, RunMetrics& out) {
   if (j.is_number()) {
-    out[prefix] = j.get<double>();
+    out.values[prefix] = j.get<double>();
+  } else if (j.is_null()) {
+    out.nulls.insert(prefix);
   } else if (j.is_object()) {
     for (auto it = j.begin(); it != j.end(); ++it) flatten(it.value(), prefix.empty() ? it.key() : prefix + "/" + it.key(), out);
   }
 }
 
-std::map<std::string, double> run_metrics(const Json& summary) {
-  std::map<std::string, double> m;
+RunMetrics run_metrics(const Json& summary) {
+  RunMetrics m;
   if (summary.contains("robots"))
     for (const auto& r : summary["robots"]) {
       Json copy = r;
@@ -125,6 +134,8 @@ struct Group {
   std::string scenario, localizer, params;
   std::size_t finished = 0, failed = 0, missing = 0;
   std::map<std::string, std::vector<double>> values;
+  std::map<std::string, std::size_t> no_value;  // runs whose value of the metric was null (no estimate)
+  std::string recall_key;          // the runs' headline recall threshold (summary.json scoring.headline)
   Json external;  // an external client's provenance (summary.json "external"), one entry per distinct client
   std::vector<std::string> names;  // the names an external client's runs recorded (summary.json "localizer"), distinct
   std::set<std::string> given;     // the runs' start_pose_given: "true", "false", "" (a run from before the key)
@@ -188,7 +199,11 @@ Census take_census(const SweepSpec& spec, const fs::path& dir) {
       } catch (const std::exception& e) {
         throw RuntimeFailure("cannot read the finished run " + r.id + ": " + e.what());
       }
-      for (const auto& [k, v] : run_metrics(s)) g.values[k].push_back(v);
+      const RunMetrics m = run_metrics(s);
+      for (const auto& [k, v] : m.values) g.values[k].push_back(v);
+      for (const auto& k : m.nulls) ++g.no_value[k];
+      if (g.recall_key.empty() && s.contains("scoring") && s["scoring"].is_object() && s["scoring"].contains("headline") && s["scoring"]["headline"].is_string())
+        g.recall_key = s["scoring"]["headline"].get<std::string>();
       name = run_name(r, s);
       given = given_text(s);
       g.given.insert(given);
@@ -228,19 +243,38 @@ std::string group_label(const Group& g, bool mark_given) {
   return g.scenario + " / " + g.localizer + mark + " / " + g.params;
 }
 
-// A group's line of the printed table, its name padded to `width`: robot 0's mean errors, its
-// position RMSE with interval.
+// A group's line of the printed table, its name padded to `width`: robot 0's recall at the headline
+// threshold and share of frames answered first (they count every frame, so they lead where
+// localizers stand side by side), then its mean errors over the answered frames and its position
+// RMSE with interval; "no estimate" where a statistic has no value in any run.
 std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, bool phased, bool mark_given, int width) {
-  auto m = [&](const std::string& k) {
-    const std::string key = phased ? "r0/tracking_phase/" + k : "r0/" + k;
-    return ivs.count(key) ? ivs[key].mean : NAN;
+  const std::string base = phased ? "r0/tracking_phase/" : "r0/";
+  auto cell = [&](const std::string& k, const char* format, double scale) {
+    const auto it = ivs.find(base + k);
+    if (it == ivs.end() || it->second.n == 0) return std::string(g.no_value.count(base + k) ? "no est." : "-");
+    char b[32];
+    std::snprintf(b, sizeof b, format, it->second.mean * scale);
+    return std::string(b);
   };
-  const std::string ci = ivs.count("r0/position_m/rmse") ? interval_text(ivs["r0/position_m/rmse"], 4) : "-";
+  std::string ci = "-";
+  if (const auto it = ivs.find("r0/position_m/rmse"); it != ivs.end() && it->second.n > 0) ci = interval_text(it->second, 4);
+  else if (g.no_value.count("r0/position_m/rmse")) ci = "no estimate";
+  if (const auto nv = g.no_value.find("r0/position_m/rmse"); nv != g.no_value.end() && ci != "no estimate")
+    ci += " (no estimate in " + std::to_string(nv->second) + " of " + std::to_string(g.finished) + " runs)";
   const std::string label = group_label(g, mark_given) + (phased ? " *" : "");
-  char line[512];
-  std::snprintf(line, sizeof line, " %4zu %4zu | %9.3f %9.3f %9.4f | %s\n", g.finished, g.failed, m("x_cm/mean"), m("y_cm/mean"),
-                m("theta_rad/mean"), ci.c_str());
+  char line[640];
+  std::snprintf(line, sizeof line, " %4zu %4zu | %8s %8s | %9s %9s %9s | %s\n", g.finished, g.failed,
+                g.recall_key.empty() ? "-" : cell("recall/" + g.recall_key, "%.1f%%", 100.0).c_str(), cell("valid_fraction", "%.1f%%", 100.0).c_str(),
+                cell("x_cm/mean", "%.3f", 1.0).c_str(), cell("y_cm/mean", "%.3f", 1.0).c_str(), cell("theta_rad/mean", "%.4f", 1.0).c_str(), ci.c_str());
   return label + std::string(static_cast<std::size_t>(std::max(0, width - static_cast<int>(label.size()))), ' ') + line;
+}
+
+// The headline threshold's name for the table's header: the groups', when they agree.
+std::string recall_header(const Census& c) {
+  std::set<std::string> keys;
+  for (const auto& g : c.groups)
+    if (!g.recall_key.empty()) keys.insert(g.recall_key);
+  return keys.size() == 1 ? *keys.begin() : keys.empty() ? "-" : "(mixed)";
 }
 
 // Aggregates every run of the sweep found finished in the folder, in run order: writes runs.csv and
@@ -248,7 +282,10 @@ std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, boo
 void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Census& census, AggregateOutcome& out) {
   // ci95_low / ci95_high hold what "interval" says (mean_ci95): t95, range (the seeds' min and max)
   // or none (n = 1: the value); "interval" is last so readers of the old columns read them as before.
-  std::string csv = "scenario,localizer,params,start_pose_given,metric,n,mean,ci95_low,ci95_high,interval\n";
+  // no_value: finished runs in which the metric was null (a statistic over no frame: no estimate);
+  // n counts the runs with a value, so n + no_value is every run that reports the metric. A metric
+  // without any value has empty mean and interval cells (null in aggregate.json), never 0.
+  std::string csv = "scenario,localizer,params,start_pose_given,metric,n,mean,ci95_low,ci95_high,interval,no_value\n";
   // expected / done / failed: a reader sees at once whether every run is in (done counts failed ones).
   Json agg{{"sweep", spec.name}, {"runs", spec.runs.size()}, {"expected", out.expected}, {"done", out.done}, {"failed", out.failed},
            {"complete", out.missing == 0}, {"omniloc", build_info_json()}, {"run_versions", census.run_versions},
@@ -259,9 +296,10 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
   const bool mark_given = kinds.count("true") && (kinds.count("false") || kinds.count("mixed"));
   int width = 44;  // the names' column: as wide as the longest name (with a phase's " *")
   for (const auto& g : census.groups) width = std::max(width, static_cast<int>(group_label(g, mark_given).size()) + 2);
-  char line[512];
-  std::snprintf(line, sizeof line, "%-*s %4s %4s | %9s %9s %9s | %-26s\n", width, "scenario / localizer / params", "ok", "fail", "mean x cm",
-                "mean y cm", "mean th", "position RMSE m (t95 for n>=5, else seeds' range)");
+  char line[640];
+  const std::string within = "in " + recall_header(census);
+  std::snprintf(line, sizeof line, "%-*s %4s %4s | %8s %8s | %9s %9s %9s | %-26s\n", width, "scenario / localizer / params", "ok", "fail",
+                within.c_str(), "answered", "mean x cm", "mean y cm", "mean th", "position RMSE m (t95 for n>=5, else seeds' range)");
   out.table = line;
   for (const auto& g : census.groups) {
     const std::string given = group_given(g);
@@ -269,11 +307,25 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
             {"finished", g.finished}, {"failed", g.failed}, {"missing", g.missing}, {"metrics", Json::object()}};
     if (!g.external.is_null()) gj["external"] = g.external;
     std::map<std::string, Interval> ivs;
-    for (const auto& [k, v] : g.values) {
-      const Interval iv = mean_ci95(v);
+    std::set<std::string> keys;
+    for (const auto& kv : g.values) keys.insert(kv.first);
+    for (const auto& kv : g.no_value) keys.insert(kv.first);
+    for (const auto& k : keys) {
+      const auto vit = g.values.find(k);
+      const Interval iv = vit == g.values.end() ? Interval{} : mean_ci95(vit->second);
+      const auto nit = g.no_value.find(k);
+      const std::size_t none = nit == g.no_value.end() ? 0 : nit->second;
       ivs[k] = iv;
-      gj["metrics"][k] = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}, {"interval", iv.kind}};
-      csv += csv_row({g.scenario, g.localizer, g.params, given, k, std::to_string(iv.n), fmt(iv.mean), fmt(iv.low), fmt(iv.high), iv.kind});
+      Json& mj = gj["metrics"][k];
+      if (iv.n > 0) {
+        mj = {{"n", iv.n}, {"mean", iv.mean}, {"ci95", {iv.low, iv.high}}, {"interval", iv.kind}};
+      } else {
+        mj = {{"n", 0}, {"mean", nullptr}, {"ci95", nullptr}, {"interval", kNoInterval}};
+      }
+      mj["no_value"] = none;
+      if (none > 0) mj["why"] = "no estimate in " + std::to_string(none) + " of " + std::to_string(none + iv.n) + " runs";
+      csv += csv_row({g.scenario, g.localizer, g.params, given, k, std::to_string(iv.n), iv.n ? fmt(iv.mean) : "", iv.n ? fmt(iv.low) : "",
+                      iv.n ? fmt(iv.high) : "", iv.kind, std::to_string(none)});
     }
     agg["groups"].push_back(gj);
     // Runs with kidnaps or covers: the tracking phase, as the papers' tables (marked "*").

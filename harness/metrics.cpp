@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/angles.hpp"
+#include "core/error.hpp"
 #include "harness/recovery.hpp"
 
 namespace omniloc::harness {
@@ -63,31 +65,98 @@ ErrorSummary summarize(const std::vector<FrameError>& errors) {
 }
 
 Json to_json(const ErrorSummary& s) {
-  auto axis = [](const AxisStats& a) { return Json{{"mean", a.mean}, {"std", a.std}, {"max", a.max}}; };
+  // Over no frame a statistic is not a number: null, never the zeros ErrorSummary holds.
+  const auto v = [&](double x) { return s.frames ? Json(x) : Json(nullptr); };
+  auto axis = [&](const AxisStats& a) { return Json{{"mean", v(a.mean)}, {"std", v(a.std)}, {"max", v(a.max)}}; };
   return Json{{"frames", s.frames},
               {"x_cm", axis(s.x_cm)},
               {"y_cm", axis(s.y_cm)},
               {"theta_rad", axis(s.theta_rad)},
-              {"position_m", {{"mean", s.pos_mean_m}, {"rmse", s.pos_rmse_m}, {"p50", s.pos_p50_m}, {"p90", s.pos_p90_m}, {"p95", s.pos_p95_m}, {"max", s.pos_max_m}}},
-              {"theta_rmse_rad", s.theta_rmse_rad}};
+              {"position_m", {{"mean", v(s.pos_mean_m)}, {"rmse", v(s.pos_rmse_m)}, {"p50", v(s.pos_p50_m)}, {"p90", v(s.pos_p90_m)}, {"p95", v(s.pos_p95_m)}, {"max", v(s.pos_max_m)}}},
+              {"theta_rmse_rad", v(s.theta_rmse_rad)}};
+}
+
+RecallThreshold Scoring::threshold(double position_m, double heading_deg) {
+  char key[64];
+  std::snprintf(key, sizeof key, "%gcm_%gdeg", position_m * 100.0, heading_deg);
+  return {position_m, heading_deg * kPi / 180.0, key};
+}
+
+std::vector<RecallThreshold> Scoring::default_recall() { return {threshold(0.10, 5), threshold(0.25, 10), threshold(0.50, 20)}; }
+
+Scoring Scoring::from_json(const Json& j, const std::string& path, Json* effective) {
+  Scoring sc;
+  JsonReader r(j, path, effective);
+  r.allow("comment");
+  if (const Json* rec = r.raw("recall")) {
+    const std::string at = r.child_path("recall");
+    if (!rec->is_array() || rec->empty() || rec->size() > 8)
+      throw ConfigError(at, json_brief(*rec), "1 to 8 thresholds [{\"position_m\": m, \"heading_deg\": deg}, ...]");
+    sc.recall.clear();
+    Json eff = Json::array();
+    for (std::size_t i = 0; i < rec->size(); ++i) {
+      Json e;
+      JsonReader t((*rec)[i], json_child(at, i), &e);
+      const double pos = t.positive("position_m", std::nullopt, 50.0);
+      const double deg = t.positive("heading_deg", std::nullopt, 180.0);
+      t.finish();
+      sc.recall.push_back(threshold(pos, deg));
+      for (std::size_t k = 0; k + 1 < sc.recall.size(); ++k)
+        if (sc.recall[k].key == sc.recall.back().key) throw ConfigError(json_child(at, i), sc.recall.back().key, "distinct thresholds");
+      eff.push_back(e);
+    }
+    if (effective) (*effective)["recall"] = eff;
+  } else if (effective) {
+    Json eff = Json::array();
+    for (const auto& t : sc.recall) eff.push_back({{"position_m", t.position_m}, {"heading_deg", t.heading_rad * 180.0 / kPi}});
+    (*effective)["recall"] = eff;
+  }
+  r.finish();
+  return sc;
+}
+
+Json recall_json(const std::vector<FrameError>& answered, std::size_t frames, const Scoring& scoring) {
+  Json j = Json::object();
+  for (const auto& t : scoring.recall) {
+    std::size_t in = 0;
+    for (const auto& e : answered) in += std::hypot(e.ex, e.ey) <= t.position_m && std::fabs(e.eth) <= t.heading_rad;
+    j[t.key] = frames ? Json(static_cast<double>(in) / static_cast<double>(frames)) : Json(nullptr);
+  }
+  return j;
 }
 
 std::string paper_table(const std::vector<TableRow>& rows) {
   std::size_t w = 4;
   for (const auto& r : rows) w = std::max(w, r.label.size());
+  const std::string recall_key = rows.empty() ? std::string() : rows.front().recall_key;
   std::string out;
-  char buf[512];
-  std::snprintf(buf, sizeof buf, "%-*s | %8s %8s %8s | %8s %8s %8s | %8s %8s %8s | %6s %8s %8s\n", static_cast<int>(w), "case",
-                "mean x", "mean y", "mean th", "std x", "std y", "std th", "max x", "max y", "max th", "frames", "rmse m", "p95 m");
+  char buf[640];
+  std::snprintf(buf, sizeof buf, "%-*s | %8s %8s %8s | %8s %8s %8s | %8s %8s %8s | %6s %8s %8s %8s | %s\n", static_cast<int>(w), "case",
+                "mean x", "mean y", "mean th", "std x", "std y", "std th", "max x", "max y", "max th", "frames", "answered", "rmse m",
+                "p95 m", "within");
   out += buf;
-  std::snprintf(buf, sizeof buf, "%-*s | %8s %8s %8s | %8s %8s %8s | %8s %8s %8s |\n", static_cast<int>(w), "", "cm", "cm", "rad",
-                "cm", "cm", "rad", "cm", "cm", "rad");
+  std::snprintf(buf, sizeof buf, "%-*s | %8s %8s %8s | %8s %8s %8s | %8s %8s %8s | %6s %8s %8s %8s | %s\n", static_cast<int>(w), "", "cm", "cm",
+                "rad", "cm", "cm", "rad", "cm", "cm", "rad", "", "", "", "", recall_key.c_str());
   out += buf;
   for (const auto& r : rows) {
     const auto& s = r.s;
-    std::snprintf(buf, sizeof buf, "%-*s | %8.3f %8.3f %8.3f | %8.3f %8.3f %8.3f | %8.3f %8.3f %8.3f | %6zu %8.3f %8.3f\n",
-                  static_cast<int>(w), r.label.c_str(), s.x_cm.mean, s.y_cm.mean, s.theta_rad.mean, s.x_cm.std, s.y_cm.std,
-                  s.theta_rad.std, s.x_cm.max, s.y_cm.max, s.theta_rad.max, s.frames, s.pos_rmse_m, s.pos_p95_m);
+    // The share of frames answered beside every error over answered frames; the recall counts them all.
+    char answered[32], recall[32];
+    if (r.frames_total) {
+      std::snprintf(answered, sizeof answered, "%7.1f%%", 100.0 * static_cast<double>(s.frames) / static_cast<double>(r.frames_total));
+      std::snprintf(recall, sizeof recall, "%.1f%%", 100.0 * r.recall);
+    } else {
+      std::snprintf(answered, sizeof answered, "%8s", "-");
+      std::snprintf(recall, sizeof recall, "-");
+    }
+    if (s.frames == 0) {
+      std::snprintf(buf, sizeof buf, "%-*s | %-84s | %6zu %8s %8s %8s | %s\n", static_cast<int>(w), r.label.c_str(),
+                    "no estimate: no error statistic", r.frames_total, answered, "-", "-", recall);
+    } else {
+      std::snprintf(buf, sizeof buf, "%-*s | %8.3f %8.3f %8.3f | %8.3f %8.3f %8.3f | %8.3f %8.3f %8.3f | %6zu %8s %8.3f %8.3f | %s\n",
+                    static_cast<int>(w), r.label.c_str(), s.x_cm.mean, s.y_cm.mean, s.theta_rad.mean, s.x_cm.std, s.y_cm.std,
+                    s.theta_rad.std, s.x_cm.max, s.y_cm.max, s.theta_rad.max, r.frames_total, answered, s.pos_rmse_m, s.pos_p95_m, recall);
+    }
     out += buf;
   }
   return out;
@@ -144,25 +213,55 @@ Json recovery_json(const std::vector<ScoredFrame>& scored, const std::vector<Epi
   return j;
 }
 
+// The coverage of a block of frames: the share answered and the recall at each threshold over all
+// `frames_total` frames; and its row of the terminal table.
+void add_coverage(const std::vector<FrameError>& answered, std::size_t frames_total, const Scoring& scoring, Json& j, TableRow& row) {
+  j["frames_total"] = frames_total;
+  j["valid_fraction"] = frames_total ? Json(static_cast<double>(answered.size()) / static_cast<double>(frames_total)) : Json(nullptr);
+  j["recall"] = recall_json(answered, frames_total, scoring);
+  if (answered.empty())  // the reason beside the nulls
+    j["why_null"] = frames_total ? "no estimate in any of the " + std::to_string(frames_total) + " scored frames" : std::string("no frame scored");
+  row.frames_total = frames_total;
+  row.recall_key = scoring.middle().key;
+  const Json& mid = j["recall"][row.recall_key];
+  row.recall = mid.is_number() ? mid.get<double>() : 0.0;
+}
+
+// When the localizer first answered, and first answered within the middle threshold (seconds from
+// the run's start; null: never). What a global start costs.
+void add_first_fix(const RobotRecord& robot, const Scoring& scoring, Json& rj) {
+  Json first = nullptr, within = nullptr;
+  const RecallThreshold& mid = scoring.middle();
+  for (const auto& r : robot.frames) {
+    if (!r.valid) continue;
+    if (first.is_null()) first = r.t;
+    if (std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y) <= mid.position_m && std::fabs(angle_diff(r.est.theta, r.truth.theta)) <= mid.heading_rad) {
+      within = r.t;
+      break;
+    }
+  }
+  rj["first_estimate_s"] = first;
+  rj["first_within_s"] = within;
+}
+
 }  // namespace
 
-RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& events, double duration) {
+RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& events, double duration, const Scoring& scoring) {
   RobotScore score;
   std::vector<FrameError> errors;
   std::vector<ScoredFrame> scored;
-  std::size_t valid = 0;
   for (const auto& r : robot.frames) {
     scored.push_back({r.t, r.truth, r.est, r.valid});
     if (!r.valid) continue;
-    ++valid;
     errors.push_back({r.t, r.est.x - r.truth.x, r.est.y - r.truth.y, angle_diff(r.est.theta, r.truth.theta)});
   }
   score.all = summarize(errors);
+  score.all_row.s = score.all;
   Json& rj = score.json;
   rj = to_json(score.all);
   rj["robot"] = robot.id;
-  rj["frames_total"] = robot.frames.size();
-  rj["valid_fraction"] = robot.frames.empty() ? 0.0 : static_cast<double>(valid) / robot.frames.size();
+  add_coverage(errors, robot.frames.size(), scoring, rj, score.all_row);
+  add_first_fix(robot, scoring, rj);
   add_frame_statistics(robot, rj);
   const auto kidnaps = episodes(events, robot.id, duration, [](const Event& e) { return e.as<Kidnap>() != nullptr; });
   if (!kidnaps.empty()) rj["recovery"] = recovery_json(scored, kidnaps);
@@ -172,7 +271,9 @@ RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& event
   if (!disruptions.empty()) {
     const PhaseSplit split = split_tracking_phase(scored, disruptions);
     score.tracking_phase = summarize(split.tracking);
+    score.tracking_row.s = *score.tracking_phase;
     Json tp = to_json(*score.tracking_phase);
+    add_coverage(split.tracking, split.frames, scoring, tp, score.tracking_row);
     tp["excluded_s"] = split.excluded_s;
     Json iv = Json::array();
     for (const auto& [a, b] : split.excluded) iv.push_back({a, b});

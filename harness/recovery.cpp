@@ -68,9 +68,10 @@ PhaseSplit split_tracking_phase(const std::vector<ScoredFrame>& frames, const st
     p.excluded_s += std::max(0.0, end - e.t_kidnap);
   }
   for (const auto& f : frames) {
-    if (!f.valid) continue;
     const bool out = std::any_of(p.excluded.begin(), p.excluded.end(), [&](const auto& iv) { return f.t >= iv.first - 1e-9 && f.t < iv.second - 1e-9; });
-    if (!out) p.tracking.push_back({f.t, f.est.x - f.truth.x, f.est.y - f.truth.y, angle_diff(f.est.theta, f.truth.theta)});
+    if (out) continue;
+    ++p.frames;
+    if (f.valid) p.tracking.push_back({f.t, f.est.x - f.truth.x, f.est.y - f.truth.y, angle_diff(f.est.theta, f.truth.theta)});
   }
   return p;
 }
@@ -89,14 +90,17 @@ Json recovery_summary(const std::vector<EpisodeResult>& results) {
     mir += r.mirrored;
   }
   Json j{{"episodes", results.size()}, {"recovered", rec},
-         {"recovered_fraction", results.empty() ? 0.0 : static_cast<double>(rec) / results.size()},
+         {"recovered_fraction", results.empty() ? Json(nullptr) : Json(static_cast<double>(rec) / results.size())},
          {"false_recoveries", fals}, {"mirrored", mir}};
   if (!times.empty()) {
     double s = 0;
     for (double t : times) s += t;
     j["recovery_time_s"] = {{"median", percentile(times, 50)}, {"mean", s / times.size()}, {"max", *std::max_element(times.begin(), times.end())}};
+  } else {  // no episode recovered: no time to state (null, never absent, so that a gate sees it)
+    j["recovery_time_s"] = {{"median", nullptr}, {"mean", nullptr}, {"max", nullptr}};
   }
   j["after_recovery"] = to_json(summarize(after));
+  if (after.empty()) j["after_recovery"]["why_null"] = rec ? "no frame with an estimate after recovery" : "no kidnap recovered";
   return j;
 }
 

@@ -49,6 +49,7 @@ EpisodeResult score_episode(const std::vector<ScoredFrame>& frames, const Episod
 /// while the robot was carried or blind, and until it found itself again, are the recovery metrics'.
 struct PhaseSplit {
   std::vector<FrameError> tracking;                  ///< errors of the valid frames kept
+  std::size_t frames = 0;                            ///< every frame kept, with an estimate or not
   std::vector<std::pair<double, double>> excluded;   ///< [from, to) seconds, one per disruption ("to" past the run's end: never recovered)
   double excluded_s = 0.0;                           ///< total excluded time within the run, seconds
 };

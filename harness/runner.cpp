@@ -120,6 +120,9 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   summary["noise_profile"] = sc.noise.name;
   summary["duration_s"] = sc.duration;
   summary["camera_rate_hz"] = sc.camera_rate;
+  // The recall thresholds every robot's "recall" block uses, and the one tables lead with.
+  summary["scoring"] = {{"recall", sc.effective.contains("scoring") ? sc.effective["scoring"]["recall"] : Json::array()},
+                        {"headline", sc.scoring.middle().key}};
   summary["omniloc"] = build_info_json();  // provenance; the regression gates compare everything else
   summary["omniloc"]["host"] = host_info_json();  // the machine the run ran on (reports quote it)
   // The renderer (OSMesa and a GPU draw slightly different pixels, docs/camera.md "GPUs") and, for a
@@ -143,12 +146,16 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
       continue;
     }
     dir.write("gt" + suffix + ".tum", truth_tum(rec));
-    const RobotScore score = score_robot(rec, sc.events, sc.duration);
+    RobotScore score = score_robot(rec, sc.events, sc.duration, sc.scoring);
     result.robots.push_back({rec.id, score.all, rec.frames.size(), score.all.frames});
     summary["robots"].push_back(score.json);
     const std::string label = sc.name + " r" + std::to_string(rec.id) + " " + localizer;
-    rows.push_back({label + (score.tracking_phase ? " (all frames)" : ""), score.all});
-    if (score.tracking_phase) rows.push_back({label + " (tracking phase)", *score.tracking_phase});
+    score.all_row.label = label + (score.tracking_phase ? " (all frames)" : "");
+    rows.push_back(score.all_row);
+    if (score.tracking_phase) {
+      score.tracking_row.label = label + " (tracking phase)";
+      rows.push_back(score.tracking_row);
+    }
   }
   dir.write("frames.csv", frames_csv(records));
   dir.write("timing.csv", timing_csv(records));

@@ -351,6 +351,12 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   external::anchor_external_paths(s.localizer);
 
   read_camera_and_vision(r, s);
+  {
+    Json eff = Json::object();
+    const Json* sc = r.raw("scoring");
+    s.scoring = Scoring::from_json(sc ? *sc : Json::object(), "/scoring", &eff);
+    s.effective["scoring"] = eff;
+  }
   r.finish();
   validate_deep(s);
   return s;

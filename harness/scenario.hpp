@@ -10,6 +10,7 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
+#include "harness/metrics.hpp"
 #include "harness/events.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/sensors.hpp"
@@ -58,6 +59,7 @@ struct Scenario {
   sim::OcclusionMask occlusion;     ///< for the whole run (paper 002 table 1)
   sim::Lighting lighting;           ///< at t = 0
   std::vector<Eigen::Vector2d> sun_velocity;  ///< m/s per sun patch (sun moving slowly)
+  Scoring scoring;           ///< recall thresholds (docs/results.md "Coverage and recall")
   Json localizer;            ///< {"type": ..., params}
   Json camera;               ///< camera configuration (profile defaults merged)
   Json vision;               ///< vision front-end configuration (calibration, colour table, scan lines)

@@ -165,6 +165,12 @@ Json scenario_schema() {
       {"localizer", localizer_schema()},
       {"camera", camera_schema()},
       {"vision", vision_schema()},
+      {"scoring", object_of({{"recall", {{"type", "array"},
+                                          {"minItems", 1},
+                                          {"maxItems", 8},
+                                          {"items", object_of({{"position_m", number("metres (> 0, <= 50)")}, {"heading_deg", number("degrees (> 0, <= 180)")}},
+                                                              "a frame within both counts as localized")}}}},
+                            "recall thresholds (docs/results.md); default 10 cm / 5 deg, 25 cm / 10 deg, 50 cm / 20 deg")},
   };
   Json s = object_of(props, "an omniloc scenario (docs/scenario.md)");
   s["$schema"] = "https://json-schema.org/draft/2020-12/schema";

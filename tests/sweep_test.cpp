@@ -216,14 +216,17 @@ TEST(Sweep, CsvFilesAreValidWithJsonObjectParameters) {
   const auto runs = parse_csv(read_file((test_dir() / "csv" / "runs.csv").string()));
   EXPECT_EQ(runs[1][4], spec.runs[0].params_label);
   EXPECT_NE(runs[1][4].find("odometry={\"trans_sigma\":0.01}"), std::string::npos) << runs[1][4];
-  // Issue 38: every row names its interval kind (last column, so old readers of ci95_low / ci95_high
-  // read them as before); kind follows n; a non-negative metric never has a negative bound.
+  // Every row names its interval kind, then how many runs had no value (columns added at the end, so
+  // old readers of ci95_low / ci95_high read them as before); kind follows n; a non-negative metric
+  // never has a negative bound. Dead reckoning answers every frame: no run lacks a value.
   const auto agg = parse_csv(read_file((test_dir() / "csv" / "aggregate.csv").string()));
-  ASSERT_EQ(agg[0].back(), "interval");
+  ASSERT_EQ(agg[0][9], "interval");
+  ASSERT_EQ(agg[0].back(), "no_value");
   ASSERT_EQ(agg[0][7], "ci95_low");
   for (std::size_t i = 1; i < agg.size(); ++i) {
     const std::size_t n = std::stoul(agg[i][5]);
-    EXPECT_EQ(agg[i].back(), n >= kMinTSeeds ? kT95Interval : n >= 2 ? kRangeInterval : kNoInterval) << agg[i][4];
+    EXPECT_EQ(agg[i][9], n >= kMinTSeeds ? kT95Interval : n >= 2 ? kRangeInterval : kNoInterval) << agg[i][4];
+    EXPECT_EQ(agg[i].back(), "0") << agg[i][4];
     if (agg[i][4].find("_cm/") != std::string::npos || agg[i][4].find("position_m/") != std::string::npos) {
       EXPECT_GE(std::stod(agg[i][7]), 0.0) << agg[i][4];
     }
