@@ -10,6 +10,11 @@
 # the check falls back to the package unpacked with dpkg -x and run on this machine's libraries,
 # which tests the layout but not the Depends line. The whole log goes to LOG; its tail is printed.
 # OMNILOC_CLEAN_ROOT_MIRROR: another Debian mirror (default http://deb.debian.org/debian).
+# OMNILOC_CLEAN_ROOT_CACHE: a folder that keeps the root's downloaded .debs between runs (default
+# /var/cache/omniloc/clean-root-debs; empty: no cache). apt still reads the mirror's package lists
+# and takes a cached .deb only when its version and checksum are the ones listed, so the root is
+# what a fresh download would give; the cache only saves the ~270 MB download. Over 2 GiB (old
+# versions piling up) it is emptied first.
 set -euo pipefail
 case "${1:-}" in -h | --help | "") sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; [ -n "${1:-}" ] && exit 0; exit 2 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
@@ -77,8 +82,18 @@ if [ -z "$why" ]; then
   # Hooks run on this machine with the root as $1; mmdebstrap mounts /proc, /dev and /sys for them
   # (share_dir() reads /proc/self/exe). The first hook marks that the root itself could be made, so a
   # failure after it is the package's, not this machine's. Format null: the root is deleted at the end.
+  cache=${OMNILOC_CLEAN_ROOT_CACHE-/var/cache/omniloc/clean-root-debs}
+  cache_opts=()
+  if [ -n "$cache" ] && mkdir -p "$cache" 2>/dev/null; then
+    [ "$(du -sm "$cache" | cut -f1)" -le 2048 ] || rm -f "$cache"/*.deb
+    say "download cache: $cache ($(find "$cache" -name '*.deb' | wc -l) .debs, $(du -sh "$cache" | cut -f1))"
+    # essential/unlink kept: the essential packages' .debs stay in the root's archive for sync-out.
+    cache_opts=(--skip=essential/unlink
+                --setup-hook='mkdir -p "$1"/var/cache/apt/archives/'
+                --setup-hook="sync-in '$cache' /var/cache/apt/archives/")
+  fi
   rc=0
-  mmdebstrap --variant=apt --mode=root --format=null \
+  mmdebstrap --variant=apt --mode=root --format=null "${cache_opts[@]}" \
     --customize-hook="touch '$work/root-ready'" \
     --customize-hook="copy-in '$deb' /tmp" \
     --customize-hook="copy-in '$work/inside.sh' /tmp" \
@@ -87,7 +102,10 @@ if [ -z "$why" ]; then
     --customize-hook='test ! -e "$1'"$PWD"'" && echo "clean-root: no source tree in the root ('"$PWD"' absent)"' \
     --customize-hook='chroot "$1" bash /tmp/inside.sh' \
     --customize-hook="bash '$work/recipe_hook.sh' \"\$1\"" \
+    ${cache_opts[@]:+--customize-hook="sync-out /var/cache/apt/archives '$cache'"} \
     bookworm /dev/null "$mirror" >>"$log" 2>&1 || rc=$?
+  # The package under test is never part of the cache.
+  [ ${#cache_opts[@]} -eq 0 ] || rm -f "$cache"/omniloc_*.deb
   if [ $rc -eq 0 ]; then
     say "passed in a clean Debian 12 root ($((SECONDS - t0)) s in all)"
     finish 0
