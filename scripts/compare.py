@@ -16,6 +16,13 @@ recorded start_pose_given pair as before. The text output fits 100 columns; --ma
 Welch's unequal-variance t-test over the seeds; "yes" where p < alpha (default 0.05), i.e. the
 difference exceeds the seed-to-seed spread. With fewer than two seeds on a side there is no spread
 to compare with, and the difference is shown alone ("n < 2"). Identical numbers give "same".
+
+Coverage first: each condition's metrics start with the recall at the headline threshold
+(recall/25cm_10deg: the share of ALL scored frames within 25 cm and 10 deg, a frame without an
+estimate counting as outside) and the share of frames answered (valid_fraction); the errors
+(position RMSE, mean x / y / heading, ...) follow and are over the answered frames only. A
+statistic that is null in some run (no estimate: no frame answered) is never averaged away: its
+row says "no estimate in k of n runs" for that side instead of a t-test on the remaining seeds.
 Exit code 0; 2 on bad arguments or folders without results.
 """
 import argparse
@@ -27,11 +34,29 @@ import textwrap
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import omniloc_results as R  # noqa: E402
 
-METRICS = ["x_cm/mean", "y_cm/mean", "theta_rad/mean", "position_m/mean", "position_m/rmse", "position_m/p95", "line_points/mean", "wrong_frames",
+# After the coverage metrics (recall at the headline threshold, valid_fraction: metrics_for), in this order.
+METRICS = ["position_m/rmse", "x_cm/mean", "y_cm/mean", "theta_rad/mean", "position_m/mean", "position_m/p95", "line_points/mean", "wrong_frames",
            "coasting_frames", "recovery/recovered", "recovery/recovery_time_s/median"]
-EXPLANATION = ("Runs pair by scenario, localizer and effective configuration (not by folder or position); numbers are robot 0's, "
-               "tracking phase where a run has one. 'exceeds spread': Welch's t-test over seeds, p < alpha; n < 2: no spread to compare with.")
+COVERAGE = "valid_fraction"
 ALPHA = 0.05
+EXPLANATION = ("Runs pair by scenario, localizer and effective configuration (not by folder or position); numbers are robot 0's, "
+               "tracking phase where a run has one. recall/T: share of all scored frames within threshold T (a frame without an estimate "
+               "counts as outside); valid_fraction: share of frames answered; the errors after them are over answered frames only. "
+               "'no estimate in k of n runs': the statistic is null there (no frame answered), so no t-test is made. "
+               "'exceeds spread': Welch's t-test over seeds, p < alpha; n < 2: no spread to compare with.")
+
+
+def metrics_for(runs, metrics=None):
+    """The metrics of a pair of conditions, coverage first: recall at the runs' headline threshold,
+    the share answered (valid_fraction), then `metrics` (default METRICS: the errors over answered
+    frames, position RMSE first), then the other recall thresholds and the time to the first
+    estimate within the headline threshold. Runs from before recall was scored: `metrics` alone."""
+    metrics = list(METRICS if metrics is None else metrics)
+    head = R.headline_key(runs)
+    if head is None:
+        return [COVERAGE] + metrics if any(r.lookup(COVERAGE)[0] for r in runs) and COVERAGE not in metrics else metrics
+    others = [f"recall/{k}" for k in R.recall_keys(runs) if k != head]
+    return [f"recall/{head}", COVERAGE] + [m for m in metrics if m != COVERAGE] + others + ["first_within_s"]
 
 
 def group_key(run):
@@ -96,11 +121,17 @@ def groups(runs):
     return g
 
 
-def verdict(w, a, b, alpha):
+def verdict(w, a, b, alpha, none_a=0, none_b=0, of_a=0, of_b=0):
+    """'yes' / 'no' (Welch, p < alpha), 'n < 2', 'same', '-'; where a side has runs without a value
+    (no estimate), no test is made and the verdict names them: 'no estimate in 1 of 3 runs (B)'."""
+    if none_a or none_b:
+        if (none_a, of_a) == (none_b, of_b):
+            return f"{R.no_estimate_text(none_a, of_a)} (A and B)"
+        return "; ".join(f"{R.no_estimate_text(k, n)} ({side})" for side, k, n in (("A", none_a, of_a), ("B", none_b, of_b)) if k)
+    if len(a) == len(b) and a and all(x == y for x, y in zip(sorted(a), sorted(b))):
+        return "same"
     if w["diff"] is None:
         return "-"
-    if all(x == y for x, y in zip(sorted(a), sorted(b))) and len(a) == len(b):
-        return "same"
     if w["p"] is None:
         return "n < 2"
     return "yes" if w["p"] < alpha else "no"
@@ -176,7 +207,7 @@ def compare_rows(runs_a, runs_b, alpha=ALPHA, metrics=METRICS):
     for ka, kb, diffs in pairs:
         label = names[ka] + (f" (A vs B: {'; '.join(diffs)})" if diffs else "")
         for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, metrics):
-            rows.append([label, m, R.fnum(sa["mean"], 4), sa["n"], R.fnum(sb["mean"], 4), sb["n"],
+            rows.append([label, m, mean_text(sa), sa["n"], mean_text(sb), sb["n"],
                          R.fnum(w["diff"], 4), R.fnum(w["p"], 3) if w["p"] is not None else "-", v])
     for k in only_a:
         why = unpaired_reason(k, gb)
@@ -195,14 +226,24 @@ def side_labels(ga, gb):
     return names
 
 
-def metric_rows(ra, rb, alpha, metrics):
-    for m in metrics:
-        a = [x for x in (r.metric(m) for r in ra) if isinstance(x, (int, float))]
-        b = [x for x in (r.metric(m) for r in rb) if isinstance(x, (int, float))]
-        if not a and not b:
+def mean_text(st, digits=4):
+    """A side's mean over seeds; 'no estimate' where every run has the statistic null."""
+    return R.NO_ESTIMATE if not st["n"] and st.get("no_value") else R.fnum(st["mean"], digits)
+
+
+def metric_rows(ra, rb, alpha, metrics=None):
+    """(metric, stats A, stats B, Welch, verdict) per metric that either side has (metrics_for's
+    order: coverage first). stats are R.run_stats: n counts the runs with a value, no_value those
+    where it is null. No difference and no test where a side has runs without a value."""
+    for m in metrics_for(list(ra) + list(rb), metrics):
+        sa, sb = R.run_stats(ra, m), R.run_stats(rb, m)
+        if not sa["of"] and not sb["of"]:
             continue
-        sa, sb, w = R.stats(a), R.stats(b), R.welch(a, b)
-        yield m, sa, sb, w, verdict(w, a, b, alpha)
+        a, b = sa["values"], sb["values"]
+        w = R.welch(a, b)
+        if sa["no_value"] or sb["no_value"]:
+            w = {"diff": None, "t": None, "df": None, "p": None}
+        yield m, sa, sb, w, verdict(w, a, b, alpha, sa["no_value"], sb["no_value"], sa["of"], sb["of"])
 
 
 def print_text(runs_a, runs_b, alpha, width=100):
@@ -219,9 +260,12 @@ def print_text(runs_a, runs_b, alpha, width=100):
         for d in diffs:
             print(wrap("differs: " + d, "  "))
         print(line(head))
-        for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, METRICS):
-            print(line([m, R.fnum(sa["mean"], 4), str(sa["n"]), R.fnum(sb["mean"], 4), str(sb["n"]), R.fnum(w["diff"], 4),
-                        R.fnum(w["p"], 3) if w["p"] is not None else "-", v]))
+        for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha):
+            short = v if len(v) <= widths[-1] else "no test"  # the runs without a value: on a line of their own
+            print(line([m, mean_text(sa), str(sa["n"]), mean_text(sb), str(sb["n"]), R.fnum(w["diff"], 4),
+                        R.fnum(w["p"], 3) if w["p"] is not None else "-", short]))
+            if short != v:
+                print(wrap(v, "    "))
         print()
     for side, keys, g, other in (("A", only_a, ga, gb), ("B", only_b, gb, ga)):
         for k in keys:

@@ -14,8 +14,15 @@ seed-to-seed spread (Welch's t-test over seeds, p < alpha, default 0.05; with fe
 on a side there is no spread, and any worsening beyond the tolerance counts).
 
 Metrics are spelled as in aggregate.csv's metric column: "r0/position_m/rmse" (robot 0's all-frames
-RMSE), "r0/tracking_phase/position_m/rmse", or a sweep-level metric; without an "r<N>/" prefix, a
-name that is not a sweep-level metric means robot 0's.
+RMSE), "r0/tracking_phase/position_m/rmse", "r0/recall/25cm_10deg" (the share of all scored frames
+within 25 cm and 10 deg), or a sweep-level metric; without an "r<N>/" prefix, a name that is not a
+sweep-level metric means robot 0's.
+
+No estimate: a statistic over zero answered frames is null in summary.json (never 0). A rule whose
+metric is null in any run of a group FAILS that group, "no estimate in N of M runs", whatever its
+limits, and so does a regression check: a run without estimates never passes an accuracy limit.
+recall/..., valid_fraction and recovered_fraction are higher-is-better: a rule on them regresses
+when they fall (unless the rule says "better").
 
 Exit 0 when every rule holds, 1 when any limit or regression fails, 2 on bad input (a missing or
 incomplete result folder, bad rules, an unknown metric, a rule that selects nothing) before any
@@ -35,6 +42,8 @@ import omniloc_results as R  # noqa: E402
 
 ALPHA = 0.05
 STATS = ("mean", "median", "max", "min")
+# Metrics where a larger value is the better one: a regression is a fall (the rule's "better" default).
+HIGHER_IS_BETTER = ("recall", "valid_fraction", "recovered_fraction")
 RULE_KEYS = {"metric", "max", "min", "scenario", "localizer", "stat", "better", "tolerance", "tolerance_fraction", "name", "comment"}
 
 
@@ -90,7 +99,7 @@ def load_rules(path, have_baseline):
         r["stat"] = rule.get("stat", "mean")
         if r["stat"] not in STATS:
             raise BadInput(f"{where}/stat: got {json.dumps(r['stat'])}, expected one of {', '.join(STATS)}")
-        better = rule.get("better", "higher" if r["min"] is not None and r["max"] is None else "lower")
+        better = rule.get("better", "higher" if higher_is_better(r["metric"]) or (r["min"] is not None and r["max"] is None) else "lower")
         if better not in ("lower", "higher"):
             raise BadInput(f"{where}/better: got {json.dumps(better)}, expected \"lower\" or \"higher\"")
         r["better"] = better
@@ -104,17 +113,27 @@ def load_rules(path, have_baseline):
     return out
 
 
+def higher_is_better(metric):
+    """Whether a larger value of `metric` is better: recall at a threshold ("r0/recall/25cm_10deg"),
+    the share of frames answered (valid_fraction) and of kidnaps recovered (recovered_fraction)."""
+    parts = metric.strip("/").split("/")
+    return "recall" in parts[:-1] or parts[-1] in HIGHER_IS_BETTER
+
+
 # ---- metrics ------------------------------------------------------------------------------------
 
 def run_metrics(summary):
     """Every number of a summary.json under its aggregate.csv name (batch/aggregate.cpp run_metrics):
-    "r<robot>/<path>" for the robots' blocks, "<path>" for the sweep-level "metrics" block."""
+    "r<robot>/<path>" for the robots' blocks, "<path>" for the sweep-level "metrics" block. A null
+    (a statistic over no answered frame) is kept as None: the metric exists and has no value."""
     out = {}
 
     def flat(obj, prefix):
         if isinstance(obj, bool):
             return
-        if isinstance(obj, (int, float)):
+        if obj is None:
+            out[prefix] = None
+        elif isinstance(obj, (int, float)):
             out[prefix] = float(obj)
         elif isinstance(obj, dict):
             for k, v in obj.items():
@@ -145,12 +164,25 @@ def metrics_of(run):
 
 
 def seed_values(runs, metric):
-    vals = []
+    """The values of `metric` over the runs that have one (see seed_counts for the others)."""
+    return seed_counts(runs, metric)[0]
+
+
+def seed_counts(runs, metric):
+    """(values, no_value, of): the numbers, how many runs have the metric null (no estimate), and how
+    many have it at all (a run made before the metric existed counts in neither)."""
+    vals, no_value, of = [], 0, 0
     for r in runs:
-        v = metrics_of(r).get(metric)
-        if v is not None and not math.isnan(v):
+        m = metrics_of(r)
+        if metric not in m:
+            continue
+        of += 1
+        v = m[metric]
+        if v is None or math.isnan(v):
+            no_value += 1
+        else:
             vals.append(v)
-    return vals
+    return vals, no_value, of
 
 
 def statistic(values, stat):
@@ -205,17 +237,19 @@ def judge(rules, runs, base_runs, alpha):
                            f"selects no group of the results; they hold: {'; '.join(have)}")
         paired_any = False
         for k in keys:
-            vals = seed_values(groups[k], metric)
-            if not vals:
+            vals, no_value, of = seed_counts(groups[k], metric)
+            if not of:
                 raise BadInput(f"rule {rule['index']}: no run of {names[k]} has the metric {metric}")
-            c = {"rule": rule, "metric": metric, "key": k, "label": names[k], "values": vals,
+            c = {"rule": rule, "metric": metric, "key": k, "label": names[k], "values": vals, "no_value": no_value, "of": of,
                  "value": statistic(vals, rule["stat"]), "interval": R.interval(vals), "failures": [], "notes": []}
+            if no_value:  # a run without estimates never passes: whatever the limits and the baseline
+                c["failures"].append((NO_ESTIMATE, R.no_estimate_text(no_value, of)))
             check_limits(c)
             if base_runs is not None:
                 if k in pair_of:
                     paired_any = True
                     ka, diffs = pair_of[k]
-                    check_regression(c, seed_values(base_groups[ka], metric), diffs, alpha)
+                    check_regression(c, seed_counts(base_groups[ka], metric), diffs, alpha)
                 else:
                     c["notes"].append("no baseline counterpart: regression not checked")
                     c["regression"] = None
@@ -225,18 +259,30 @@ def judge(rules, runs, base_runs, alpha):
     return checks
 
 
+NO_ESTIMATE = "no estimate"  # the kind of failure of a metric that is null in some run
+
+
 def check_limits(c):
     r, v = c["rule"], c["value"]
+    if v is None:  # no run has a value: failed already (no estimate)
+        return
     if r["max"] is not None and v > r["max"]:
         c["failures"].append(("limit", f"{r['stat']} {v:.6g} > max {r['max']:.6g}"))
     if r["min"] is not None and v < r["min"]:
         c["failures"].append(("limit", f"{r['stat']} {v:.6g} < min {r['min']:.6g}"))
 
 
-def check_regression(c, base_vals, diffs, alpha):
+def check_regression(c, base, diffs, alpha):
+    """Regression of check `c` against the baseline's (values, no_value, of). A candidate without an
+    estimate in some run has failed already; a baseline without one in some run is compared on the
+    runs that have one, and the line says how many had none."""
     r = c["rule"]
-    if not base_vals:
-        c["notes"].append("the baseline group has no value of this metric: regression not checked")
+    base_vals, base_none, base_of = base
+    if base_none:
+        c["notes"].append(f"baseline: {R.no_estimate_text(base_none, base_of)}")
+    if not base_vals or c["value"] is None:
+        if not base_vals:
+            c["notes"].append("the baseline group has no value of this metric: regression not checked")
         c["regression"] = None
         return
     b = statistic(base_vals, r["stat"])
@@ -266,16 +312,27 @@ def rule_text(r):
     return " and ".join(limits) if limits else f"no worse than baseline ({r['better']} is better)"
 
 
+def value_text(c):
+    """'mean 0.0453 (n=5)', or 'no estimate (n=0 of 1)' where no run has a value."""
+    if c["value"] is None:
+        return f"no estimate (n=0 of {c['of']})"
+    return f"{c['rule']['stat']} {c['value']:.6g} (n={len(c['values'])}" + (f" of {c['of']}" if c.get("no_value") else "") + ")"
+
+
+def failure_text(kind, msg):
+    return msg if kind == NO_ESTIMATE else f"{kind}: {msg}"
+
+
 def line(c):
     r = c["rule"]
     verdict = "FAIL" if c["failures"] else "PASS"
-    s = f"{verdict}  {c['label']}  {c['metric']}  {r['stat']} {c['value']:.6g} (n={len(c['values'])})  limit {rule_text(r)}"
+    s = f"{verdict}  {c['label']}  {c['metric']}  {value_text(c)}  limit {rule_text(r)}"
     reg = c.get("regression")
     if reg:
         p = "-" if reg["p"] is None else f"{reg['p']:.3g}"
         s += f"  baseline {reg['baseline']:.6g} (n={reg['baseline_n']}, p {p})"
     for kind, msg in c["failures"]:
-        s += f"  [{kind}: {msg}]"
+        s += f"  [{failure_text(kind, msg)}]"
     for n in c["notes"]:
         s += f"  [{n}]"
     return s
@@ -314,9 +371,10 @@ def junit_xml(checks, results, baseline):
             case = ET.SubElement(suite, "testcase", name=f"{c['label']}: {title}",
                                  classname=f"omniloc.{scenario}.{c['key'][1]}", time="0")
             if c["failures"]:
-                msg = "; ".join(f"{kind}: {c['metric']} {m}" for kind, m in c["failures"])
+                msg = "; ".join(f"{c['metric']}: {m}" if kind == NO_ESTIMATE else f"{kind}: {c['metric']} {m}" for kind, m in c["failures"])
                 fail = ET.SubElement(case, "failure", message=msg, type=" and ".join(sorted({k for k, _ in c["failures"]})))
-                fail.text = line(c) + "\nseed values: " + ", ".join(f"{v:.6g}" for v in c["values"])
+                fail.text = line(c) + "\nseed values: " + (", ".join(f"{v:.6g}" for v in c["values"]) or "none") + (
+                    f"; {R.no_estimate_text(c['no_value'], c['of'])}" if c.get("no_value") else "")
             else:
                 out = ET.SubElement(case, "system-out")
                 out.text = line(c)
@@ -337,12 +395,13 @@ def unit_of(metric):
 
 def benchmark_json(checks):
     """github-action-benchmark's "customSmallerIsBetter" input: [{name, unit, value, range, extra}].
-    Only rules where lower is better can be expressed; the others are left out (returned). One entry
-    per group, metric and statistic (the action keys its series by name): two rules on the same
-    number share it, with both limits in "extra"."""
+    Only rules where lower is better can be expressed; the others are left out (returned), and so
+    are checks without a value (no run had an estimate: returned too). One entry per group, metric
+    and statistic (the action keys its series by name): two rules on the same number share it, with
+    both limits in "extra"; a value over fewer runs than the group has says so in "extra"."""
     entries, left = {}, []
     for c in checks:
-        if c["rule"]["better"] != "lower":
+        if c["rule"]["better"] != "lower" or c["value"] is None:
             left.append(c)
             continue
         name = f"{c['label']}: {c['metric']} ({c['rule']['stat']})"
@@ -354,7 +413,7 @@ def benchmark_json(checks):
         e = {"name": name, "unit": unit_of(c["metric"]), "value": c["value"]}
         if iv["kind"] in (R.T95, R.RANGE):
             e["range"] = f"{iv['lo']:.6g} to {iv['hi']:.6g} ({'95 % t interval' if iv['kind'] == R.T95 else 'seeds range'})"
-        e["extra"] = f"n={len(c['values'])} seeds; " + verdict
+        e["extra"] = f"n={len(c['values'])} seeds; " + (f"{R.no_estimate_text(c['no_value'], c['of'])}; " if c.get("no_value") else "") + verdict
         entries[name] = e
     return list(entries.values()), left
 
@@ -393,8 +452,11 @@ def main(argv=None):
     if a.benchmark_json:
         entries, left = benchmark_json(checks)
         write_atomic(a.benchmark_json, json.dumps(entries, indent=2) + "\n")
-        if left:
-            print(f"note: {len(left)} check(s) where higher is better are not in {a.benchmark_json} (customSmallerIsBetter)")
+        higher = sum(1 for c in left if c["rule"]["better"] != "lower")
+        if higher:
+            print(f"note: {higher} check(s) where higher is better are not in {a.benchmark_json} (customSmallerIsBetter)")
+        if len(left) > higher:
+            print(f"note: {len(left) - higher} check(s) without a value (no estimate) are not in {a.benchmark_json}")
     print(f"gate: {len(checks) - failed} of {len(checks)} checks passed" + (f", {failed} failed" if failed else ""))
     return 1 if failed else 0
 

@@ -21,7 +21,13 @@ nineteen track at 3 cm. So, per localizer over the runs (seeds) given:
   harness/metrics.cpp), as a fraction of all frames, and the number of runs with any;
 - **mean over all**: mean position error over every valid frame, the statistic that hides both;
 - **beyond the walls**: frames whose estimate lies outside the floor (field.json beside the run),
-  valid ones and all (an invalid MCL estimate is still the set's mean, written to frames.csv).
+  valid ones and all (an invalid MCL estimate is still the set's mean, written to frames.csv);
+- **recall** (first column): the mean over runs of summary.json's recall at the headline threshold
+  (the share of ALL frames within 25 cm / 10 deg, a frame without an estimate counting as outside),
+  the share of frames answered, and the median time to the first estimate within that threshold
+  (summary.json first_within_s; runs that never got there are counted, not averaged).
+A statistic over no frame (no valid frame, no right frame) is None in the JSON and "-" or "no
+estimate" in the table, never 0.
 
 Usage: scripts/global_start.py FOLDER... [--markdown] [--json OUT]
 (folders: sweep folders or run folders, e.g. results/sweeps/global_tracking). Plain python3.
@@ -60,7 +66,7 @@ def score_run(rows, half_floor=None):
     never), the sums over right frames, the wrong and total frame counts, the mean over all, and
     (with half_floor = (half x, half y) of the floor inside the walls, metres) the valid frames
     whose estimate lies beyond the walls."""
-    rows = [r for r in rows if r.get("robot", "0") == "0"]
+    rows = [r for r in rows if r.get("robot", "0") == "0" and r.get("err_pos") not in (None, "")]  # scored frames (with truth)
     fr = [_frame(r) for r in rows]
     outside = outside_any = 0
     if half_floor:
@@ -92,7 +98,7 @@ def score_run(rows, half_floor=None):
         "frames": len(fr), "ended_right": ended_right, "t_first": t_first, "wrong_frames": wrong,
         "right_frames": len(right), "sum_x": sum(f[2] for f in right), "sum_y": sum(f[3] for f in right),
         "sum_th": sum(f[4] for f in right), "sum_p2": sum(f[5] ** 2 for f in right),
-        "max_x": max((f[2] for f in right), default=0.0), "max_y": max((f[3] for f in right), default=0.0),
+        "max_x": max((f[2] for f in right), default=None), "max_y": max((f[3] for f in right), default=None),
         "valid_frames": len(valid), "sum_pos_all": sum(f[5] for f in valid),
         "outside_walls_frames": outside, "outside_walls_any_frames": outside_any,
         "sum_spread": sum(spreads), "spread_frames": len(spreads),
@@ -120,8 +126,8 @@ def summarise(per_run):
         "right_mean_y_cm": 100 * sum(r["sum_y"] for r in per_run) / nr if nr else None,
         "right_mean_theta_rad": sum(r["sum_th"] for r in per_run) / nr if nr else None,
         "right_pos_rmse_cm": 100 * math.sqrt(sum(r["sum_p2"] for r in per_run) / nr) if nr else None,
-        "right_max_x_cm": 100 * max((r["max_x"] for r in per_run), default=0.0),
-        "right_max_y_cm": 100 * max((r["max_y"] for r in per_run), default=0.0),
+        "right_max_x_cm": _max_cm(r["max_x"] for r in per_run),  # None: no right frame in any run (never 0)
+        "right_max_y_cm": _max_cm(r["max_y"] for r in per_run),
         "wrong_frame_fraction": sum(r["wrong_frames"] for r in per_run) / frames if frames else None,
         "runs_with_wrong_frames": sum(1 for r in per_run if r["wrong_frames"] > 0),
         "all_mean_pos_cm": 100 * sum(r["sum_pos_all"] for r in per_run) / nv if nv else None,
@@ -129,7 +135,32 @@ def summarise(per_run):
         "outside_walls_any_frames": sum(r["outside_walls_any_frames"] for r in per_run),
         "right_mean_spread_cm": (100 * sum(r.get("sum_spread", 0.0) for r in per_run) / ns
                                  if (ns := sum(r.get("spread_frames", 0) for r in per_run)) else None),
+        "runs_without_estimate": sum(1 for r in per_run if r["valid_frames"] == 0),
+        # From summary.json (collect() adds them): the coverage-aware figures, None where no run has them.
+        "recall_key": next((r["recall_key"] for r in per_run if r.get("recall_key")), None),
+        "recall_mean": _mean(r.get("recall") for r in per_run),
+        "answered_mean": _mean(r.get("valid_fraction") for r in per_run),
+        "first_within_median_s": _median_or_none([r["first_within_s"] for r in per_run if r.get("first_within_s") is not None]),
+        "runs_never_within": sum(1 for r in per_run if "first_within_s" in r and r["first_within_s"] is None),
     }
+
+
+def _max_cm(values):
+    v = [x for x in values if x is not None]
+    return 100 * max(v) if v else None
+
+
+def _mean(values):
+    v = [x for x in values if isinstance(x, (int, float)) and not isinstance(x, bool)]
+    return sum(v) / len(v) if v else None
+
+
+def _median_or_none(values):
+    v = sorted(values)
+    if not v:
+        return None
+    m = len(v) // 2
+    return v[m] if len(v) % 2 else 0.5 * (v[m - 1] + v[m])
 
 
 def collect(folders):
@@ -149,25 +180,48 @@ def collect(folders):
         # averaged into a global-start one.
         if run.start_pose_given:
             key += " (given the start pose)"
-        by.setdefault(key, []).append((run.seed, score_run(run.frames(), half)))
+        scored = score_run(run.frames(), half)
+        # The coverage summary.json states (robot 0): recall at the run's headline threshold, the
+        # share answered, when it first answered within that threshold (None: never).
+        head = run.headline
+        scored.update(recall_key=head, recall=run.metric(f"recall/{head}", "all") if head else None,
+                      valid_fraction=run.metric("valid_fraction", "all"))
+        found, first = run.lookup("first_within_s", "all")
+        if found:
+            scored["first_within_s"] = first
+        by.setdefault(key, []).append((run.seed, scored))
     return by
 
 
-def _f(v, fmt):
-    return "-" if v is None else fmt % v
+def _f(v, fmt, scale=1.0):
+    return "-" if v is None else fmt % (scale * v)
+
+
+def _no_estimate(v, fmt, s):
+    """A statistic over the valid frames, "no estimate" where no run had one."""
+    return ("no estimate" if s.get("runs_without_estimate") == s["runs"] else "-") if v is None else fmt % v
+
+
+def recall_header(table):
+    key = next((s["recall_key"] for s in table.values() if s.get("recall_key")), None)
+    return f"within {R.recall_label(key)}" if key else "within the headline threshold"
 
 
 def markdown(table):
-    out = ["| localizer | runs | ended right | Wilson 95 % | first correct convergence median / max s | "
+    out = [f"| localizer | runs | {recall_header(table)}: mean over runs (answered) | first within it: median s (runs never) | ended right | "
+           "Wilson 95 % | first correct convergence median / max s | "
            "error while right: mean x / y cm, th rad, pos RMSE cm | wrong frames (runs with any) | mean pos error over all valid frames cm | frames beyond the walls: valid / all |",
-           "|---|---|---|---|---|---|---|---|---|"]
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for loc, s in table.items():
-        out.append(f"| {loc} | {s['runs']} | {s['ended_right']} ({_f(100 * s['ended_right_fraction'], '%.0f')} %) | "
+        out.append(f"| {loc} | {s['runs']} | {R.percent(s.get('recall_mean'))} ({R.percent(s.get('answered_mean'))}) | "
+                   f"{_f(s.get('first_within_median_s'), '%.2f')} ({s.get('runs_never_within', 0)}) | "
+                   f"{s['ended_right']} ({_f(s['ended_right_fraction'], '%.0f', 100)} %) | "
                    f"{100 * s['wilson95'][0]:.0f}-{100 * s['wilson95'][1]:.0f} % | "
                    f"{_f(s['t_first_median_s'], '%.2f')} / {_f(s['t_first_max_s'], '%.2f')} ({s['converged_runs']} runs) | "
-                   f"{_f(s['right_mean_x_cm'], '%.2f')} / {_f(s['right_mean_y_cm'], '%.2f')}, {_f(s['right_mean_theta_rad'], '%.4f')}, "
-                   f"{_f(s['right_pos_rmse_cm'], '%.2f')} | {_f(100 * s['wrong_frame_fraction'], '%.2f')} % ({s['runs_with_wrong_frames']}) | "
-                   f"{_f(s['all_mean_pos_cm'], '%.1f')} | {s['outside_walls_frames']} / {s['outside_walls_any_frames']} |")
+                   f"{_no_estimate(s['right_mean_x_cm'], '%.2f', s)} / {_no_estimate(s['right_mean_y_cm'], '%.2f', s)}, "
+                   f"{_no_estimate(s['right_mean_theta_rad'], '%.4f', s)}, "
+                   f"{_no_estimate(s['right_pos_rmse_cm'], '%.2f', s)} | {_f(s['wrong_frame_fraction'], '%.2f', 100)} % ({s['runs_with_wrong_frames']}) | "
+                   f"{_no_estimate(s['all_mean_pos_cm'], '%.1f', s)} | {s['outside_walls_frames']} / {s['outside_walls_any_frames']} |")
     return "\n".join(out)
 
 
@@ -180,7 +234,8 @@ def main(argv=None):
     by = collect(a.folders)
     order = [loc for loc in ("mcl", "hybrid", "grid_global") if loc in by] + sorted(set(by) - {"mcl", "hybrid", "grid_global"})
     table = {loc: summarise([r for _, r in by[loc]]) for loc in order}
-    per_run = {loc: [{"seed": seed, "ended_right": r["ended_right"], "t_first_s": r["t_first"], "wrong_frames": r["wrong_frames"],
+    per_run = {loc: [{"seed": seed, "recall": r.get("recall"), "valid_fraction": r.get("valid_fraction"), "first_within_s": r.get("first_within_s"),
+                      "ended_right": r["ended_right"], "t_first_s": r["t_first"], "wrong_frames": r["wrong_frames"],
                       "outside_walls_frames": r["outside_walls_frames"],
                       "outside_walls_any_frames": r["outside_walls_any_frames"], "frames": r["frames"]} for seed, r in sorted(by[loc], key=lambda x: x[0])] for loc in order}
     if a.json:

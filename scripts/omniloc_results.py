@@ -25,6 +25,14 @@ interval exists, so the seeds' range min..max is given instead and says so ("ran
 Each result names its kind. outliers() flags a seed whose error lies far above the others.
 Welch's t-test for two result sets. No SciPy: Debian's python3 and python3-matplotlib are the only
 dependencies.
+
+No estimate (docs/results.md "Coverage and recall"): an error statistic over zero answered frames is
+null in summary.json, with "why_null" beside it; it is never 0. Run.lookup() tells a null (found,
+None) from an absent key (not found: a run from before the key); run_stats() counts the runs with a
+value ("n") and those without ("no_value"), and every tool says "no estimate in k of n runs"
+(no_estimate_text) where a statistic has none, never a number. recall/<threshold> is the share of
+ALL scored frames within a (position, heading) threshold, valid_fraction the share answered; the
+headline threshold (summary.json scoring.headline, headline_key()) is the one tables lead with.
 """
 import contextlib
 import csv
@@ -32,6 +40,7 @@ import json
 import math
 import os
 import pathlib
+import re
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAPERS = ROOT / "results" / "reference" / "papers.json"
@@ -162,15 +171,48 @@ class Run:
     def metric(self, path, phase="tracking", robot=0):
         """A number of robot `robot`'s summary, e.g. "x_cm/mean" or "recovery/recovered". With
         phase "tracking" it is read from the tracking-phase block where the run has one (kidnaps,
-        covers) and the block has it; otherwise from the all-frames figures. None when absent."""
+        covers) and the block has the key; otherwise from the all-frames figures. None when absent
+        AND when null (no estimate): lookup() tells the two apart. A null of the tracking phase is
+        never replaced by the all-frames figure."""
+        found, v = self.lookup(path, phase, robot)
+        return _plain(v) if found else None
+
+    def lookup(self, path, phase="tracking", robot=0):
+        """(found, value): found False when the summary has no such key (a run made before it);
+        (True, None) when the statistic is null: no frame with an estimate (see why_null())."""
+        r = self.robot(robot)
+        if r is None:
+            return False, None
+        if phase == "tracking" and isinstance(r.get("tracking_phase"), dict):
+            found, v = find(r["tracking_phase"], path)
+            if found:
+                return True, v
+        return find(r, path)
+
+    def why_null(self, path, phase="tracking", robot=0):
+        """The reason summary.json gives beside a null statistic ("no estimate in any of the 30
+        scored frames", "no kidnap recovered"): the "why_null" of the innermost block on the path
+        that has one; None when there is none."""
         r = self.robot(robot)
         if r is None:
             return None
-        if phase == "tracking" and "tracking_phase" in r:
-            v = dig(r["tracking_phase"], path)
-            if v is not None:
-                return v
-        return dig(r, path)
+        block = r
+        if phase == "tracking" and isinstance(r.get("tracking_phase"), dict) and find(r["tracking_phase"], path)[0]:
+            block = r["tracking_phase"]
+        why = block.get("why_null")
+        for part in path.strip("/").split("/")[:-1]:
+            block = block.get(part) if isinstance(block, dict) else None
+            if not isinstance(block, dict):
+                break
+            why = block.get("why_null", why)
+        return why if isinstance(why, str) else None
+
+    @property
+    def headline(self):
+        """The key of the headline recall threshold ("25cm_10deg", summary.json scoring.headline);
+        None for a run made before recall was scored."""
+        h = (self.summary.get("scoring") or {}).get("headline")
+        return h if isinstance(h, str) else None
 
     def frames(self):
         return read_csv(self.folder / "frames.csv")
@@ -188,15 +230,26 @@ def read_csv(path):
 
 
 def dig(obj, path):
-    """obj["a"]["b"] for path "a/b" (numbers only); None when absent."""
+    """obj["a"]["b"] for path "a/b" (numbers only); None when absent or null."""
+    found, v = find(obj, path)
+    return _plain(v) if found else None
+
+
+def find(obj, path):
+    """(found, value) of obj["a"]["b"] for path "a/b": (True, None) for a null (a statistic over no
+    frame), (False, None) for an absent key."""
     for part in path.strip("/").split("/"):
         if isinstance(obj, dict) and part in obj:
             obj = obj[part]
         elif isinstance(obj, list) and part.isdigit() and int(part) < len(obj):
             obj = obj[int(part)]
         else:
-            return None
-    return obj if isinstance(obj, (int, float)) and not isinstance(obj, bool) else (obj if isinstance(obj, (dict, list, str, bool)) else None)
+            return False, None
+    return True, obj
+
+
+def _plain(v):
+    return v if isinstance(v, (int, float)) and not isinstance(v, bool) else (v if isinstance(v, (dict, list, str, bool)) else None)
 
 
 def pointer(obj, ptr):
@@ -397,6 +450,112 @@ def stats(values, method=None):
     out["sd"] = math.sqrt(sum((x - iv["mean"]) ** 2 for x in v) / (n - 1))
     out["lo"], out["hi"], out["method"] = iv["lo"], iv["hi"], iv["kind"]
     return out
+
+
+def is_number(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and not (isinstance(v, float) and math.isnan(v))
+
+
+def no_estimate_text(k, n):
+    """'no estimate in 1 of 3 runs': how every tool names runs whose statistic is null."""
+    return f"no estimate in {k} of {n} runs"
+
+
+def run_values(runs, path, phase="tracking"):
+    """(values, no_value, of) of one statistic over runs: the numbers of the runs that have one, how
+    many runs have it null (no estimate), and how many have the key at all (a run made before the
+    key counts in neither)."""
+    values, no_value, of = [], 0, 0
+    for r in runs:
+        found, v = r.lookup(path, phase)
+        if not found:
+            continue
+        of += 1
+        if is_number(v):
+            values.append(v)
+        elif v is None:
+            no_value += 1
+    return values, no_value, of
+
+
+def run_stats(runs, path, phase="tracking"):
+    """stats() over the runs that have a value, with "no_value" (runs where the statistic is null:
+    no estimate), "of" (runs that have the key) and "why" (the reason to print where no run has a
+    value: the runs' why_null where they agree on one that is not about estimates, e.g. "no kidnap
+    recovered"; else "no estimate")."""
+    values, no_value, of = run_values(runs, path, phase)
+    st = stats(values)
+    st.update(no_value=no_value, of=of, why=None)
+    if no_value:
+        whys = {r.why_null(path, phase) for r in runs if r.lookup(path, phase) == (True, None)}
+        one = whys.pop() if len(whys) == 1 else None
+        st["why"] = one if one and not one.startswith("no estimate") else NO_ESTIMATE
+    return st
+
+
+NO_ESTIMATE = "no estimate"
+
+
+def stat_cell(st, digits=3, scale=1.0):
+    """A table cell for run_stats() output: the mean; "no estimate" (or the runs' shared reason)
+    where no run has a value; "-" where no run has the key. Runs without a value beside runs with one
+    are not noted here: the caller names them once per row (no_value_note)."""
+    if st.get("n"):
+        return fnum(st["mean"] * scale, digits)
+    if st.get("no_value"):
+        return st.get("why") or NO_ESTIMATE
+    return "-"
+
+
+def no_value_note(sts):
+    """'no estimate in 1 of 3 runs' for the worst of several run_stats() results of one row ('' when
+    every run has every value)."""
+    worst = max(sts, key=lambda s: (s.get("no_value", 0), s.get("of", 0)), default=None)
+    if not worst or not worst.get("no_value"):
+        return ""
+    return no_estimate_text(worst["no_value"], worst["of"])
+
+
+DEFAULT_HEADLINE = "25cm_10deg"
+
+
+def headline_key(runs):
+    """The headline recall threshold of a set of runs (the one most of them name in
+    summary.json scoring.headline); None when none of them records one (runs made before recall)."""
+    counts = {}
+    for r in runs:
+        h = r.headline
+        if h:
+            counts[h] = counts.get(h, 0) + 1
+    return max(sorted(counts), key=lambda h: counts[h]) if counts else None
+
+
+def recall_keys(runs):
+    """Every recall threshold key the runs have (robot 0), tightest first."""
+    keys = set()
+    for r in runs:
+        rob = r.robot() or {}
+        keys |= {k for k in (rob.get("recall") or {})}
+    return sorted(keys, key=recall_order)
+
+
+def recall_order(key):
+    m = _RECALL_KEY.fullmatch(str(key))
+    return (float(m.group(1)), float(m.group(2)), key) if m else (math.inf, math.inf, str(key))
+
+
+_RECALL_KEY = re.compile(r"(\d+(?:\.\d+)?(?:e[-+]?\d+)?)cm_(\d+(?:\.\d+)?(?:e[-+]?\d+)?)deg")
+
+
+def recall_label(key):
+    """'25 cm / 10 deg' for the key "25cm_10deg" (a reader's words, no underscore)."""
+    m = _RECALL_KEY.fullmatch(str(key or ""))
+    return f"{m.group(1)} cm / {m.group(2)} deg" if m else str(key).replace("_", " ")
+
+
+def percent(v, digits=1):
+    """'93.3 %' for 0.933; '-' for None."""
+    return "-" if not is_number(v) else f"{100.0 * v:.{digits}f} %"
 
 
 def outliers(values, factor=3.0):

@@ -7,6 +7,12 @@
   written next to the claim in papers.json. The rules are data: "range" (the value, or for
   "ratio_to_published" ours / paper, lies in "holds" or "partly"), and "checks" (every check
   holds: holds; some: partly; none: does not).
+
+A claim judged from runs of which some have no estimate (the statistic is null in summary.json: no
+frame answered) is not judged on the others: its figure is "no estimate in k of n runs" and its
+verdict "does not" (a localizer that does not answer does not reproduce an accuracy figure).
+row_coverage() gives the coverage of the runs behind a claim (recall at the headline threshold,
+share answered), which the scorecard shows before our figure.
 """
 import json
 import math
@@ -40,12 +46,23 @@ def runs_given(sel):
 
 
 def row_stats(runs, key, defaults, metrics, phase="tracking"):
-    """Per metric path: stats over the matched runs (one value per run = seed)."""
+    """Per metric path: R.run_stats over the matched runs (one value per run = seed; "no_value":
+    runs where the statistic is null, no estimate)."""
     sel = R.select(runs, key, defaults)
     out = {}
     for m in metrics:
-        out[m] = R.stats([r.metric(m, phase) for r in sel])
+        out[m] = R.run_stats(sel, m, phase)
     return sel, out
+
+
+COVERAGE_METRICS = ["valid_fraction"]  # with recall/<headline> (coverage_metrics)
+
+
+def coverage_metrics(runs):
+    """The coverage metrics a table of these runs shows before its errors: recall at the runs'
+    headline threshold (when they record one) and the share of frames answered."""
+    head = R.headline_key(runs)
+    return ([f"recall/{head}"] if head else []) + COVERAGE_METRICS
 
 
 def external_peers(runs, key, defaults, metrics):
@@ -61,7 +78,7 @@ def external_peers(runs, key, defaults, metrics):
         everything = R.select(runs, dict(base, localizer=name), defaults)
         for given in sorted({r.start_pose_given for r in everything}, key=lambda g: (g is None, g is True)):
             sel = [r for r in everything if r.start_pose_given is given]
-            st = {m: R.stats([r.metric(m) for r in sel]) for m in metrics}
+            st = {m: R.run_stats(sel, m) for m in metrics}
             peers.append({"name": name, "runs": sel, "stats": st, "start_pose_given": given,
                           "version": (sel[0].summary.get("external") or {}).get("version", "")})
     return peers
@@ -109,7 +126,7 @@ def pair_table(papers, table, runs, labels=None, include_extra=True):
     beside a row that ran the other start-pose task). "shown": the label to print (shown_labels)."""
     t = papers[table]
     rb = t["reproduced_by"]
-    metrics = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
+    metrics = [f"{a}/{s}" for a, s in R.TABLE_KEYS] + coverage_metrics(runs)
     wanted = list(rb["rows"]) + (list(rb.get("extra_rows", {})) if include_extra else [])
     if labels:
         unknown = [l for l in labels if l not in wanted]
@@ -128,6 +145,30 @@ def pair_table(papers, table, runs, labels=None, include_extra=True):
     shown_labels(rows)
     place_peers(rows)
     return rows
+
+
+def table_coverage(rows):
+    """(metrics, headers) of the coverage columns a table shows before its errors: recall at the
+    headline threshold and the share answered, each where some run of the table has it (none for
+    runs made before they were scored)."""
+    metrics, heads = [], []
+    for p in rows:
+        for st_of in [p["stats"]] + [q["stats"] for q in p["peers"]]:
+            for m, st in st_of.items():
+                if (m.startswith("recall/") or m == "valid_fraction") and st.get("of") and m not in metrics:
+                    metrics.append(m)
+    metrics.sort(key=lambda m: m == "valid_fraction")  # recall first
+    for m in metrics:
+        heads.append(f"within {R.recall_label(m.split('/', 1)[1])}" if m.startswith("recall/") else "answered")
+    return metrics, heads
+
+
+def row_cells(st, cov, runs):
+    """One of our rows: coverage (percent over all frames), the nine errors over answered frames
+    ("no estimate" where no run has one), line points, and the seeds with those that had no estimate."""
+    note = R.no_value_note([st[f"{c}/{s}"] for c, s in R.TABLE_KEYS])
+    return ([R.percent(st[m]["mean"]) if st.get(m) else "-" for m in cov] + [R.stat_cell(st[f"{c}/{s}"], 3) for c, s in R.TABLE_KEYS]
+            + [R.stat_cell(st["line_points/mean"], 0), str(len(runs)) + (f"; {note}" if note else "")])
 
 
 def timing_ms(papers, row, runs):
@@ -198,10 +239,16 @@ def quantity(q, ctx):
         if not sel:
             return None, note
         metrics = q["metric"] if isinstance(q["metric"], list) else [q["metric"]]
-        per_run = []
+        per_run, no_value = [], 0
         for r in sel:
+            found = [r.lookup(m, q.get("phase", "tracking")) for m in metrics]
+            if any(f and v is None for f, v in found):  # null: no estimate in this run
+                no_value += 1
+                continue
             vals = [r.metric(m, q.get("phase", "tracking")) for m in metrics]
             per_run.append(None if any(v is None for v in vals) else sum(vals))
+        if no_value:  # never judged on the runs that answered alone
+            return None, R.no_estimate_text(no_value, len(sel))
         per_run = [v for v in per_run if v is not None]
         if not per_run:
             return None, f"{'+'.join(metrics)} absent in {len(sel)} run(s)"
@@ -234,6 +281,8 @@ def quantity(q, ctx):
         per_run = [G.score_run(r.frames()) for r in sel]
         if not any(p["frames"] for p in per_run):
             return None, f"no frames.csv in {len(sel)} run(s)"
+        if not any(p["valid_frames"] for p in per_run):
+            return None, R.no_estimate_text(len(sel), len(sel))
         v = _number(G.summarise(per_run).get(q["stat"]))
         return (v, f"n={len(sel)} runs, per run") if v is not None else (None, f"{q['stat']} undefined over {len(sel)} run(s)")
     if "expr" in q:
@@ -294,11 +343,18 @@ def verdict_text(c):
     return c["verdict"] + (f" {WEAK_TEXT}" if c.get("weak") else "")
 
 
-def judge(value, rule, published=None):
+def no_estimate(note):
+    """Whether a quantity's note says its runs had no estimate (quantity() returns None then)."""
+    return str(note or "").startswith(R.NO_ESTIMATE)
+
+
+def judge(value, rule, published=None, note=None):
+    """The verdict of a value by a claim's rule: holds / partly / does not; "not run" without a
+    value, except where the runs were made and gave no estimate (`note` says so): "does not"."""
     if rule is None:
         return "n/a"
     if value is None:
-        return "not run"
+        return "does not" if no_estimate(note) else "not run"
     v = value / published if rule["kind"] == "ratio_to_published" else value
     inside = lambda iv: iv is not None and iv[0] - 1e-12 <= v <= iv[1] + 1e-12
     if inside(rule.get("holds")):
@@ -437,14 +493,15 @@ def evaluate_claims(ctx):
             for ch in checks:
                 v, note = quantity(ch["ours"], ctx)
                 pub = ch.get("published") if ch["rule"]["kind"] == "ratio_to_published" else None
-                verdict = judge(v, ch["rule"], pub)
+                verdict = judge(v, ch["rule"], pub, note)
                 verdicts.append(verdict)
                 ratio = v / pub if v is not None and pub else None
                 row["checks"].append({"label": ch["label"], "ours": v, "note": note, "verdict": verdict, "ratio": ratio,
                                       "published": ch.get("published"), "seeds": evidence_seeds(ch["ours"], ctx)})
             row["verdict"] = _combine(verdicts)
             row["ours"] = None
-            row["ours_text"] = "; ".join(f"{ch['label']}: {R.fnum(ch['ours'], 3)}" + (f" ({R.fnum(ch['ratio'], 2)}x the paper's)" if ch["ratio"] is not None else "")
+            row["ours_text"] = "; ".join(f"{ch['label']}: " + (R.fnum(ch["ours"], 3) if ch["ours"] is not None or not no_estimate(ch["note"]) else ch["note"])
+                                         + (f" ({R.fnum(ch['ratio'], 2)}x the paper's)" if ch["ratio"] is not None else "")
                                          + f" {ch['verdict']}" for ch in row["checks"])
             if all(ch["ours"] is None for ch in row["checks"]):  # nothing measured: say why once, not per axis
                 row["ours_text"] = "; ".join(dict.fromkeys(ch["note"] for ch in row["checks"]))
@@ -456,15 +513,71 @@ def evaluate_claims(ctx):
             row["ours_text"] = (R.fnum(v, 3) + (f" {row['unit']}" if row["unit"] not in ("x", "") else "") + (f" ({note})" if note else "")) if v is not None else note
             if isinstance(c.get("published"), (int, float)) and v is not None and c["published"]:
                 row["ratio"] = v / c["published"]
-            row["verdict"] = judge(v, c.get("rule"), c.get("published") if isinstance(c.get("published"), (int, float)) else None)
+            row["verdict"] = judge(v, c.get("rule"), c.get("published") if isinstance(c.get("published"), (int, float)) else None, note)
             row["seeds"] = evidence_seeds(c.get("ours"), ctx)
         if row["checks"]:
             counts = [ch["seeds"] for ch in row["checks"] if ch["seeds"] is not None]
             row["seeds"] = min(counts) if counts else None
         # A verdict that rests on one seed or trial is weak evidence, and says so (issue 38).
         row["weak"] = row["verdict"] in ("holds", "partly", "does not") and row["seeds"] == 1
+        row["coverage"] = claim_coverage(c, ctx)
         out.append(row)
     return out
+
+
+def claim_rows(q, out=None):
+    """The published rows [table, label] a quantity selector (or claim) reads runs of, in order."""
+    out = [] if out is None else out
+    if isinstance(q, dict):
+        for k in ("row", "global_start"):
+            if k in q and list(q[k]) not in out:
+                out.append(list(q[k]))
+        for x in list(q.get("ratio") or q.get("fraction") or []) + list((q.get("vars") or {}).values()):
+            claim_rows(x, out)
+        if "ours" in q:
+            claim_rows(q["ours"], out)
+        for ch in q.get("checks") or []:
+            claim_rows(ch, out)
+    return out
+
+
+def row_coverage(ctx, row):
+    """{"recall", "answered", "key", "runs", "no_value"} of the runs reproducing one published row:
+    the mean over runs of the recall at their headline threshold and of the share of frames
+    answered (tracking phase where a run has one); None where the row has no runs."""
+    sel, _ = _row_runs(ctx, row)
+    if not sel:
+        return None
+    key = R.headline_key(sel)
+    rec = R.run_stats(sel, f"recall/{key}") if key else None
+    ans = R.run_stats(sel, "valid_fraction")
+    return {"key": key, "recall": rec["mean"] if rec else None, "answered": ans["mean"], "runs": len(sel),
+            "no_value": R.run_stats(sel, "position_m/rmse")["no_value"]}
+
+
+def claim_coverage(c, ctx):
+    """[(row label, row_coverage)] of the rows a claim of papers.json is judged on ([] for claims
+    judged from experiments or timings)."""
+    out = []
+    for row in claim_rows(c):
+        cov = row_coverage(ctx, row)
+        if cov is not None:
+            out.append((row[1], cov))
+    return out
+
+
+def coverage_text(cov):
+    """'within 25 cm / 10 deg 97.0 %, answered 100.0 %' for row_coverage() output, with the row's
+    label where a claim reads several rows; '-' when nothing is known."""
+    parts = []
+    for label, c in cov or []:
+        if c["key"] is None and c["answered"] is None:  # runs made before coverage was scored
+            continue
+        t = (f"within {R.recall_label(c['key'])} {R.percent(c['recall'])}, " if c["key"] else "") + f"answered {R.percent(c['answered'])}"
+        if c["no_value"]:
+            t += f" ({R.no_estimate_text(c['no_value'], c['runs'])})"
+        parts.append((f"{label}: " if len(cov) > 1 else "") + t)
+    return "; ".join(parts) if parts else "-"
 
 
 def totals(claims):

@@ -19,6 +19,12 @@ of the same task: a run given the true start pose (summary.json start_pose_given
 of its own, labelled "(given the start pose)" or "(global start)". Where a table holds both kinds,
 its rows given the start pose say "(given the start pose)".
 
+Coverage: the papers' errors are over the frames a localizer answered. Beside them each of our rows
+shows first the share of all scored frames within the headline recall threshold ("within 25 cm /
+10 deg", summary.json recall) and the share of frames answered ("answered"), means over seeds; an
+error with no value (no frame answered) reads "no estimate", and a row where some seeds had none
+says "no estimate in k of n runs" in its seeds column (its errors are then over the others).
+
 Noise profile: rows pair runs of one profile. --profile NAME picks it (robot, field_robot, ...);
 without it the profile is read from the runs: robot where there are robot runs, else the one
 profile the runs have (e.g. the field_robot sweep), and the table says which.
@@ -126,25 +132,24 @@ def print_error_table(papers, key, runs, labels, markdown):
     except KeyError as e:
         print(f"error: {e.args[0]}", file=sys.stderr)
         return 2
-    head = ["row", "source"] + SHORT + ["line points / frame", "seeds"]
+    cov, cov_head = C.table_coverage(rows)
+    head = ["row", "source"] + cov_head + SHORT + ["line points / frame", "seeds"]
     lines, notes = [], []
     for p in rows:
         st = p["stats"]
         if p["runs"]:
-            lines.append([p["shown"] + (" (tracking phase)" if p["phased"] else ""), "omniloc"] +
-                         [f"{st[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] + [f"{st['line_points/mean']['mean']:.0f}", str(st["x_cm/mean"]["n"])])
+            lines.append([p["shown"] + (" (tracking phase)" if p["phased"] else ""), "omniloc"] + C.row_cells(st, cov, p["runs"]))
         else:
-            lines.append([p["label"], "not run"] + ["-"] * 9 + ["-", "0"])
+            lines.append([p["label"], "not run"] + ["-"] * (len(cov) + 9) + ["-", "0"])
             notes.append(f"not run: {p['label']} ({R.describe_key(p['key'])}); run: {report_command(p['command'])}")
         for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario, configuration and start pose
-            pst = peer["stats"]
-            lines.append([peer["row"], f"external: {peer['name']}"] + [f"{pst[f'{c}/{s}']['mean']:.3f}" for c, s in R.TABLE_KEYS] +
-                         [f"{pst['line_points/mean']['mean']:.0f}", str(pst["x_cm/mean"]["n"])])
+            lines.append([peer["row"], f"external: {peer['name']}"] + C.row_cells(peer["stats"], cov, peer["runs"]))
         if p["published"]:
-            lines.append([p["label"], "paper"] + [f"{v:.3f}" for v in p["published"]] + ["-", "-"])
+            lines.append([p["label"], "paper"] + ["-"] * len(cov) + [f"{v:.3f}" for v in p["published"]] + ["-", "-"])
             if p["runs"]:
-                lines.append([p["label"], "ours/paper"] + [f"{st[f'{c}/{s}']['mean'] / v:.2f}" if v else "-"
-                                                            for (c, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
+                mean = lambda m: st[m]["mean"]
+                lines.append([p["label"], "ours/paper"] + [""] * len(cov) + [f"{mean(f'{c}/{s}') / v:.2f}" if v and mean(f"{c}/{s}") is not None else "-"
+                                                                            for (c, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
     if markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
@@ -156,7 +161,10 @@ def print_error_table(papers, key, runs, labels, markdown):
             print("  ".join(x.ljust(w[i]) if i < 2 else x.rjust(w[i]) for i, x in enumerate(l)))
     for n in notes:
         print(n)
-    print(f"\nunits: x, y in cm, th in rad; paper: {papers[key]['source']}\n")
+    print(f"\nunits: x, y in cm, th in rad; paper: {papers[key]['source']}"
+          + ("; ours: errors over the frames answered, " + ", ".join(
+              f"'{h}': share of all frames " + ("within that threshold (a frame without an estimate counts as outside)" if h != "answered" else "with an estimate")
+              for h in cov_head) + ", means over seeds" if cov_head else "") + "\n")
     return 0
 
 

@@ -28,6 +28,13 @@ such folders (searched recursively). The report is laid out for a reader with te
   - on a page of its own (history.html, linked), for developers: instruction counts and benchmark
     wall times per workload over the commits (--history DIR, default results/history);
   - the references: the five papers, cited in the text as 'Lu et al. 2013 [3]' (paper_claims.BIBLIOGRAPHY).
+Coverage first (docs/results.md "Coverage and recall"): an error is over the frames a localizer
+answered, so wherever the report shows one it shows the share of frames answered beside it, and
+wherever localizers or conditions stand side by side (the scorecard, the published tables, the sweep
+tables, the per-seed tables, the global-start table, the error CDF) the recall at the headline
+threshold ("within 25 cm / 10 deg": the share of ALL frames within it, a frame without an estimate
+counting as outside) comes first. A statistic over no answered frame reads "no estimate" (or "no
+estimate in k of n runs"), never a number; results made before recall was scored show as before.
 The text speaks to a reader: claims and tables by readable labels, never papers.json keys or issue
 numbers, abbreviations spelled out at first use (paper_claims.py; scripts/check_report_html.py checks).
 Pictures are embedded, compressed (palette PNG, JPEG for camera frames) so that report.html stays
@@ -544,6 +551,15 @@ def scorecard(rep, ctx, judged=None):
              "claim in results/reference/papers.json; a claim stated on a row of a published error table is judged on every axis "
              "the paper states there (mean x, y and heading): all hold: holds, some: partly. Claims that do not hold stay "
              "visible, and no model is tuned to turn one.")
+    # Coverage of the runs behind each claim first (recall at the headline threshold, share answered):
+    # the papers' figures are errors over the frames answered. Results made before recall: no column.
+    cov = lambda c: C.coverage_text(c.get("coverage"))
+    show_cov = any(cov(c) != "-" for c in claims)
+    show_fcov = field_claims is not None and any(cov(f) != "-" for f in field_claims.values())
+    if show_cov:
+        rep.para("'Our runs' gives, for a claim judged from runs, the share of their frames within the headline threshold and the share "
+                 "answered (docs/results.md, coverage and recall): our figure beside it is an error over the answered frames only; a claim "
+                 "whose runs gave no estimate in some run is not judged on the others (does not).")
     for kind in C.KINDS:
         mine = [c for c in claims if c["kind"] == kind]
         if not mine:
@@ -552,16 +568,19 @@ def scorecard(rep, ctx, judged=None):
         for c in mine:
             pub = c["published"]
             pub_text = (fnum(pub, 3) + ("" if c["unit"] in ("x", "", "recovered") else f" {c['unit']}")) if isinstance(pub, (int, float)) else (pub or "-")
-            row = [C.cite_field(c["paper"]), c["claim"], c["ours_text"] + ("" if not c["notes"] else " (" + "; ".join(c["notes"]) + ")"), pub_text,
-                   fnum(c["ratio"], 2) if c["ratio"] is not None else "-", C.verdict_text(c)]
+            row = [C.cite_field(c["paper"]), c["claim"]] + ([cov(c)] if show_cov else []) + [
+                c["ours_text"] + ("" if not c["notes"] else " (" + "; ".join(c["notes"]) + ")"), pub_text,
+                fnum(c["ratio"], 2) if c["ratio"] is not None else "-", C.verdict_text(c)]
             if field_claims is not None:
                 f = field_claims[c["id"]]
-                row += [f["ours_text"].replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json"), C.verdict_text(f)] \
-                    if c["uses_runs"] else ["same as robot (experiment)", "-"]
+                row += ([cov(f) if c["uses_runs"] else "-"] if show_fcov else []) + (
+                    [f["ours_text"].replace("sweeps/paper_suite.json", "sweeps/paper_suite_field_robot.json"), C.verdict_text(f)]
+                    if c["uses_runs"] else ["same as robot (experiment)", "-"])
             rows.append(row + [c["rule_text"]])
-        header = ["paper", "claim", "ours (robot profile)", "paper's", "ours / paper", "verdict"]
+        header = ["paper", "claim"] + (["our runs: coverage"] if show_cov else []) + [
+            "ours (robot profile)", "paper's", "ours / paper", "verdict"]
         if field_claims is not None:
-            header += ["ours (field_robot)", "verdict (field_robot)"]
+            header += (["our runs: coverage (field_robot)"] if show_fcov else []) + ["ours (field_robot)", "verdict (field_robot)"]
         cap = f"{KIND_TEXT[kind]}: " + C.totals_text({kind: C.totals(mine)[kind]}).split(": ", 1)[1] + "."
         if kind == "timing":
             cap += f" Ours: median wall time on {machine_text()}."
@@ -592,9 +611,11 @@ def ratio_text(c):
         return ", ".join(f"{re.sub(r'^mean ', '', l)} {fnum(r, 2)}x" for l, r in rs)
     if c["ratio"] is not None and c["ours"] is not None and isinstance(c["published"], (int, float)):
         return f"{fnum(c['ours'], 2)} / {fnum(c['published'], 2)} = {fnum(c['ratio'], 2)}x"
+    # Runs that gave no estimate: say so, not '-' (which reads as "not measured").
+    none = c["ours_text"] if C.no_estimate(c.get("ours_text")) else "-"
     if c["checks"]:
-        return "; ".join(f"{ch['label']}: {fnum(ch['ours'], 3)}" for ch in c["checks"] if ch["ours"] is not None) or "-"
-    return fnum(c["ours"], 3) if c["ours"] is not None else "-"
+        return "; ".join(f"{ch['label']}: {fnum(ch['ours'], 3)}" for ch in c["checks"] if ch["ours"] is not None) or none
+    return fnum(c["ours"], 3) if c["ours"] is not None else none
 
 
 def per_profile(values):
@@ -657,9 +678,10 @@ def causes_section(rep, claims, field_claims, causes):
 MAIN_GAP = ("tracking_accuracy", "occlusion_mild", "mcl_alone", "lighting_autoadjust", "kidnap_002", "kidnap_000")
 
 
-def error_ratios(papers, runs):
+def error_ratios(papers, runs, used=None):
     """Ours / paper over the published error-table rows these runs reproduce (each set of runs
-    once): (median over mean x and mean y, median over mean heading, rows)."""
+    once): (median over mean x and mean y, median over mean heading, rows). `used`, a list, receives
+    the runs of those rows (for their coverage)."""
     pos, head, seen = [], [], set()
     keys = [f"{a}/{s}" for a, s in R.TABLE_KEYS]
     for table in ("002_table1_occlusion", "002_table2_lighting", "000_tracking"):
@@ -668,6 +690,8 @@ def error_ratios(papers, runs):
             if not p["runs"] or not p["published"] or ident in seen:
                 continue
             seen.add(ident)
+            if used is not None:
+                used.extend(p["runs"])
             pub = dict(zip(keys, p["published"]))
             for m, bucket in (("x_cm/mean", pos), ("y_cm/mean", pos), ("theta_rad/mean", head)):
                 v = p["stats"][m]["mean"]
@@ -675,6 +699,18 @@ def error_ratios(papers, runs):
                     bucket.append(v / pub[m])
     med = lambda v: statistics.median(v) if v else None
     return med(pos), med(head), len(seen)
+
+
+def coverage_sentence(runs):
+    """'errors over the frames answered: those runs answered 100.0 % of their frames, 97.3 % within
+    25 cm / 10 deg' (means over the runs; '' for runs made before coverage was scored)."""
+    key = R.headline_key(runs)
+    ans = R.run_stats(runs, "valid_fraction")["mean"]
+    rec = R.run_stats(runs, f"recall/{key}")["mean"] if key else None
+    if ans is None and rec is None:
+        return ""
+    return ("errors over the frames answered: those runs answered " + R.percent(ans) + " of their frames"
+            + (f", {R.percent(rec)} within {R.recall_label(key)}" if rec is not None else ""))
 
 
 def lower_first(label):
@@ -705,10 +741,14 @@ def headline(rep, ctx, claims, field_claims, causes):
                 s += (f" Under the field_robot profile (the camera blurred, defocused and tilted, its mirror decentred) {cnt['holds']} of "
                       f"{len(fj)} hold, {cnt['partly']} partly, {cnt['does not']} do not.")
         parts.append(s)
-    pos, head, n = error_ratios(ctx.papers, ctx.runs)
+    used = []
+    pos, head, n = error_ratios(ctx.papers, ctx.runs, used)
     if pos is not None and head is not None:
         s = (f"Our simulated tracking error is about {fnum(pos, 2)}x the papers' in position and {fnum(head, 2)}x in heading "
              f"(median of ours / paper over the {n} published error-table row{'s' if n != 1 else ''} we ran, robot profile")
+        cov = coverage_sentence(used)
+        if cov:
+            s += f"; {cov}"
         field = field_robot_runs(ctx.runs)
         if field:
             with R.pairing_profile("field_robot"):
@@ -739,9 +779,22 @@ def headline(rep, ctx, claims, field_claims, causes):
 SEED_METRICS = [("x_cm/mean", "mean x cm", 2), ("y_cm/mean", "mean y cm", 2), ("theta_rad/mean", "mean th rad", 4)]
 
 
-def seed_values_text(sel, values, flagged, digits):
-    """'s1 3.10, s2 806.00 (outlier), s3 2.90': every seed's value beside the mean."""
-    return ", ".join(f"s{r.seed}\u00a0{fnum(v, digits)}" + ("\u00a0(outlier)" if i in flagged else "") for i, (r, v) in enumerate(zip(sel, values)))
+def coverage_cols(runs):
+    """The coverage columns of a table of these runs, shown before its errors: [(metric, header)]
+    for the recall at the runs' headline threshold and the share of frames answered, each where the
+    runs record it (runs made before recall was scored: answered only, or nothing)."""
+    head = R.headline_key(runs)
+    cols = [(f"recall/{head}", f"within {R.recall_label(head)}")] if head else []
+    if any(r.lookup("valid_fraction")[0] for r in runs):
+        cols.append(("valid_fraction", "answered"))
+    return cols
+
+
+def seed_values_text(sel, values, flagged, digits, nulls=()):
+    """'s1 3.10, s2 806.00 (outlier), s3 no estimate': every seed's value beside the mean."""
+    nulls = set(nulls)
+    return ", ".join(f"s{r.seed}\u00a0" + ("no estimate" if i in nulls else fnum(v, digits)) + ("\u00a0(outlier)" if i in flagged else "")
+                     for i, (r, v) in enumerate(zip(sel, values)))
 
 
 def interval_text(st, digits):
@@ -759,7 +812,7 @@ def flag_outliers(sel, metric="x_cm/mean", phase="tracking"):
 def outlier_cause(run, wrong_m=0.5):
     """What happened in an outlying run, read from frames.csv (robot 0) and events.jsonl: when the
     position error went above `wrong_m` for good and what the localizer said it was doing then."""
-    frames = [f for f in run.frames() if f.get("robot", "0") == "0"]
+    frames = [f for f in run.frames() if f.get("robot", "0") == "0" and f.get("err_pos") not in (None, "")]  # scored frames (with truth)
     if not frames:
         return "no frames.csv to read the cause from"
     events = []
@@ -830,30 +883,42 @@ def seed_table(rep, rows_runs, phase="tracking", caption_extra=""):
     seed)]. Returns the outlying runs, which the caller plots."""
     rows, classes, flagged_runs, methods = [], [], [], set()
     rep.__dict__.setdefault("seeded", set()).update(r.folder for _, sel in rows_runs for r in sel)  # shown once (report_sweep)
+    # Coverage first (percent of all frames), then the errors over the answered frames.
+    metrics = [(m, f"{h}, % of frames", 1, 100.0) for m, h in coverage_cols([r for _, sel in rows_runs for r in sel])] + \
+        [(m, name, digits, 1.0) for m, name, digits in SEED_METRICS]
     for label, sel in rows_runs:
         if not sel:
             continue
         out = flag_outliers(sel, phase=phase)
         flagged_runs += out
         row = [label, len(sel)]
-        for metric, _, digits in SEED_METRICS:
-            vals = [r.metric(metric, phase) for r in sel]
+        for metric, _, digits, scale in metrics:
+            found = [r.lookup(metric, phase) for r in sel]
+            vals = [v * scale if R.is_number(v) else None for _, v in found]
+            nulls = [i for i, (f, v) in enumerate(found) if f and v is None]  # no estimate in that seed
             st = R.stats(vals)
             if st["method"]:
                 methods.add(st["method"])
             flagged = {i for i, r in enumerate(sel) if r in out} if metric == "x_cm/mean" else set()  # the metric flagged on
             # One cell per metric (the mean with its interval, the median, every seed): a table a
             # reader takes in without scrolling sideways.
-            row.append(f"mean {interval_text(st, digits)}; median {fnum(st['median'], digits)}; seeds: {seed_values_text(sel, vals, flagged, digits)}")
+            if not st["n"] and nulls:
+                row.append(R.no_estimate_text(len(nulls), len(sel)))
+                continue
+            row.append(f"mean {interval_text(st, digits)}; median {fnum(st['median'], digits)}; seeds: {seed_values_text(sel, vals, flagged, digits, nulls)}"
+                       + (f" ({R.no_estimate_text(len(nulls), len(sel))}: the mean is over the others)" if nulls else ""))
         row.append("; ".join(f"s{r.seed}: {outlier_cause(r)}" for r in out) or "-")
         rows.append(row)
         classes.append("outlier" if out else "")
     if not rows:
         return []
-    header = ["row", "n"] + [name for _, name, _ in SEED_METRICS]
+    header = ["row", "n"] + [name for _, name, _, _ in metrics]
     rep.table(header + ["outlying seeds and cause"], rows,
-              "Every seed beside the mean: mean with its interval; median; each seed's value. The "
-              + R.INTERVAL_RULE_TEXT + ". A seed is flagged as an outlier when its mean x error lies above 3x "
+              "Every seed beside the mean: mean with its interval; median; each seed's value. "
+              + ("The share of frames within the headline threshold (a frame without an estimate counts as outside) and the share answered come "
+                 "first; the errors after them are over the answered frames, and a seed without any says 'no estimate'. "
+                 if len(metrics) > len(SEED_METRICS) else "")
+              + "The " + R.INTERVAL_RULE_TEXT + ". A seed is flagged as an outlier when its mean x error lies above 3x "
               "the median of the other seeds and further from it than 3x their range; its cause is read from its frames.csv and events.jsonl."
               + caption_extra, classes)
     return flagged_runs
@@ -866,6 +931,8 @@ def strip_plot(rep, title, rows_runs, phase="tracking"):
     if not rows_runs:
         return
     fig, axes = plt.subplots(1, 2, figsize=(10, 0.42 * len(rows_runs) + 1.3), sharey=True)
+    # A seed without an estimate has no dot: its row's label says so (never a dot at 0).
+    missing = [sum(1 for r in sel if r.lookup("x_cm/mean", phase) == (True, None)) for _, sel in rows_runs]
     for ax, (metric, unit) in zip(axes, [("x_cm/mean", "mean x error per seed (cm)"), ("theta_rad/mean", "mean heading error per seed (rad)")]):
         allv = []
         for k, (label, sel) in enumerate(rows_runs):
@@ -895,7 +962,7 @@ def strip_plot(rep, title, rows_runs, phase="tracking"):
         if ax.get_legend_handles_labels()[1]:
             ax.legend(fontsize=7, loc="lower right")
     axes[0].set_yticks(range(len(rows_runs)))
-    axes[0].set_yticklabels([l for l, _ in rows_runs], fontsize=8)
+    axes[0].set_yticklabels([l + (f" ({R.no_estimate_text(k, len(sel))})" if k else "") for (l, sel), k in zip(rows_runs, missing)], fontsize=8)
     axes[0].invert_yaxis()
     rep.figure(fig, "seeds", f"{title}: every seed (dots; red diamonds: outlying seeds), the mean over seeds (black bar)")
 
@@ -923,31 +990,34 @@ def command(cmd):
 def error_table(rep, papers, table, runs):
     t = papers[table]
     rep.heading(C.table_label(table) + profile_suffix(), 3, table)
-    rep.para(f"Published: {t.get('source', table)} (results/reference/papers.json); th: heading. Ours: mean over seeds of each run's statistic (robot 0), with n; "
-             "runs with kidnaps or covers use their tracking phase (see docs/results.md). Paper rows in italics, then ours / paper.")
-    header = ["row", "source"] + R.TABLE_COLS + ["line points / frame", "seeds"]
-    rows, classes = [], []
     pairs = C.pair_table(papers, table, runs)
+    cov, cov_head = C.table_coverage(pairs)
+    rep.para(f"Published: {t.get('source', table)} (results/reference/papers.json); th: heading. Ours: mean over seeds of each run's statistic (robot 0), with n; "
+             "runs with kidnaps or covers use their tracking phase (see docs/results.md). Paper rows in italics, then ours / paper."
+             + (" Our rows lead with the share of all frames within the headline threshold (a frame without an estimate counts as outside) "
+                "and the share answered: the errors after them, like the papers', are over the answered frames only; 'no estimate' where "
+                "a run answered no frame." if cov else ""))
+    header = ["row", "source"] + cov_head + R.TABLE_COLS + ["line points / frame", "seeds"]
+    rows, classes = [], []
     for p in pairs:
         st = p["stats"]
         if p["runs"]:
             label = p["shown"] + (" (tracking phase)" if p["phased"] else "")
-            rows.append([label, "omniloc"] + [fnum(st[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
-                        [fnum(st["line_points/mean"]["mean"], 0), st["x_cm/mean"]["n"]])
+            rows.append([label, "omniloc"] + C.row_cells(st, cov, p["runs"]))
             classes.append("")
         else:
-            rows.append([p["label"], "not run"] + ["-"] * 9 + ["-", 0])
+            rows.append([p["label"], "not run"] + ["-"] * (len(cov) + 9) + ["-", 0])
             classes.append("missing")
         for peer in p.get("peers", []):  # external localizers (docs/protocol.md), same scenario, configuration and start pose
-            pst = peer["stats"]
-            rows.append([peer["row"], f"external: {peer['name']}"] + [fnum(pst[f"{a}/{s}"]["mean"], 3) for a, s in R.TABLE_KEYS] +
-                        [fnum(pst["line_points/mean"]["mean"], 0), pst["x_cm/mean"]["n"]])
+            rows.append([peer["row"], f"external: {peer['name']}"] + C.row_cells(peer["stats"], cov, peer["runs"]))
             classes.append("")
         if p["published"]:
-            rows.append([p["label"], "paper"] + [fnum(v, 3) for v in p["published"]] + ["-", "-"])
+            rows.append([p["label"], "paper"] + ["-"] * len(cov) + [fnum(v, 3) for v in p["published"]] + ["-", "-"])
             classes.append("paper")
             if p["runs"]:
-                rows.append([p["label"], "ours / paper"] + [fnum(st[f"{a}/{s}"]["mean"] / v, 2) if v else "-" for (a, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
+                mean = lambda m: st[m]["mean"]
+                rows.append([p["label"], "ours / paper"] + [""] * len(cov) + [fnum(mean(f"{a}/{s}") / v, 2) if v and mean(f"{a}/{s}") is not None else "-"
+                                                                             for (a, s), v in zip(R.TABLE_KEYS, p["published"])] + ["", ""])
                 classes.append("ratio")
     rep.table(header, rows, row_classes=classes)
     missing = [p for p in pairs if not p["runs"]]
@@ -978,17 +1048,20 @@ def kidnap_table(rep, papers, runs):
         for label, key in t["reproduced_by"]["rows"].items():
             sel = R.select(runs, key)
             if sel:
+                # Counts: a run without a recovery block counts none. Statistics: run_stats, so that a
+                # null (no kidnap recovered, no estimate) reads as such, never as 0.
                 ep = sum(r.metric("recovery/episodes", "all") or 0 for r in sel)
                 rec = sum(r.metric("recovery/recovered", "all") or 0 for r in sel)
                 fal = sum(r.metric("recovery/false_recoveries", "all") or 0 for r in sel)
-                med = R.stats([r.metric("recovery/recovery_time_s/median", "all") for r in sel])
-                after = R.stats([r.metric("recovery/after_recovery/x_cm/mean", "all") for r in sel])
-                phase = R.stats([r.metric("x_cm/mean", "tracking") for r in sel])
-                allf = R.stats([r.metric("x_cm/mean", "all") for r in sel])
+                med = R.run_stats(sel, "recovery/recovery_time_s/median", "all")
+                after = R.run_stats(sel, "recovery/after_recovery/x_cm/mean", "all")
+                phase = R.run_stats(sel, "x_cm/mean", "tracking")
+                allf = R.run_stats(sel, "x_cm/mean", "all")
                 per_seed = ", ".join(f"s{r.seed}\u00a0{r.metric('recovery/recovered', 'all') or 0:.0f}/{r.metric('recovery/episodes', 'all') or 0:.0f}"
-                                     f"\u00a0{fnum(r.metric('x_cm/mean', 'tracking'), 2)}" for r in sel)
-                rows.append([f"{C.table_label(table)}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}", fnum(med["mean"], 2), fnum(after["mean"], 2),
-                             fnum(phase["mean"], 2), fnum(allf["mean"], 1), per_seed, len(sel)])
+                                     f"\u00a0{seed_cell(r, 'x_cm/mean', 'tracking', 2)}" for r in sel)
+                rows.append([f"{C.table_label(table)}: {label}", "omniloc", f"{rec:.0f} / {ep:.0f}", f"{fal:.0f}",
+                             R.stat_cell(med, 2) if med["n"] or not med["no_value"] else "none recovered", R.stat_cell(after, 2),
+                             answered_beside(R.stat_cell(phase, 2), sel, "tracking"), answered_beside(R.stat_cell(allf, 1), sel, "all"), per_seed, len(sel)])
                 classes.append("")
             else:
                 rows.append([f"{C.table_label(table)}: {label}", "not run", "-", "-", "-", "-", "-", "-", "-", 0])
@@ -998,7 +1071,21 @@ def kidnap_table(rep, papers, runs):
     rep.table(["case", "source", "recovered / kidnaps", "false recoveries", "median recovery s", "after recovery: mean x cm",
                "tracking phase: mean x cm", "all frames: mean x cm", "per seed: recovered, tracking-phase mean x cm", "seeds"], rows,
               "Over all seeds, and every seed beside the means. Recovered: error under 0.3 m and 0.2 rad for 1 s. The tracking phase leaves out the carried period and the time to recovery; "
-              "'all frames' includes them (that is why it is large).", classes)
+              "'all frames' includes them (that is why it is large). The errors are over the frames answered (their share beside them); "
+              "'no estimate' where a run answered none, 'no kidnap recovered' where no recovery left a frame to score.", classes)
+
+
+def seed_cell(run, path, phase, digits):
+    """One run's statistic: its value, or "no estimate" where it is null (see R.Run.lookup)."""
+    found, v = run.lookup(path, phase)
+    return R.NO_ESTIMATE if found and v is None else fnum(run.metric(path, phase), digits)
+
+
+def answered_beside(cell, runs, phase):
+    """An error cell with the share of frames answered beside it: '2.31 (answered 98.0 %)' (mean
+    over the runs; the cell alone for runs made before valid_fraction)."""
+    st = R.run_stats(runs, "valid_fraction", phase)
+    return f"{cell} (answered {R.percent(st['mean'])})" if st["n"] else cell
 
 
 def timing_table(rep, papers, runs):
@@ -1142,9 +1229,13 @@ def error_budget_section(rep, ctx):
         """mean [95 % interval] over the seeds (issue 29), or the mean alone for one seed or an old file."""
         if key not in r:
             return "failed" if key == "position_rmse_cm" else "-"
+        if r[key] is None:  # over no answered frame: never a number
+            return R.NO_ESTIMATE
         seeds = [x.get(key) for x in r.get("per_seed", [])]
         if len(seeds) < 2:
             return fnum(r[key], 2)
+        if any(v is None for v in seeds):
+            return fnum(r[key], 2) + f" ({R.no_estimate_text(sum(v is None for v in seeds), len(seeds))})"
         st = R.stats(seeds)
         if max(seeds) - min(seeds) <= 1e-9 * max(1.0, abs(st["mean"])):
             return f"{fnum(st['mean'], 2)} (= every seed)"
@@ -1168,7 +1259,7 @@ def error_budget_section(rep, ctx):
     fig, ax = plt.subplots(figsize=(9, 0.45 * len(sources) + 1.5))
     h = 0.8 / max(1, len(locs))
     for i, l in enumerate(locs):
-        vals = [rows_by_source[s].get(l, {}).get("position_rmse_cm", float("nan")) for s in sources]
+        vals = [v if R.is_number(v := rows_by_source[s].get(l, {}).get("position_rmse_cm")) else float("nan") for s in sources]
         ax.barh([k + i * h for k in range(len(sources))], vals, height=h, label=l)
     ax.set_yticks([k + 0.4 - h / 2 for k in range(len(sources))])
     ax.set_yticklabels(sources)
@@ -1186,7 +1277,7 @@ def reference_error_text(rep, rows_by_source, ctx):
     ratios = []
     for src, per in rows_by_source.items():
         r = per.get("matching", {})
-        if r.get("position_rmse_cm") and "heading_rmse_deg" in r:
+        if r.get("position_rmse_cm") and R.is_number(r.get("heading_rmse_deg")):
             ratios.append((r["heading_rmse_deg"] / r["position_rmse_cm"], src))
     if not ratios:
         return
@@ -1239,15 +1330,25 @@ def global_start_section(rep, sweeps):
             continue
         rep.heading(f"Global start, judged per run: {sw.name}", 2, "global_start")
         rows = []
-        for loc in sorted(by, key=lambda k: (k not in ("mcl", "hybrid", "grid_global"), k)):
-            g = G.summarise([r for _, r in by[loc]])
-            rows.append([loc, f"{g['ended_right']} / {g['runs']}", f"{100 * g['wilson95'][0]:.0f}-{100 * g['wilson95'][1]:.0f} %",
-                         fnum(g["t_first_median_s"], 2), fnum(g["right_mean_x_cm"], 2), fnum(g["right_mean_y_cm"], 2),
-                         fnum(g["right_mean_theta_rad"], 4), fnum(100 * g["wrong_frame_fraction"], 2), fnum(g["all_mean_pos_cm"], 1)])
-        rep.table(["localizer", "ended right", "Wilson 95 %", "first correct convergence median s", "while right: mean x cm", "mean y cm",
+        table = {loc: G.summarise([r for _, r in by[loc]]) for loc in sorted(by, key=lambda k: (k not in ("mcl", "hybrid", "grid_global"), k))}
+        with_recall = any(g.get("recall_key") for g in table.values())
+        none = lambda v, d, g: (R.NO_ESTIMATE if g["runs_without_estimate"] == g["runs"] else "-") if v is None else fnum(v, d)
+        for loc, g in table.items():
+            rows.append([loc] + ([R.percent(g["recall_mean"]), R.percent(g["answered_mean"]),
+                                  fnum(g["first_within_median_s"], 2) + (f" ({g['runs_never_within']} never)" if g["runs_never_within"] else "")]
+                                 if with_recall else []) +
+                        [f"{g['ended_right']} / {g['runs']}", f"{100 * g['wilson95'][0]:.0f}-{100 * g['wilson95'][1]:.0f} %",
+                         fnum(g["t_first_median_s"], 2), none(g["right_mean_x_cm"], 2, g), none(g["right_mean_y_cm"], 2, g),
+                         none(g["right_mean_theta_rad"], 4, g), fnum(g["wrong_frame_fraction"] * 100 if g["wrong_frame_fraction"] is not None else None, 2),
+                         none(g["all_mean_pos_cm"], 1, g)])
+        head = G.recall_header(table)
+        rep.table(["localizer"] + ([head, "answered", "first within it: median s"] if with_recall else []) +
+                  ["ended right", "Wilson 95 %", "first correct convergence median s", "while right: mean x cm", "mean y cm",
                    "mean th rad", "wrong frames %", "mean position error over all valid frames cm"], rows,
                   "scripts/global_start.py (definitions there and in docs/global_localization.md). Paper 002's 'MCL alone 15-40 cm' "
-                  "is to be read on the success rate and the error while right, not on the mean over all frames.")
+                  "is to be read on the success rate and the error while right, not on the mean over all frames."
+                  + (f" '{head}': the share of all frames within it (a frame without an estimate counts as outside), mean over runs; "
+                     "'answered': the share of frames with an estimate." if with_recall else ""))
 
 
 def field_lines(ax, run):
@@ -1285,7 +1386,7 @@ def plot_run(rep, run, title):
     for rid, fr in sorted(by_robot.items()):
         gx, gy = [], []
         for f in fr:  # a break where the truth jumps (teleport / kidnap), not a line across the field
-            x, y = float(f["gt_x"]), float(f["gt_y"])
+            x, y = float(f["gt_x"] or "nan"), float(f["gt_y"] or "nan")  # no truth: a gap
             if gx and not math.isnan(gx[-1]) and math.hypot(x - gx[-1], y - gy[-1]) > 0.5:
                 gx.append(float("nan"))
                 gy.append(float("nan"))
@@ -1303,7 +1404,7 @@ def plot_run(rep, run, title):
     for k, (col, label, unit, scale) in enumerate([("err_pos", "position error", "cm", 100.0), ("err_theta", "heading error", "deg", 180.0 / math.pi)]):
         ax = axes[1 + k]
         for rid, fr in sorted(by_robot.items()):
-            v = [f for f in fr if f["valid"] == "1"]
+            v = [f for f in fr if f["valid"] == "1" and f.get(col) not in (None, "")]  # no error without truth
             ax.plot([float(f["t"]) for f in v], [abs(float(f[col])) * scale for f in v], lw=0.8, label=f"r{rid}", zorder=3)
         # Events: a triangle above the plotting area and a faint dashed line BEHIND the data, so a
         # mark never hides the error it explains.
@@ -1345,9 +1446,35 @@ def run_title(run, params=None):
 POSITION_COLS = ["position mean m", "position RMSE m", "position p95 m"]
 
 
+def block_cell(block, path, digits):
+    """A statistic of one summary.json block: its value; where it is null, the block's why_null in
+    short ("no estimate", "no kidnap recovered"); "-" where the block lacks it (an older run)."""
+    found, v = R.find(block or {}, path)
+    if found and v is None:
+        why = (block or {}).get("why_null") or ""
+        return why if why and not why.startswith(R.NO_ESTIMATE) else R.NO_ESTIMATE
+    return fnum(v if R.is_number(v) else None, digits)
+
+
 def position_cells(block):
-    pm = block.get("position_m") or {}
-    return [fnum(pm.get(k), 3) for k in ("mean", "rmse", "p95")]
+    return [block_cell(block, f"position_m/{k}", 3) for k in ("mean", "rmse", "p95")]
+
+
+def coverage_cells(block, key, with_answered):
+    """The share of the block's frames within the headline threshold and the share answered."""
+    return ([R.percent((block.get("recall") or {}).get(key))] if key else []) + ([R.percent(block.get("valid_fraction"))] if with_answered else [])
+
+
+def first_fix_text(s, key):
+    """'robot 0: first estimate at 0.03 s, first within 25 cm / 10 deg at 0.50 s' (never: 'never')."""
+    parts = []
+    for r in s.get("robots", []):
+        if "first_estimate_s" not in r and "first_within_s" not in r:
+            continue
+        t = lambda k: "never" if r.get(k) is None else f"at {r[k]:.2f} s"
+        parts.append(f"robot {r.get('robot', 0)}: first estimate {t('first_estimate_s')}"
+                     + (f", first within {R.recall_label(key)} {t('first_within_s')}" if key else ""))
+    return "; ".join(parts)
 
 
 def report_run(rep, run, plots, params=None, note=None):
@@ -1355,23 +1482,30 @@ def report_run(rep, run, plots, params=None, note=None):
     title = run_title(run, params) + (f" ({note})" if note else "")
     rep.heading(f"Run {title}", 3)
     rows = []
+    key = run.headline
+    answered = any("valid_fraction" in r for r in s.get("robots", []))
     for r in s.get("robots", []):
-        rows.append([f"r{r['robot']}" + (" all frames" if "tracking_phase" in r else "")] + [fnum(r[a][st], 3) for a, st in R.TABLE_KEYS] +
-                    position_cells(r) + [r.get("frames", "-")])
+        rows.append([f"r{r['robot']}" + (" all frames" if "tracking_phase" in r else "")] + coverage_cells(r, key, answered) +
+                    [block_cell(r, f"{a}/{st}", 3) for a, st in R.TABLE_KEYS] + position_cells(r) + [r.get("frames", "-")])
         if "tracking_phase" in r:
             tp = r["tracking_phase"]
-            rows.append([f"r{r['robot']} tracking phase"] + [fnum(tp[a][st], 3) for a, st in R.TABLE_KEYS] + position_cells(tp) + [tp.get("frames", "-")])
+            rows.append([f"r{r['robot']} tracking phase"] + coverage_cells(tp, key, answered) + [block_cell(tp, f"{a}/{st}", 3) for a, st in R.TABLE_KEYS]
+                        + position_cells(tp) + [tp.get("frames", "-")])
     task = R.start_pose_text(run.start_pose_given)
-    rep.table(["robot"] + R.TABLE_COLS + POSITION_COLS + ["frames"], rows,
+    first = first_fix_text(s, key)
+    rep.table(["robot"] + ([f"within {R.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + R.TABLE_COLS + POSITION_COLS + ["frames"], rows,
               f"noise profile {s.get('noise_profile')}, {s.get('duration_s')} s at {s.get('camera_rate_hz')} Hz" + (f"; {task}" if task else "") +
-              f"; omniloc {(s.get('omniloc') or {}).get('version', 'unrecorded')}")
+              f"; omniloc {(s.get('omniloc') or {}).get('version', 'unrecorded')}"
+              + ("; errors over the frames answered" if answered else "") + (f"; {first}" if first else ""))
     for r in s.get("robots", []):
         rec = r.get("recovery")
         if rec:
-            rt = rec.get("recovery_time_s", {})
+            rt = rec.get("recovery_time_s") or {}
+            after = rec.get("after_recovery") or {}
+            none = lambda v: "none recovered" if v is None and "recovery_time_s" in rec else fnum(v, 2)
             rep.table(["robot", "kidnaps", "recovered", "false", "mirrored", "median s", "max s", "after: mean x cm", "mean y cm"],
-                      [[f"r{r['robot']}", rec["episodes"], rec["recovered"], rec["false_recoveries"], rec["mirrored"], fnum(rt.get("median"), 2),
-                        fnum(rt.get("max"), 2), fnum(rec["after_recovery"]["x_cm"]["mean"], 2), fnum(rec["after_recovery"]["y_cm"]["mean"], 2)]],
+                      [[f"r{r['robot']}", rec.get("episodes", "-"), rec.get("recovered", "-"), rec.get("false_recoveries", "-"), rec.get("mirrored", "-"),
+                        none(rt.get("median")), none(rt.get("max")), block_cell(after, "x_cm/mean", 2), block_cell(after, "y_cm/mean", 2)]],
                       "kidnap recovery (error under 0.3 m and 0.2 rad for 1 s)")
     if plots:
         plot_run(rep, run, title)
@@ -1398,6 +1532,22 @@ def sweep_runs(sweep, all_runs):
     return [(r, p, n) for _, _, r, p, n in sorted(out, key=lambda x: (x[0], x[1]))]
 
 
+def aggregate_cell(metric, digits):
+    """One metric of an aggregate.json group ({"n", "mean", "no_value", ...}): its mean; "no
+    estimate" where no run had a value; "-" where the group lacks the metric."""
+    if not metric:
+        return "-"
+    if metric.get("mean") is None:
+        return R.NO_ESTIMATE if metric.get("no_value") else "-"
+    return fnum(metric["mean"], digits)
+
+
+def middle_recall_key(agg):
+    """The middle recall threshold an aggregate names (its runs' headline where they do not say)."""
+    keys = sorted({k.split("/")[-1] for g in agg.get("groups", []) for k in g.get("metrics", {}) if k.startswith("r0/recall/")}, key=R.recall_order)
+    return keys[len(keys) // 2] if keys else None
+
+
 def report_sweep(rep, sweep, all_runs, max_runs):
     agg = json.loads((sweep / "aggregate.json").read_text())
     name = agg.get("sweep", agg.get("name", sweep.name))
@@ -1410,19 +1560,29 @@ def report_sweep(rep, sweep, all_runs, max_runs):
     # from before start_pose_given has neither).
     kinds = {g.get("start_pose_given") for g in agg["groups"]}
     mark = True in kinds and (False in kinds or "mixed" in kinds)
+    runs = sweep_runs(sweep, all_runs)
+    key = R.headline_key([r for r, _, _ in runs]) or middle_recall_key(agg)
+    answered = any("r0/valid_fraction" in g["metrics"] for g in agg["groups"])
     for g in agg["groups"]:
         m = g["metrics"]
         phase = "r0/tracking_phase/x_cm/mean" in m
-        val = lambda a, s: m.get(f"r0/tracking_phase/{a}/{s}" if phase else f"r0/{a}/{s}", {}).get("mean")
-        n = m.get("r0/x_cm/mean", {}).get("n", 0)
+        name = lambda path: f"r0/tracking_phase/{path}" if phase else f"r0/{path}"
+        cell = lambda path, digits: aggregate_cell(m.get(name(path)), digits)
+        x = m.get("r0/x_cm/mean", {})
+        n, without = x.get("n", 0), x.get("no_value", 0)
         given = g.get("start_pose_given")
         task = " (given the start pose)" if mark and given is True else " (start pose: mixed)" if given == "mixed" else ""
         rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')}{task} / {params_text(g.get('params', ''))}" + (" (tracking phase)" if phase else "")] +
-                    [fnum(val(a, s), 3) for a, s in R.TABLE_KEYS] + [fnum(val("position_m", "mean"), 3), fnum(val("position_m", "rmse"), 3)] +
-                    [f"{g.get('finished', '-')}/{g.get('failed', 0)}", n])
-    rep.table(["group"] + R.TABLE_COLS + ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
-              "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'.")
-    runs = sweep_runs(sweep, all_runs)
+                    ([R.percent((m.get(name(f"recall/{key}")) or {}).get("mean"))] if key else []) +
+                    ([R.percent((m.get(name("valid_fraction")) or {}).get("mean"))] if answered else []) +
+                    [cell(f"{a}/{s}", 3) for a, s in R.TABLE_KEYS] + [cell("position_m/mean", 3), cell("position_m/rmse", 3)] +
+                    [f"{g.get('finished', '-')}/{g.get('failed', 0)}", f"{n}; {R.no_estimate_text(without, n + without)}" if without else n])
+    rep.table(["group"] + ([f"within {R.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + R.TABLE_COLS +
+              ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
+              "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'."
+              + (f" 'within {R.recall_label(key)}': the share of all frames within that threshold (a frame without an estimate counts as outside); "
+                 "'answered': the share of frames with an estimate; the errors are over the answered frames, 'no estimate' where no run of the "
+                 "group answered any, and n counts the runs with a value (aggregate.csv also counts those without one)." if key or answered else ""))
     groups = {}
     for run, params, name in runs:
         groups.setdefault((run.scenario, name, params), []).append(run)
@@ -1450,38 +1610,64 @@ def report_sweep(rep, sweep, all_runs, max_runs):
     return [r for r, _, _ in runs]
 
 
-def tracking_errors(run):
-    """Position errors (m) of the valid frames of the tracking phase (outside the excluded intervals)."""
+def tracking_errors(run, counts=None):
+    """Position errors (m) of the valid frames of the tracking phase (outside the excluded intervals).
+    `counts`, a dict, receives "frames": every tracking-phase frame, answered or not."""
     excl = {}
     for r in run.summary.get("robots", []):
         excl[str(r.get("robot"))] = (r.get("tracking_phase") or {}).get("excluded", [])
-    out = []
+    out, total = [], 0
     for f in run.frames():
-        if f["valid"] != "1":
+        if f.get("err_pos") in (None, ""):  # no truth: not scored
             continue
         t = float(f["t"])
         if any(a - 1e-9 <= t < b - 1e-9 for a, b in excl.get(f["robot"], [])):
             continue
+        total += 1
+        if f["valid"] != "1":
+            continue
         out.append(float(f["err_pos"]))
+    if counts is not None:
+        counts["frames"] = counts.get("frames", 0) + total
     return out
+
+
+def pooled_coverage(runs, key):
+    """(recall at threshold `key`, share answered) pooled over every robot's tracking-phase frames
+    of the runs, from their summary.json (recall x frames_total summed); None where unknown."""
+    within = answered = total = 0.0
+    for run in runs:
+        for r in run.summary.get("robots", []):
+            b = r.get("tracking_phase") if isinstance(r.get("tracking_phase"), dict) else r
+            n = b.get("frames_total")
+            if not R.is_number(n) or not n:
+                continue
+            rec, vf = (b.get("recall") or {}).get(key), b.get("valid_fraction")
+            if not (R.is_number(rec) and R.is_number(vf)):
+                continue
+            within, answered, total = within + rec * n, answered + vf * n, total + n
+    return (within / total, answered / total) if total else (None, None)
 
 
 def cdf_and_timing(rep, runs):
     """Error CDF and timing per localizer AND noise profile (issue 38): frames of robot and
     field_robot runs are never pooled into one curve, row or bar; every row names its profile and
     how many runs its frames come from."""
-    errs, timing, nruns = {}, {}, {}
+    errs, timing, nruns, frames, by_key = {}, {}, {}, {}, {}
     for run in runs:
         key = (run.localizer, profile_of(run))  # (localizer, noise profile)
         nruns[key] = nruns.get(key, 0) + 1
-        errs.setdefault(key, []).extend(tracking_errors(run))
+        by_key.setdefault(key, []).append(run)
+        errs.setdefault(key, []).extend(tracking_errors(run, frames.setdefault(key, {})))
         for r in run.timing():
             d = timing.setdefault(key, {"render_ms": [], "vision_ms": [], "localize_ms": [], "compute_ms": []})
             for k in d:
                 if r.get(k) not in (None, ""):  # compute_ms: only an external client that reports its own time
                     d[k].append(float(r[k]))
-    errs = {k: v for k, v in errs.items() if v}
+    # A localizer that answered no frame stays in the table ("no estimate"); it has no curve.
+    errs = {k: v for k, v in errs.items() if v or frames[k].get("frames")}
     profiles = sorted({p for _, p in list(errs) + list(timing)})
+    head = R.headline_key(runs)
     name = lambda key: f"{key[0]} ({key[1]} profile)"
     runs_text = lambda key: f"{nruns[key]} run{'s' if nruns[key] != 1 else ''}"
     apart = (f"Per localizer and noise profile ({', '.join(profiles)}): runs of different profiles are never pooled." if len(profiles) > 1
@@ -1491,20 +1677,32 @@ def cdf_and_timing(rep, runs):
         fig, ax = plt.subplots(figsize=(7, 4))
         styles = {p: s for p, s in zip(profiles, ["-", "--", ":", "-."] * 4)}
         for key, e in sorted(errs.items()):
+            if not e:
+                continue
+            # Over ALL tracking-phase frames: a frame without an estimate is never within any error,
+            # so a curve levels off at the share answered (a localizer that answers only easy frames
+            # does not look better).
+            n = max(frames[key].get("frames", 0), len(e))
             e = sorted(max(x, 1e-4) for x in e)
-            ax.plot(e, [(i + 1) / len(e) for i in range(len(e))], styles[key[1]], label=f"{name(key)}: {len(e)} frames, {runs_text(key)}")
+            ax.plot(e, [(i + 1) / n for i in range(len(e))], styles[key[1]],
+                    label=f"{name(key)}: {len(e)} of {n} frames answered, {runs_text(key)}")
         log_axis(ax.xaxis, ax, "x")
         ax.set_ylim(0, 1)
         ax.set_xlabel("position error (m, log scale)")
-        ax.set_ylabel("fraction of valid frames")
+        ax.set_ylabel("share of all frames within the error")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         rep.figure(fig, "cdf", "position error CDF over the reported runs' tracking phases (carried periods and recoveries left out), "
-                   "one curve per localizer and noise profile (line style: profile). " + apart)
-        rep.table(["localizer", "profile", "runs", "frames", "median m", "p90 m", "p99 m"],
-                  [[key[0], key[1], nruns[key], len(e), fnum(statistics.median(e), 4), fnum(sorted(e)[int(0.9 * (len(e) - 1))], 4),
-                    fnum(sorted(e)[int(0.99 * (len(e) - 1))], 4)] for key, e in sorted(errs.items())],
-                  "valid tracking-phase frames pooled over the localizer's runs (seeds and scenarios) under that one profile. " + apart)
+                   "one curve per localizer and noise profile (line style: profile), over all their frames: a frame without an estimate "
+                   "counts as never within, so each curve levels off at the share of frames answered. " + apart)
+        q = lambda e, f: fnum(sorted(e)[int(f * (len(e) - 1))], 4) if e else R.NO_ESTIMATE
+        cov = {key: pooled_coverage(by_key[key], head) if head else (None, None) for key in errs}
+        rep.table(["localizer", "profile", "runs"] + ([f"within {R.recall_label(head)}", "answered"] if head else []) + ["frames", "median m", "p90 m", "p99 m"],
+                  [[key[0], key[1], nruns[key]] + ([R.percent(cov[key][0]), R.percent(cov[key][1])] if head else []) +
+                   [len(e), fnum(statistics.median(e), 4) if e else R.NO_ESTIMATE, q(e, 0.9), q(e, 0.99)] for key, e in sorted(errs.items())],
+                  ("Coverage first: the share of all tracking-phase frames within the headline threshold (a frame without an estimate "
+                   "counts as outside) and the share answered, pooled over the localizer's runs; then " if head else "")
+                  + "the errors of the valid (answered) tracking-phase frames pooled over the localizer's runs (seeds and scenarios) under that one profile. " + apart)
     if timing:
         rep.heading("Timing per stage, per localizer and noise profile", 2)
         rows = []
@@ -1704,8 +1902,11 @@ def main():
         base_runs, _, _ = R.discover(a.baseline, a.accept_incomplete)
         rep.heading("Comparison with the baseline", 2, "baseline")
         header, rows = compare.compare_rows(base_runs, runs)
+        # Metric names as the reader types them (aggregate.csv's, summary.json's): code.
+        rows = [r[:1] + ([f"`{r[1]}`"] if not str(r[1]).startswith("(") else r[1:2]) + r[2:] for r in rows]
+        explanation = compare.EXPLANATION.replace("recall/T", "`recall/T`").replace("valid_fraction", "`valid_fraction`")
         rep.table(header, rows, f"baseline: {' '.join(a.baseline)}; this report's results as 'new'. "
-                  + compare.EXPLANATION)
+                  + explanation)
     in_sweeps = set()
     for sw in sweeps:
         for r in report_sweep(rep, sw, runs, a.max_runs):

@@ -5,6 +5,10 @@ The results are two sweeps of the shipped CI suite (scenarios/sweeps/ci_quick.js
 no frame drawn): the built-in matching as it ships, and the same with a deliberately degraded
 distance map (cell 0.4 m instead of 0.05 m: the map's gradient is coarser than the line points'
 spread, so RPROP settles up to a cell off; position rmse about 12 cm instead of about 4 cm).
+Runs without an estimate (class NoEstimate): a sweep of the hand-written recording with mcl, which
+answers none of its 30 frames (every error statistic null in summary.json), beside matching, which
+answers every one; and a copy of the CI sweep with one run's statistic made null. A run without
+estimates never passes an accuracy limit, a regression check or a recall limit.
 Run with OMNILOC_BIN=build/omniloc /usr/bin/python3 -m unittest gate_test (ctest gate_py).
 """
 import csv
@@ -24,6 +28,7 @@ GATE = [sys.executable, str(ROOT / "scripts" / "gate.py")]
 SUITE = ROOT / "scenarios" / "sweeps" / "ci_quick.json"
 XSD = ROOT / "tests" / "data" / "junit.xsd"
 DEGRADED = '{"type": "matching", "cell": 0.4}'
+HANDWRITTEN = ROOT / "tests" / "data" / "handwritten_recording"
 
 
 CWD = tempfile.mkdtemp(prefix="gate_test_cwd_")  # omniloc's caches (results/cache) land here, not in the tree
@@ -31,6 +36,10 @@ CWD = tempfile.mkdtemp(prefix="gate_test_cwd_")  # omniloc's caches (results/cac
 
 def run(cmd, **kw):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=CWD, **kw)
+
+
+def tearDownModule():
+    shutil.rmtree(CWD, ignore_errors=True)
 
 
 class Gate(unittest.TestCase):
@@ -46,7 +55,6 @@ class Gate(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
-        shutil.rmtree(CWD, ignore_errors=True)
 
     def rules(self, rules, name="rules.json"):
         f = self.tmp / name
@@ -133,6 +141,26 @@ class Gate(unittest.TestCase):
         self.assertEqual(self.gate(self.bad, "--rules", tight, "--baseline", self.good).returncode, 1)
         frac = self.rules([{"metric": "r0/position_m/rmse", "scenario": "ci_tracking", "tolerance_fraction": 2.0}])
         self.assertEqual(self.gate(self.bad, "--rules", frac, "--baseline", self.good).returncode, 0)  # 12 cm < 4 cm + 200 %
+
+    def test_recall_is_higher_is_better_in_regressions(self):
+        # The degraded map puts a third of the tracking frames within 10 cm / 5 deg instead of all:
+        # a baseline-only rule on recall knows that a fall is the regression (no "better" given).
+        r = self.rules([{"metric": "r0/recall/10cm_5deg", "scenario": "ci_tracking"}])
+        p = self.gate(self.bad, "--rules", r, "--baseline", self.good)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        (line,) = self.verdicts(p.stdout)
+        self.assertIn("[regression: mean", line)
+        self.assertEqual(self.gate(self.good, "--rules", r, "--baseline", self.bad).returncode, 0)
+        # The same for valid_fraction, and a "max" on recall does not turn the direction round.
+        sys.path.insert(0, str(ROOT / "scripts"))
+        import gate
+        self.assertTrue(gate.higher_is_better("r0/tracking_phase/recall/25cm_10deg"))
+        self.assertTrue(gate.higher_is_better("valid_fraction"))
+        self.assertTrue(gate.higher_is_better("r0/recovery/recovered_fraction"))
+        self.assertFalse(gate.higher_is_better("r0/position_m/rmse"))
+        rules = gate.load_rules(self.rules([{"metric": "r0/recall/10cm_5deg", "max": 1.0}, {"metric": "r0/position_m/rmse", "min": 0.0},
+                                            {"metric": "r0/recall/10cm_5deg", "better": "lower"}]), True)
+        self.assertEqual([r["better"] for r in rules], ["higher", "higher", "lower"])  # min alone: higher, as before
 
     def test_higher_is_better_direction(self):
         # valid_fraction is 1 on both sides; a rule saying higher is better on the position error
@@ -244,6 +272,31 @@ class Gate(unittest.TestCase):
             scenario = e["name"].split(" / ")[0]
             self.assertAlmostEqual(e["value"], self.aggregate_mean(self.good, scenario, "r0/position_m/rmse"), places=12)
 
+    def test_partial_no_estimate_fails_and_a_baseline_without_one_is_noted(self):
+        # One of five runs without an estimate: the group fails whatever its limit, and the mean over
+        # the four others is not what decides.
+        partial = self.tmp / "one_null"
+        shutil.copytree(self.good, partial)
+        with open(partial / "runs.csv", newline="") as fh:
+            first = next(r["id"] for r in csv.DictReader(fh) if r["id"].startswith("ci_tracking"))
+        f = partial / "runs" / first / "summary.json"
+        s = json.loads(f.read_text())
+        s["robots"][0]["position_m"]["rmse"] = None
+        f.write_text(json.dumps(s))
+        rules = self.rules([{"metric": "r0/position_m/rmse", "max": 1.0, "scenario": "ci_tracking"}])
+        p = self.gate(partial, "--rules", rules)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        (line,) = self.verdicts(p.stdout)
+        self.assertTrue(line.startswith("FAIL"), line)
+        self.assertIn("(n=4 of 5)", line)
+        self.assertIn("[no estimate in 1 of 5 runs]", line)
+        # Regression against a complete baseline: fails the same way.
+        self.assertEqual(self.gate(partial, "--rules", rules, "--baseline", self.good).returncode, 1)
+        # A baseline without an estimate in one run: compared on the others, and said.
+        p = self.gate(self.good, "--rules", rules, "--baseline", partial)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("[baseline: no estimate in 1 of 5 runs]", p.stdout)
+
     # ---- through the omniloc binary ------------------------------------------------------------
 
     def test_cli_forwarding(self):
@@ -266,6 +319,96 @@ class Gate(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
         self.assertIn("Slurm", p.stderr)
         self.assertFalse((self.tmp / "x").exists())
+
+
+class NoEstimate(unittest.TestCase):
+    """mcl answers none of the hand-written recording's 30 frames: summary.json has every error
+    statistic null (never 0), recall 0 and valid_fraction 0; matching answers every frame."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = pathlib.Path(tempfile.mkdtemp(prefix="gate_none_"))
+        spec = {"name": "handwritten", "scenarios": [{"recording": str(HANDWRITTEN)}], "localizers": [{"type": "mcl"}, {"type": "matching"}]}
+        (cls.tmp / "sweep.json").write_text(json.dumps(spec))
+        cls.sweep = cls.tmp / "sweep"
+        p = run([BIN, "sweep", str(cls.tmp / "sweep.json"), "-o", str(cls.sweep)])
+        assert p.returncode == 0, p.stdout + p.stderr
+        cls.mcl = next(d for d in (cls.sweep / "runs").iterdir() if "__mcl__" in d.name)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def rules(self, rules, name="rules.json"):
+        f = self.tmp / name
+        f.write_text(json.dumps({"rules": rules}))
+        return str(f)
+
+    def gate(self, *args):
+        return run(GATE + [str(a) for a in args])
+
+    def lines(self, out, localizer):
+        return [ln for ln in out.splitlines() if ln.startswith(("PASS", "FAIL")) and f" / {localizer} " in ln]
+
+    def test_the_fixture_has_no_estimate(self):
+        r = json.loads((self.mcl / "summary.json").read_text())["robots"][0]
+        self.assertIsNone(r["position_m"]["rmse"])
+        self.assertEqual(r["frames"], 0)
+        self.assertEqual(r["valid_fraction"], 0.0)
+        self.assertIn("no estimate", r["why_null"])
+
+    def test_a_run_without_estimates_fails_an_accuracy_limit(self):
+        junit = self.tmp / "junit.xml"
+        p = self.gate(self.mcl, "--rules", self.rules([{"metric": "position_m/rmse", "max": 0.10}]), "--junit", junit)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        (line,) = self.lines(p.stdout, "mcl")
+        self.assertTrue(line.startswith("FAIL"), line)
+        self.assertIn("no estimate in 1 of 1 runs", line)
+        self.assertNotIn("mean 0 ", line)
+        self.assertIn("gate: 0 of 1 checks passed, 1 failed", p.stdout)
+        (case,) = ET.parse(junit).getroot().iter("testcase")
+        fail = case.find("failure")
+        self.assertIsNotNone(fail)
+        self.assertIn("no estimate in 1 of 1 runs", fail.get("message"))
+        self.assertEqual(fail.get("type"), "no estimate")
+        if shutil.which("xmllint"):
+            v = run(["xmllint", "--noout", "--schema", str(XSD), str(junit)])
+            self.assertEqual(v.returncode, 0, v.stderr)
+
+    def test_every_kind_of_rule_fails_without_an_estimate(self):
+        rules = self.rules([{"metric": "r0/position_m/rmse", "max": 0.10}, {"metric": "r0/theta_rmse_rad", "min": 0.0},
+                            {"metric": "r0/x_cm/max", "stat": "max", "max": 100.0}, {"metric": "r0/first_within_s", "max": 1.0}])
+        p = self.gate(self.sweep, "--rules", rules)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        mcl, matching = self.lines(p.stdout, "mcl"), self.lines(p.stdout, "matching")
+        self.assertEqual(len(mcl), 4)
+        self.assertTrue(all(ln.startswith("FAIL") and "no estimate in 1 of 1 runs" in ln for ln in mcl), mcl)
+        self.assertTrue(all(ln.startswith("PASS") for ln in matching), matching)
+        # A baseline-only rule (the run against itself): no estimate still fails.
+        p = self.gate(self.sweep, "--rules", self.rules([{"metric": "r0/position_m/rmse"}]), "--baseline", self.sweep)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        self.assertTrue(self.lines(p.stdout, "mcl")[0].startswith("FAIL"))
+        self.assertTrue(self.lines(p.stdout, "matching")[0].startswith("PASS"))
+
+    def test_a_min_recall_rule(self):
+        rules = self.rules([{"metric": "recall/25cm_10deg", "min": 0.9}, {"metric": "r0/valid_fraction", "min": 0.9}])
+        p = self.gate(self.sweep, "--rules", rules)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        for ln in self.lines(p.stdout, "mcl"):  # recall and valid_fraction are 0, not null: a number below the limit
+            self.assertTrue(ln.startswith("FAIL"), ln)
+            self.assertIn("mean 0 (n=1)", ln)
+            self.assertIn("< min 0.9", ln)
+        self.assertTrue(all(ln.startswith("PASS") for ln in self.lines(p.stdout, "matching")))
+        only = self.rules([{"metric": "r0/recall/25cm_10deg", "min": 0.9, "localizer": "matching"}])
+        self.assertEqual(self.gate(self.sweep, "--rules", only).returncode, 0)
+
+    def test_benchmark_json_leaves_out_a_check_without_value(self):
+        out = self.tmp / "bench.json"
+        p = self.gate(self.sweep, "--rules", self.rules([{"metric": "r0/position_m/rmse", "max": 0.10}]), "--benchmark-json", out)
+        self.assertEqual(p.returncode, 1)
+        data = json.loads(out.read_text())
+        self.assertEqual([e["name"] for e in data], ["handwritten / matching: r0/position_m/rmse (mean)"])
+        self.assertIn("1 check(s) without a value (no estimate) are not in", p.stdout)
 
 
 if __name__ == "__main__":

@@ -87,6 +87,46 @@ class ScoreRun(unittest.TestCase):
             s = G.summarise([r for _, r in by["mcl"]])
             self.assertEqual((s["ended_right"], s["runs_with_wrong_frames"], s["outside_walls_frames"]), (1, 1, 60))
 
+    def test_a_run_without_any_estimate_has_no_error_while_right(self):
+        # Every frame invalid (the localizer never answered): no right frame, so no error while
+        # right and no maximum (None, never 0), and the table says "no estimate".
+        rows = [row(k / 30, 3.0, valid=False) for k in range(60)]
+        r = G.score_run(rows)
+        self.assertEqual((r["valid_frames"], r["right_frames"]), (0, 0))
+        self.assertIsNone(r["max_x"])
+        s = G.summarise([r, r])
+        for k in ("right_mean_x_cm", "right_pos_rmse_cm", "right_max_x_cm", "right_max_y_cm", "all_mean_pos_cm", "t_first_median_s"):
+            self.assertIsNone(s[k], k)
+        self.assertEqual((s["ended_right"], s["runs_without_estimate"], s["wrong_frame_fraction"]), (0, 2, 0.0))
+        md = G.markdown({"mcl": s})
+        self.assertIn("no estimate / no estimate, no estimate, no estimate", md)
+        self.assertNotIn("0.00 / 0.00", md)
+        # Frames without ground truth (a log not made by omniloc) are not scored, not a crash.
+        blank = dict(row(0.0, 0.1), err_x="", err_y="", err_theta="", err_pos="")
+        self.assertEqual(G.score_run([blank] + rows)["frames"], 60)
+
+    def test_collect_reads_recall_from_the_summaries(self):
+        with tempfile.TemporaryDirectory() as d:
+            for seed, (recall, first) in ((1, (0.9, 0.5)), (2, (0.0, None))):
+                f = pathlib.Path(d) / f"run{seed}"
+                f.mkdir()
+                rob = {"robot": 0, "frames": 60, "frames_total": 60, "valid_fraction": 1.0 if seed == 1 else 0.5,
+                       "recall": {"10cm_5deg": recall, "25cm_10deg": recall, "50cm_20deg": recall}, "first_within_s": first}
+                (f / "summary.json").write_text(json.dumps({"scenario": "tracking", "localizer": "mcl", "seed": seed, "robots": [rob],
+                                                            "scoring": {"headline": "25cm_10deg"}}))
+                with (f / "frames.csv").open("w", newline="") as fh:
+                    w = csv.DictWriter(fh, fieldnames=COLS)
+                    w.writeheader()
+                    for k in range(60):
+                        w.writerow(row(k / 30, 0.02))
+            s = G.summarise([r for _, r in G.collect([d])["mcl"]])
+            self.assertAlmostEqual(s["recall_mean"], 0.45)
+            self.assertAlmostEqual(s["answered_mean"], 0.75)
+            self.assertEqual((s["recall_key"], s["first_within_median_s"], s["runs_never_within"]), ("25cm_10deg", 0.5, 1))
+            md = G.markdown({"mcl": s})
+            self.assertIn("| within 25 cm / 10 deg: mean over runs (answered) |", md)
+            self.assertIn("| mcl | 2 | 45.0 % (75.0 %) | 0.50 (1) |", md)
+
 
 if __name__ == "__main__":
     unittest.main()

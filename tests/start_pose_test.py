@@ -56,8 +56,32 @@ class StartPoseSweep(unittest.TestCase):
         self.assertEqual(client["localizer"], "py_dead_reckoning")  # no label given: the client's ready.name
         self.assertEqual(client["external"]["name"], "py_dead_reckoning")
         for s in (mcl, client):
-            pm = s["robots"][0]["position_m"]
-            self.assertLessEqual(pm["mean"], pm["rmse"] + 1e-12)  # mean <= RMSE always
+            r = s["robots"][0]
+            pm = r["position_m"]
+            if r["frames"]:
+                self.assertLessEqual(pm["mean"], pm["rmse"] + 1e-12)  # mean <= RMSE always
+            else:  # no frame answered (a global start that never settles in 2 s): null, never 0
+                self.assertIsNone(pm["rmse"])
+                self.assertIn("no estimate", r["why_null"])
+
+    def test_coverage_is_recorded_and_shown_beside_the_errors(self):
+        # Both tasks are scored over every frame: recall at the headline threshold and the share
+        # answered, which paper_table prints before the errors (and the aggregate's no_value column).
+        for label in ("mcl", "dead_reckoning"):
+            s = self.summary(label)
+            r = s["robots"][0]
+            self.assertEqual(s["scoring"]["headline"], "25cm_10deg")
+            self.assertEqual(sorted(r["recall"]), ["10cm_5deg", "25cm_10deg", "50cm_20deg"])
+            self.assertAlmostEqual(r["valid_fraction"], r["frames"] / r["frames_total"])
+            self.assertLessEqual(r["recall"]["25cm_10deg"], r["valid_fraction"] + 1e-12)  # a frame without an estimate is never within
+        header = (self.out / "aggregate.csv").read_text().splitlines()[0].split(",")
+        self.assertEqual(header[-1], "no_value")
+        r = subprocess.run([PY, str(ROOT / "scripts" / "paper_table.py"), str(self.out), "--paper", "000_tracking", "--rows", MCL_ROW],
+                           capture_output=True, text=True, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        head = r.stdout.splitlines()[0]
+        self.assertLess(head.index("within 25 cm / 10 deg"), head.index("answered"))
+        self.assertLess(head.index("answered"), head.index("mean x"))
 
     def test_aggregate_rows_are_apart_and_named_as_their_runs(self):
         agg = json.loads((self.out / "aggregate.json").read_text())
