@@ -49,13 +49,12 @@ class FieldMap {
     /// clamps; off the table (or on its last row / column) the out-of-line path.
     template <bool kGradient>
     Sample at_cells(double fx, double fy) const {
-      // On the table iff 0 <= fx < nx - 1 and 0 <= fy < ny - 1: the cell indices (truncated) as
-      // unsigned below nx - 1, ny - 1 (a negative index or NaN's INT_MIN wraps above), and the
-      // smaller coordinate not negative (fx in (-1, 0) truncates to 0).
-      const int i = static_cast<int>(fx), j = static_cast<int>(fy);
-      if (!(static_cast<unsigned>(i) < last_i && static_cast<unsigned>(j) < last_j && std::min(fx, fy) >= 0.0)) [[unlikely]]
+      // On the table iff 0 <= fx < nx - 1 and 0 <= fy < ny - 1, tested on the doubles before any
+      // conversion: converting NaN or a value beyond int's range to int is undefined behaviour
+      // (UBSan reports it), and NaN fails every comparison, so it goes off the table too.
+      if (!(fx >= 0.0 && fy >= 0.0 && fx < last_x && fy < last_y)) [[unlikely]]
         return off_table(*this, fx, fy, kGradient);
-      return interpolate<kGradient>(fx, fy, i, j);
+      return interpolate<kGradient>(fx, fy, static_cast<int>(fx), static_cast<int>(fy));
     }
     /// The bilinear interpolant at a table position inside [0, nx - 1) x [0, ny - 1).
     template <bool kGradient>

@@ -409,7 +409,9 @@ TEST(RobustInput, RecordingNumbersOutsideTheirLimitsAreExit2) {
                                             {"right_bearing", 1e9}, {"distance", 3.0}, {"area_px", 40}, {"left_occluded", false},
                                             {"right_occluded", false}}})},
   };
-  for (const auto& [path, value] : cases) {
+  for (const auto& c : cases) {
+    const std::string& path = c.first;  // not a structured binding: clang 14 cannot capture those
+    const Json& value = c.second;
     const std::string dir = handwritten("bad_value", [&](Json& f) { f[Json::json_pointer(path)] = value; });
     for (const char* localizer : {"matching", "grid_global", "mcl"}) {
       const fs::path out = scratch("bad_value_out");
