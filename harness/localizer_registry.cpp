@@ -30,7 +30,7 @@ const std::vector<LocalizerInfo>& localizers() {
          return std::make_unique<MatchingLocalizer>(*ctx.field, MatchingParams::from_json(r), ctx.cache_dir);
        },
        &MatchingParams::schema},
-      {"mcl", "Monte Carlo localization, 600 particles, compass headings, distance-map sensor model (paper 002)", false, true,
+      {"mcl", "Monte Carlo localization, distance-map sensor model: 600 particles with compass headings (paper 002); without a compass 5000, KLD-adaptive, 2 m clamp", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<McLLocalizer>(*ctx.field, McLParams::from_json(r), ctx.seed, ctx.cache_dir);
        },

@@ -4,10 +4,14 @@
 // the analytic field model and cached on disk.
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "core/field.hpp"
 
@@ -49,12 +53,23 @@ class FieldMap {
     /// clamps; off the table (or on its last row / column) the out-of-line path.
     template <bool kGradient>
     Sample at_cells(double fx, double fy) const {
-      // On the table iff 0 <= fx < nx - 1 and 0 <= fy < ny - 1, tested on the doubles before any
-      // conversion: converting NaN or a value beyond int's range to int is undefined behaviour
-      // (UBSan reports it), and NaN fails every comparison, so it goes off the table too.
-      if (!(fx >= 0.0 && fy >= 0.0 && fx < last_x && fy < last_y)) [[unlikely]]
+      // On the table iff 0 <= fx < nx - 1 and 0 <= fy < ny - 1: the cell indices (truncated) as
+      // unsigned below nx - 1, ny - 1 (a negative index, or NaN's and a huge value's INT_MIN, wraps
+      // above), and the smaller coordinate not negative (fx in (-1, 0) truncates to 0).
+      const int i = truncate(fx), j = truncate(fy);
+      if (!(static_cast<unsigned>(i) < last_i && static_cast<unsigned>(j) < last_j && std::min(fx, fy) >= 0.0)) [[unlikely]]
         return off_table(*this, fx, fy, kGradient);
-      return interpolate<kGradient>(fx, fy, static_cast<int>(fx), static_cast<int>(fy));
+      return interpolate<kGradient>(fx, fy, i, j);
+    }
+    /// Truncation to int defined for every double: INT_MIN for NaN and for values beyond int's
+    /// range (a plain cast is undefined behaviour there, which UBSan reports; SSE2's cvttsd2si, the
+    /// instruction the cast compiles to, gives exactly this, so the hot loops pay nothing).
+    static int truncate(double v) {
+#if defined(__SSE2__)
+      return _mm_cvttsd_si32(_mm_set_sd(v));
+#else
+      return v > -2147483649.0 && v < 2147483648.0 ? static_cast<int>(v) : std::numeric_limits<int>::min();
+#endif
     }
     /// The bilinear interpolant at a table position inside [0, nx - 1) x [0, ny - 1).
     template <bool kGradient>

@@ -25,6 +25,10 @@ const ParamList<McLParams>& McLParams::params() {
       number_param("alpha_slow", &P::alpha_slow, 0.0, 1.0, "", "augmented MCL: slow average of the likelihood (0 = off)"),
       number_param("alpha_fast", &P::alpha_fast, 0.0, 1.0, "", "augmented MCL: fast average of the likelihood (0 = off)"),
       number_param("cell", &P::cell, 0.005, 0.5, "m", "distance-map cell"),
+      bool_param("adapt_to_no_compass", &P::adapt_to_no_compass,
+                 "without a compass at the first frame: no_compass_particles as a KLD-adaptive set and no_compass_clamp (false: paper 002's set whatever the sensors)"),
+      integer_param("no_compass_particles", &P::no_compass_particles, 10, 100000, "without a compass: the first set (then KLD-adaptive)"),
+      positive_param("no_compass_clamp", &P::no_compass_clamp, 10.0, "m", "without a compass: the sensor model's clamp"),
   };
   return list;
 }
@@ -72,6 +76,13 @@ Pose2 McLLocalizer::random_pose(std::optional<double> heading) {
 }
 
 void McLLocalizer::init_uniform(std::optional<double> heading) {
+  if (!heading && !initialised_ && p_.adapt_to_no_compass && !no_compass_) {
+    // A global start without a compass: see McLParams::adapt_to_no_compass.
+    no_compass_ = true;
+    p_.particles = p_.no_compass_particles;
+    p_.clamp = p_.no_compass_clamp;
+    p_.kld.enabled = true;
+  }
   ps_.clear();
   for (int i = 0; i < p_.particles; ++i) ps_.push_back({random_pose(heading), 0.0});
   initialised_ = true;

@@ -40,6 +40,19 @@ struct McLParams {
   /// kld_bin_theta, kld_min_particles), off by default; `particles` is then the maximum.
   filter::KldParams kld;
   double cell = 0.05;
+  /// Without a compass (no heading at the first frame) the initial set must cover every heading,
+  /// a pose space about 17 times larger than paper 002's (uniform headings over 2 pi against the
+  /// compass prior's effective width sqrt(2 pi) 0.15 rad = 0.38 rad). 600 particles then put 0.06-0.11
+  /// of them where the true pose beats every wrong one (measured on NuBot's real frames: a
+  /// 0.16-0.29 m^2 rad region), and standing still nothing brings others there. So, when adapting:
+  /// `no_compass_particles` as the first set (KLD-adaptive afterwards, so the two 180-degree twins of
+  /// a symmetric field are decided in about a second instead of being held by thousands of
+  /// particles), and `no_compass_clamp` as the clamp, which widens that region to 0.49-1.11 m^2 rad
+  /// (paper 000's global grid search uses c = 2.55 m for the same reason). With a compass nothing
+  /// changes: paper 002's configuration. data/real/nubot/README.md has the measurements.
+  bool adapt_to_no_compass = true;
+  int no_compass_particles = 5000;
+  double no_compass_clamp = 2.0;  ///< m
   static McLParams from_json(JsonReader& r);
   /// Its own keys (plus filter::OdometryNoiseParams' planar odo_* keys and filter::KldParams').
   static const ParamList<McLParams>& params();
@@ -86,6 +99,7 @@ class McLLocalizer : public Localizer {
   std::vector<Particle> ps_;
   std::vector<double> logw_, w_;  ///< per-update scratch (kept to avoid reallocation)
   bool initialised_ = false, converged_ = false;
+  bool no_compass_ = false;  ///< adapted to a start without a compass (McLParams::adapt_to_no_compass)
   double w_slow_ = 0.0, w_fast_ = 0.0;
   int resets_ = 0;  ///< times the whole set was beyond the walls and drawn again
 };
