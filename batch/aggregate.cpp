@@ -30,6 +30,13 @@ double t975(std::size_t df) {
          (3 * std::pow(z, 7) + 19 * std::pow(z, 5) + 17 * z * z * z - 15 * z) / (384 * d * d * d);
 }
 
+// Metrics that are shares of frames or episodes, within [0, 1]: recall at a threshold, the share
+// of frames answered, of kidnaps recovered.
+bool is_fraction(const std::string& metric) {
+  const auto ends = [&](const std::string& tail) { return metric.size() >= tail.size() && metric.compare(metric.size() - tail.size(), tail.size(), tail) == 0; };
+  return metric.find("/recall/") != std::string::npos || metric.rfind("recall/", 0) == 0 || ends("valid_fraction") || ends("recovered_fraction");
+}
+
 // A run's metrics: its numbers by path ("r0/position_m/rmse"), and the paths whose value is null (a
 // statistic over no frame: no estimate), which a group counts instead of averaging.
 struct RunMetrics {
@@ -312,7 +319,8 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
     for (const auto& kv : g.no_value) keys.insert(kv.first);
     for (const auto& k : keys) {
       const auto vit = g.values.find(k);
-      const Interval iv = vit == g.values.end() ? Interval{} : mean_ci95(vit->second);
+      Interval iv = vit == g.values.end() ? Interval{} : mean_ci95(vit->second);
+      if (is_fraction(k)) iv.high = std::min(iv.high, 1.0);  // a share never has a bound above 1 (nor below 0: mean_ci95)
       const auto nit = g.no_value.find(k);
       const std::size_t none = nit == g.no_value.end() ? 0 : nit->second;
       ivs[k] = iv;

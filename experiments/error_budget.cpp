@@ -182,8 +182,12 @@ void collect_cells(const BudgetSweep& b, const std::string& sweep_dir, ErrorBudg
     }
     const Json sj = read_json_strict(summary.string(), summary.string());
     const Json& rob = sj["robots"][0];
+    if (!rob["position_m"]["rmse"].is_number()) {  // null: no estimate in any frame (never averaged as 0)
+      ++cell.no_estimate;
+      continue;
+    }
     cell.per_seed.push_back({run.seed, 100.0 * rob["position_m"]["rmse"].get<double>(), 100.0 * rob["position_m"]["p50"].get<double>(),
-                             rob.value("theta_rmse_rad", 0.0) * 180.0 / 3.141592653589793, rob.value("wrong_frames", 0L)});
+                             rob["theta_rmse_rad"].get<double>() * 180.0 / 3.141592653589793, rob.value("wrong_frames", 0L)});
   }
   // The cell's figures from its seeds: means of the errors, the wrong frames summed.
   for (auto& [key, cell] : r.cells)
@@ -248,7 +252,9 @@ std::string budget_markdown(const ErrorBudgetConfig& c, const ErrorBudgetResult&
     md << "| " << name << " |";
     for (const auto& l : r.localizers) {
       const ErrorBudgetCell cell = r.cell(name, l);
-      md << (cell.runs > 0 ? strprintf(" %.2f | %.2f | %.2f |", cell.rmse_cm, cell.p50_cm, cell.theta_rmse_deg) : std::string(" failed | | |"));
+      const std::string none = cell.no_estimate ? strprintf(" (no estimate in %d of %d runs)", cell.no_estimate, cell.no_estimate + cell.runs) : "";
+      md << (cell.runs > 0 ? strprintf(" %.2f%s | %.2f | %.2f |", cell.rmse_cm, none.c_str(), cell.p50_cm, cell.theta_rmse_deg)
+                           : cell.no_estimate ? " no estimate | | |" : std::string(" failed | | |"));
     }
     md << "\n";
   }
@@ -260,13 +266,13 @@ std::string budget_markdown(const ErrorBudgetConfig& c, const ErrorBudgetResult&
 
 std::string budget_csv(const ErrorBudgetResult& r) {
   std::ostringstream csv;
-  csv << "source,localizer,runs,failed,position_rmse_cm,position_p50_cm,heading_rmse_deg,wrong_frames\n";
+  csv << "source,localizer,runs,failed,position_rmse_cm,position_p50_cm,heading_rmse_deg,wrong_frames,no_estimate\n";
   for (const auto& name : r.rows)
     for (const auto& l : r.localizers) {
       const ErrorBudgetCell cell = r.cell(name, l);
       csv << '"' << name << "\"," << l << "," << cell.runs << "," << cell.failed << ","
           << (cell.runs ? strprintf("%.4f,%.4f,%.4f", cell.rmse_cm, cell.p50_cm, cell.theta_rmse_deg) : std::string(",,")) << ","
-          << cell.wrong_frames << "\n";
+          << cell.wrong_frames << "," << cell.no_estimate << "\n";
     }
   return csv.str();
 }
@@ -276,7 +282,8 @@ Json budget_json(const ErrorBudgetResult& r) {
   for (const auto& name : r.rows)
     for (const auto& l : r.localizers) {
       const ErrorBudgetCell cell = r.cell(name, l);
-      Json row{{"source", name}, {"localizer", l}, {"runs", cell.runs}, {"failed", cell.failed}, {"wrong_frames", cell.wrong_frames}};
+      Json row{{"source", name}, {"localizer", l}, {"runs", cell.runs}, {"failed", cell.failed}, {"wrong_frames", cell.wrong_frames},
+               {"no_estimate", cell.no_estimate}};
       if (cell.runs > 0) {
         row["position_rmse_cm"] = cell.rmse_cm;
         row["position_p50_cm"] = cell.p50_cm;

@@ -54,6 +54,7 @@ struct ErrorBudgetSeed {
 
 struct ErrorBudgetCell {
   int runs = 0, failed = 0;
+  int no_estimate = 0;  ///< finished runs whose localizer answered no frame: no error to average, said as such
   double rmse_cm = 0, p50_cm = 0, theta_rmse_deg = 0;  ///< means over the runs that finished
   long wrong_frames = 0;                                ///< summed over them
   std::vector<ErrorBudgetSeed> per_seed;                ///< the finished runs, by seed

@@ -73,7 +73,7 @@ def visible_text(dom):
 # (omniloc_results.interval clips the t interval at 0; the seeds' range of non-negative values is too).
 # The report prints intervals of such quantities only; aggregate.csv also holds signed ones, told by name.
 REPORT_INTERVAL = re.compile(r"(-?\d+(?:\.\d+)?) (?:\[(-?\d+(?:\.\d+)?), -?\d+(?:\.\d+)?\]|\(seeds' range (-?\d+(?:\.\d+)?) to )")
-NON_NEGATIVE_METRIC = re.compile(r"(^|/)(x_cm|y_cm|theta_rad|position_m|line_points|recovery|after_recovery)(/|$)|"
+NON_NEGATIVE_METRIC = re.compile(r"(^|/)(x_cm|y_cm|theta_rad|position_m|line_points|recovery|after_recovery|recall)(/|$)|"
                                  r"(^|/)(frames|valid_fraction|coasting_frames|relocalisations|wrong_frames|mirrored_frames|excluded_s)$")
 
 
