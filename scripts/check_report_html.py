@@ -158,6 +158,13 @@ def reader_names():
             names |= set(values(json.loads(p.read_text())))
         except (OSError, ValueError):
             pass
+    for p in ROOT.glob("data/**/recording.json"):  # stored recordings' names (nubot_robot1): a sweep's scenario names
+        try:
+            name = json.loads(p.read_text()).get("name")
+            if isinstance(name, str):
+                names.add(name)
+        except (OSError, ValueError, AttributeError):
+            pass
     try:
         names |= {p["name"] for p in json.loads((ROOT / "data" / "noise_profiles.json").read_text()).get("profiles", [])}
     except (OSError, ValueError, AttributeError, KeyError, TypeError):

@@ -6,13 +6,18 @@ usage: report.py RESULTS... -o DIR [--title TEXT] [--max-runs N] [--baseline RES
 RESULTS are folders: a run (summary.json), a sweep (aggregate.json with runs/ inside), an
 experiment (PNG / JSON / markdown files written by `omniloc experiment`), or any folder holding
 such folders (searched recursively). The report is laid out for a reader with ten minutes
-(issue 30; docs/results.md), in this order:
+(docs/results.md), in this order:
   - a headline of two or three sentences, computed from the results: what reproduces and what does
     not, our error against the papers' (median ratio), the main gap and its measured cause;
   - the reproduction scorecard: every claim of results/reference/papers.json with our figure, the
     paper's, the ratio and the verdict computed by the rule written next to the claim, counted
     apart by kind (accuracy / robustness / timing), judged on every axis a published row states,
     with the field_robot runs judged by the same rules in their own column; then the contents;
+  - real robots (scripts/real_robots.py): the global localizers on real robots' frames
+    (scenarios/sweeps/real_robots.json: data/real/nubot), each run classified found / twin / wrong
+    against the reference pose and its 180-degree twin, and the real line points' noise by range
+    beside the simulated robot and field_robot profiles' (from the paper suite sweeps' recordings);
+    without those results it says what to run;
   - provenance: which omniloc builds (git describe, compiler, build type) made the results, when,
     and the machine (CPU model, cores);
   - every published table beside the runs that reproduce it, paired BY KEY (scenario, localizer,
@@ -65,6 +70,7 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import omniloc_results as R  # noqa: E402
 import paper_claims as C  # noqa: E402
+import real_robots as RR  # noqa: E402
 
 EVENT_COLOURS = {"kidnap": "red", "cover": "black", "teleport": "red", "occlude": "grey", "lights": "orange", "camera": "purple"}
 VERDICT_CLASS = {"holds": "ok", "partly": "partly", "does not": "no", "not run": "notrun", "n/a": "notrun",
@@ -1434,9 +1440,13 @@ def params_text(params):
     return f"`{params}`" if params and params != "default" else (params or "")
 
 
-def run_title(run, params=None):
+def run_title(run, params=None, name=None):
+    """'scenario / localizer / params / seed N (profile)'; name: the sweep's row name of the localizer
+    (its label: two configurations of one localizer type in a sweep, e.g. mcl and mcl_as_published)."""
     s = run.summary
-    parts = [s["scenario"], s["localizer"]] + ([params_text(params)] if params and params != "default" else []) + [f"seed {s['seed']}"]
+    parts = [s["scenario"], name or s["localizer"]] + ([params_text(params)] if params and params != "default" else []) + [f"seed {s['seed']}"]
+    if ((s.get("omniloc") or {}).get("replay") or {}).get("recorded_with") == "not omniloc":
+        return " / ".join(str(p) for p in parts) + " (a log not made by omniloc: no noise profile)"
     prof = profile_of(run)
     return " / ".join(str(p) for p in parts) + (f" ({prof} profile)" if prof != R.SCENARIO_DEFAULT_PROFILE else "")
 
@@ -1477,9 +1487,9 @@ def first_fix_text(s, key):
     return "; ".join(parts)
 
 
-def report_run(rep, run, plots, params=None, note=None):
+def report_run(rep, run, plots, params=None, note=None, name=None):
     s = run.summary
-    title = run_title(run, params) + (f" ({note})" if note else "")
+    title = run_title(run, params, name) + (f" ({note})" if note else "")
     rep.heading(f"Run {title}", 3)
     rows = []
     key = run.headline
@@ -1604,7 +1614,7 @@ def report_sweep(rep, sweep, all_runs, max_runs):
         first = (run.scenario, name, params) not in seen
         seen.add((run.scenario, name, params))
         report_run(rep, run, plots=(first and plotted < max_runs) or run in flagged, params=params,
-                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None)
+                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None, name=name)
         plotted += first
     rep.end_details()
     return [r for r, _, _ in runs]
@@ -1892,6 +1902,9 @@ def main():
         rep.para(f"**Incomplete sweep** (--accept-incomplete): {pathlib.Path(d).name} has no final aggregate; only its finished runs are reported.")
     _, _, totals = scorecard(rep, ctx, judged)
     rep.mark_toc()
+    # The only real data: right after the scorecard. Its runs are judged against the reference pose
+    # and its twin there, and left out of the pooled CDF (which scores against the reference only).
+    real = {r.folder for r in RR.section(rep, runs, sweeps)}
     provenance(rep, runs, sweeps)
     published_tables(rep, papers, ctx)
     global_start_section(rep, sweeps)
@@ -1918,7 +1931,7 @@ def main():
         for run in loose:
             report_run(rep, run, plots=True)
         rep.end_details()
-    cdf_and_timing(rep, runs)
+    cdf_and_timing(rep, [r for r in runs if r.folder not in real])
     for exp in experiments:
         report_experiment(rep, exp)
     # Developers' charts (speed over commits) are not results: a page of their own, linked here.

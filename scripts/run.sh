@@ -1,8 +1,14 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing (apt), builds, runs the paper suite as one sweep
 # (scenarios/sweeps/paper_suite.json: every scenarios/paper/*.json and the variants the published
-# tables need, three seeds each, both workers), the paper figures' experiments, and writes the
-# comparison report (results/report/report.html and report.md) with the reproduction scorecard.
+# tables need, three seeds each, both workers), the global localizers on the real robots' frames of
+# data/real/nubot (scenarios/sweeps/real_robots.json, seconds), the paper suite under the field_robot
+# profile, the paper figures' experiments, and writes the comparison report (results/report/report.html
+# and report.md) with the reproduction scorecard and the real robots' section. Phases:
+#   1/8 dependencies and build          5/8 paper suite, the other seeds (report)
+#   2/8 paper suite, first seed         6/8 paper suite under the field_robot profile (report)
+#   3/8 first scorecard and report      7/8 experiments (the papers' figures)
+#   4/8 real robots' frames             8/8 final scorecard and report
 #
 # Usage: scripts/run.sh            default size (see README for the measured time)
 #        scripts/run.sh --full     five seeds per scenario, the field_robot rows at three seeds, the
@@ -16,7 +22,7 @@ cd "$(dirname "$0")/.."
 # A header per phase, so a reader of the terminal knows where the run is and how long each took.
 t_start=$SECONDS
 phase() { echo; echo "=== $1 (at $(( (SECONDS - t_start) / 60 )) min)"; }
-phase "1/7 dependencies and build"
+phase "1/8 dependencies and build"
 scripts/install-deps.sh
 # Only the program it runs: the test and benchmark programs took 157 s of a fresh 9-minute build.
 OMNILOC_BUILD_TARGETS=omniloc scripts/build.sh
@@ -67,13 +73,20 @@ if [ $full -eq 1 ]; then
   spec=results/suites/paper_suite.json
 fi
 results=(results/sweeps/paper_suite)
-phase "2/7 paper suite, first seed ($(runs_of results/suites/paper_suite_first_seed.json) runs, robot profile)"
+phase "2/8 paper suite, first seed ($(runs_of results/suites/paper_suite_first_seed.json) runs, robot profile)"
 ./build/omniloc sweep results/suites/paper_suite_first_seed.json -j "$jobs"
 # The first answer: the robot profile's scorecard from one seed (its verdicts say they rest on one).
-phase "3/7 first scorecard and report (robot profile, one seed)"
-report "the other seeds of the paper suite, the field_robot suite, then the experiments"
+phase "3/8 first scorecard and report (robot profile, one seed)"
+report "the real robots' frames, the other seeds of the paper suite, the field_robot suite, then the experiments"
 
-phase "4/7 paper suite, the other seeds ($(runs_of "$spec") runs in all)"
+# The only real data: NuBot's four calibration frames (data/real/nubot) replayed with the global
+# localizers, a few seconds; the report's "Real robots" section classifies each run against the
+# reference pose and its 180-degree twin. In every report from here on.
+phase "4/8 real robots' frames ($(runs_of scenarios/sweeps/real_robots.json) runs)"
+./build/omniloc sweep scenarios/sweeps/real_robots.json -j "$jobs"
+results+=(results/sweeps/real_robots)
+
+phase "5/8 paper suite, the other seeds ($(runs_of "$spec") runs in all)"
 ./build/omniloc sweep "$spec" -j "$jobs" --resume
 report "the field_robot suite, then the experiments"
 
@@ -84,7 +97,7 @@ if [ $full -eq 1 ]; then
   with_seeds "$fr_spec" 3 results/suites/paper_suite_field_robot.json
   fr_spec=results/suites/paper_suite_field_robot.json
 fi
-phase "5/7 paper suite under the field_robot profile ($(runs_of "$fr_spec") runs)"
+phase "6/8 paper suite under the field_robot profile ($(runs_of "$fr_spec") runs)"
 ./build/omniloc sweep "$fr_spec" -j "$jobs"
 results+=(results/sweeps/paper_suite_field_robot)
 if [ $full -eq 1 ]; then
@@ -98,7 +111,7 @@ report "the experiments"
 
 # The figures' experiments (quick versions by default). Their tables go to the report, not the
 # terminal: each one's own output is kept in results/experiments/<name>.log.
-phase "6/7 experiments (the papers' figures)"
+phase "7/8 experiments (the papers' figures)"
 quick=--quick; [ $full -eq 1 ] && quick=
 mkdir -p results/experiments
 for e in $(./build/omniloc list | sed -n '/^experiments:/,/^$/p' | awk 'NR>1 && NF {print $1}'); do
@@ -108,5 +121,5 @@ for e in $(./build/omniloc list | sed -n '/^experiments:/,/^$/p' | awk 'NR>1 && 
   results+=("results/experiments/$e")
 done
 
-phase "7/7 final scorecard and report"
+phase "8/8 final scorecard and report"
 report ""

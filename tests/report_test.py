@@ -5,6 +5,7 @@ statistics. Run by ctest (tests/CMakeLists.txt) with OMNILOC_BIN = the built omn
 import csv
 import io
 import json
+import math
 import re
 import os
 import pathlib
@@ -645,7 +646,7 @@ class ReaderReport(unittest.TestCase):
             doc = (tmp / "rep" / "report.html").read_text()
             md = (tmp / "rep" / "report.md").read_text()
             h2 = [m for m in __import__("re").findall(r"<h2 id=\"([^\"]+)\"", doc)]
-            self.assertEqual(h2[:2], ["scorecard", "provenance"])
+            self.assertEqual(h2[:3], ["scorecard", "real-robots", "provenance"])  # the real robots' section (says what to run) after the scorecard
             self.assertLess(doc.index('id="scorecard"'), doc.index('<nav id="contents">'))
             self.assertLess(doc.index('<nav id="contents">'), doc.index('id="provenance"'))
             for text in (doc, md):
@@ -987,11 +988,12 @@ class NoEstimate(unittest.TestCase):
 
     def test_a_sweep_with_a_localizer_that_never_answers(self):
         # Through the binary: mcl answers none of the hand-written recording's frames, matching all.
+        # (Paper 002's 600-particle MCL: with its defaults MCL adapts to the missing compass and answers.)
         import check_report_html as K
         with tempfile.TemporaryDirectory() as tmp:
             tmp = pathlib.Path(tmp)
             spec = {"name": "hw", "scenarios": [{"recording": str(ROOT / "tests" / "data" / "handwritten_recording")}],
-                    "localizers": [{"type": "mcl"}, {"type": "matching"}]}
+                    "localizers": [{"type": "mcl", "adapt_to_no_compass": False}, {"type": "matching"}]}
             (tmp / "hw.json").write_text(json.dumps(spec))
             out = subprocess.run([OMNILOC, "sweep", str(tmp / "hw.json"), "-o", str(tmp / "hw")], capture_output=True, text=True, cwd=tmp, timeout=300)
             self.assertEqual(out.returncode, 0, out.stdout + out.stderr)
@@ -1287,3 +1289,186 @@ class ErrorBudgetSeeds(unittest.TestCase):
             self.assertIn("| vibration | 4.50 (seeds' range 4.00 to 5.00, n=3) |", md)  # three seeds: their range, no interval
             self.assertIn("Mean over 3 seeds; intervals: n >= 5 seeds", md)
             self.assertIn("Which real-robot error is missing", md)
+
+
+REAL = ROOT / "data" / "real" / "nubot"
+
+
+def real_reference(robot):
+    return json.loads((REAL / robot / "recording.json").read_text())["reference"]
+
+
+def write_real_run(folder, frame, label, seed, estimates, localizer=None, config=None):
+    """A run folder of a replay of the real recording data/real/nubot/<frame> (as omniloc writes
+    one): frames.csv at 30 Hz with the reference pose as truth and `estimates`, one (x, y, theta) or
+    None (no estimate) per frame."""
+    folder = pathlib.Path(folder) / f"nubot_{frame}__{label}__recording__s{seed}"
+    ref = real_reference(frame)["reference"]
+    n = len(estimates)
+    answered = sum(e is not None for e in estimates)
+    write_run(folder, f"nubot_{frame}", localizer or label, seed, config or {"localizer": {"type": localizer or label}},
+              scored(robot(1.0), answered=answered / n, within=0.0, total=n), start_pose_given=False, scoring=SCORING)
+    summary = json.loads((folder / "summary.json").read_text())
+    summary["omniloc"]["replay"] = {"format": "omniloc-recording/1", "recorded_seed": 1, "recorded_with": "not omniloc",
+                                    "recording": str(REAL / frame)}
+    (folder / "summary.json").write_text(json.dumps(summary))
+    head = "t,robot,gt_x,gt_y,gt_theta,est_x,est_y,est_theta,err_x,err_y,err_theta,err_pos,valid,mode"
+    lines = [head]
+    for k, e in enumerate(estimates):
+        est = e if e is not None else (0.0, 0.0, 0.0)
+        err = math.hypot(est[0] - ref[0], est[1] - ref[1])
+        lines.append(f"{k / 30:.4f},0,{ref[0]},{ref[1]},{ref[2]},{est[0]},{est[1]},{est[2]},0,0,0,{err},{1 if e is not None else 0},"
+                     + ("converged" if e is not None else "global"))
+    (folder / "frames.csv").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def write_sim_recording(sweep, profile="robot"):
+    """A sweep folder holding one recording of the tracking path (as `omniloc sweep` draws it into
+    recordings/) with one frame of hand-placed line points, robot at (-4.5, 0, 0) on msl2012, whose
+    distances to the nearest marking are known: 0-1.5 m: 22.5 cm (the penalty spot's rim);
+    1.5-3 m: 5 and 4 cm; 3-5 m: 0 and 3 cm (the centre line); 5-7.5 m: 5 and 10 cm (the touch lines).
+    A second frame without a usable image is left out."""
+    sweep = pathlib.Path(sweep)
+    rec = sweep / "recordings" / "tracking__s1__0123456789abcdef"
+    rec.mkdir(parents=True)
+    (sweep / "runs.csv").write_text("index,id,scenario,localizer,params,seed,status\n")
+    (sweep / "aggregate.json").write_text(json.dumps({"sweep": sweep.name, "runs": 0, "groups": []}))
+    head = {"format": "omniloc-recording/1", "name": "tracking", "seed": 1, "field": "msl2012", "camera_rate_hz": 30.0, "duration_s": 0.1,
+            "frames": 2, "frames_file": "frames.jsonl", "ground_truth": True, "robots": [{"id": 0}],
+            "scenario": {"name": "tracking", "noise_profile": profile, "field": "msl2012"}}
+    (rec / "recording.json").write_text(json.dumps(head))
+    pts = [[-1.2, 0.0], [-2.2, 0.0], [2.46, 0.0], [4.5, 0.5], [4.53, 0.5], [0.0, 5.95], [0.0, -5.9]]
+    frames = [{"k": 0, "t": 0.0, "robots": [{"robot": 0, "odometry": [0, 0, 0], "heading": 0.0, "camera_ok": True, "line_points": pts,
+                                             "truth": [-4.5, 0.0, 0.0]}]},
+              {"k": 1, "t": 0.0333, "robots": [{"robot": 0, "odometry": [0, 0, 0], "heading": 0.0, "camera_ok": False, "line_points": [[3.0, 3.0]],
+                                                "truth": [-4.5, 0.0, 0.0]}]}]
+    (rec / "frames.jsonl").write_text("".join(json.dumps(f) + "\n" for f in frames))
+    return sweep
+
+
+class RealRobots(unittest.TestCase):
+    """The report's "Real robots" section (scripts/real_robots.py): runs on the real NuBot frames
+    classified found / twin / wrong against the reference pose and its twin, and the line-point
+    noise of the real frames beside the simulated profiles'."""
+
+    def test_found_twin_and_wrong_from_a_real_sweep_and_faked_runs(self):
+        import real_robots as RR
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            # A tiny real-robots sweep: one real recording, two localizers, by the binary.
+            (tmp / "rr.json").write_text(json.dumps({"name": "real_robots", "scenarios": [{"recording": str(REAL / "robot1")}], "localizers": [
+                {"type": "grid_global"}, {"type": "mcl", "adapt_to_no_compass": False, "label": "mcl_as_published"}]}))
+            out = subprocess.run([OMNILOC, "sweep", str(tmp / "rr.json"), "-o", str(tmp / "results" / "real_robots"), "-j", "2"],
+                                 capture_output=True, text=True, timeout=300)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            loose = tmp / "results" / "loose"
+            ref2 = real_reference("robot2")
+            twin2 = ref2["twin"]
+            # robot 2, mcl: no estimate for 10 frames, then 2 cm and 0.01 rad from the TWIN: found as the twin.
+            write_real_run(loose, "robot2", "mcl", 1, [None] * 10 + [(twin2[0] + 0.02, twin2[1], twin2[2] + 0.01)] * 20)
+            # robot 4, hybrid: on the reference, then 1.2 m off at the end: wrong.
+            ref4 = real_reference("robot4")["reference"]
+            write_real_run(loose, "robot4", "hybrid", 1, [tuple(ref4)] * 20 + [(ref4[0] - 1.2, ref4[1], ref4[2])] * 10)
+            # robot 5, hybrid: right, then no estimate in the last frame.
+            ref5 = real_reference("robot5")["reference"]
+            write_real_run(loose, "robot5", "hybrid", 1, [tuple(ref5)] * 29 + [None])
+            # robot 1, grid_global at seed 2, ending on the twin: two seeds of one frame are counted.
+            twin1 = real_reference("robot1")["twin"]
+            write_real_run(loose, "robot1", "grid_global", 2, [tuple(twin1)] * 30)
+            runs, sweeps, _ = R.discover([tmp / "results"])
+            judged = {(x["label"], x["folder"].name, x["run"].seed): x["judged"] for x in RR.real_runs(runs)}
+            self.assertEqual(judged[("grid_global", "robot1", 1)]["outcome"], "found")  # the exhaustive grid: reference or twin, here the reference
+            self.assertLess(judged[("grid_global", "robot1", 1)]["error_m"], 0.05)
+            self.assertEqual(judged[("grid_global", "robot1", 1)]["first_fix_s"], 0.0)
+            self.assertIn(judged[("mcl_as_published", "robot1", 1)]["outcome"], ("found", "twin", "wrong", "none"))
+            j = judged[("mcl", "robot2", 1)]
+            self.assertEqual(j["outcome"], "twin")
+            self.assertAlmostEqual(j["error_m"], 0.02, places=6)
+            self.assertAlmostEqual(j["error_deg"], math.degrees(0.01), delta=0.001)  # the header's twin is rounded to 1e-5 rad
+            self.assertAlmostEqual(j["answered"], 20 / 30)
+            self.assertAlmostEqual(j["first_fix_s"], 10 / 30, places=3)
+            self.assertEqual(judged[("hybrid", "robot4", 1)]["outcome"], "wrong")
+            self.assertAlmostEqual(judged[("hybrid", "robot4", 1)]["error_m"], 1.2, places=6)
+            self.assertEqual(judged[("hybrid", "robot4", 1)]["first_fix_s"], 0.0)
+            self.assertEqual(judged[("hybrid", "robot5", 1)]["outcome"], "none")
+            self.assertEqual(judged[("grid_global", "robot1", 2)]["outcome"], "twin")
+            # The report: the section right after the scorecard, every case as classified.
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(tmp / "results"), "-o", str(tmp / "rep"), "--history", "none"],
+                                 capture_output=True, text=True, cwd=str(tmp))
+            self.assertEqual(out.returncode, 0, out.stderr)
+            md = (tmp / "rep" / "report.md").read_text()
+            doc = (tmp / "rep" / "report.html").read_text()
+            h2 = re.findall(r"<h2 id=\"([^\"]+)\"", doc)
+            self.assertEqual(h2[:3], ["scorecard", "real-robots", "provenance"])
+            section = md.split("## Real robots", 1)[1].split("\n## ", 1)[0]
+            self.assertIn("| mcl | data/real/nubot/robot2 | 1 | twin | 2.0 cm | 0.6 deg | 66.7 % | 0.33 s |", section)
+            self.assertIn("| hybrid | data/real/nubot/robot4 | 1 | wrong | 1.20 m | 0.0 deg | 100.0 % | 0.00 s |", section)
+            self.assertIn("| hybrid | data/real/nubot/robot5 | 1 | no estimate at the end |", section)
+            self.assertIn("| grid_global | data/real/nubot/robot1 | 1, 2 | 2 of 2 found or twin (1 found, 1 twin) |", section)
+            self.assertIn("| mcl_as_published (Lu et al. 2013 [3]'s 600-particle MCL as published: `adapt_to_no_compass` false) | data/real/nubot/robot1 | 1 |",
+                          section)
+            # Totals per localizer.
+            self.assertIn("| grid_global | 2 | 1 | 1 | 1 | 0 | 0 | 2 of 2 |", section)
+            self.assertIn("| hybrid | 2 | 2 | 0 | 0 | 1 | 1 | 0 of 2 |", section)
+            self.assertIn("not by any localizer under test", section)
+            self.assertIn("lower bound", section)
+            self.assertNotIn("Not run**: no replay", section)
+            # The real runs stay out of the pooled CDF (scored there against the reference only).
+            self.assertNotIn("Error CDF per localizer", md)
+            for text in (doc, md):
+                self.assertNotIn(str(tmp), text)
+
+    def test_noise_table_real_and_simulated(self):
+        import real_robots as RR
+        import report
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            # The real figures equal those the recordings' headers carry (the converter's).
+            for robot in ("robot1", "robot2", "robot4", "robot5"):
+                head = json.loads((REAL / robot / "recording.json").read_text())
+                got = RR.real_noise(REAL / robot, head)
+                for g, want in zip(got, head["reference"]["line_point_noise"]["bands"]):
+                    self.assertEqual((g["range_m"], g["points"]), (want["range_m"], want["points"]))
+                    for k in ("median_cm", "p90_cm"):
+                        if want[k] is None:
+                            self.assertIsNone(g[k])
+                        else:
+                            self.assertAlmostEqual(g[k], want[k], delta=0.006, msg=f"{robot} {k}")
+            write_sim_recording(tmp / "paper_suite")
+            _, sweeps, _ = R.discover([tmp / "paper_suite"])
+            rep = report.Report(tmp / "out", "t")
+            RR.section(rep, [], sweeps)
+            rep.write()
+            md = (tmp / "out" / "report.md").read_text()
+            self.assertIn("| range m | real: robot1 | real: robot2 | real: robot4 | real: robot5 | simulated: robot profile | simulated: field_robot profile |", md)
+            self.assertIn("| 0-1.5 | 0 points | 0 points | 0 points | 0 points | 1: 22.5 / 22.5 | not run |", md)
+            self.assertIn("| 1.5-3 | 261: 2.7 / 5.1 | 332: 1.5 / 3.8 | 318: 2.6 / 6.3 | 327: 1.6 / 3.5 | 2: 4.5 / 4.9 | not run |", md)
+            self.assertIn("| 3-5 | 744: 4.4 / 10.1 | 709: 5.4 / 10.4 | 781: 4.5 / 10.8 | 698: 5.4 / 10.5 | 2: 1.5 / 2.7 | not run |", md)
+            self.assertIn("| 5-7.5 | 762: 6.2 / 16.2 | 1052: 5.1 / 12.4 | 880: 4.8 / 12.9 | 918: 4.2 / 11.9 | 2: 7.5 / 9.5 | not run |", md)
+            self.assertIn("robot: 1 recording of the tracking path (seed 1), every frame, 1 frames", md)
+            self.assertIn("build/omniloc sweep scenarios/sweeps/paper_suite_field_robot.json -j 2", md)  # what to run for the missing profile
+
+    def test_without_real_results_the_section_says_what_to_run(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = pathlib.Path(tmp)
+            write_occlusion_sweep(tmp / "results" / "s", [0.0])
+            out = subprocess.run([PY, str(ROOT / "scripts/report.py"), str(tmp / "results"), "-o", str(tmp / "rep"), "--history", "none"],
+                                 capture_output=True, text=True, cwd=str(tmp))
+            self.assertEqual(out.returncode, 0, out.stderr)
+            md = (tmp / "rep" / "report.md").read_text()
+            section = md.split("## Real robots", 1)[1].split("\n## ", 1)[0]
+            self.assertIn("**Not run**: no replay of a real recording among these results. Run `build/omniloc sweep scenarios/sweeps/real_robots.json -j 2`",
+                          section)
+            self.assertIn("| 3-5 | 744: 4.4 / 10.1 |", section)  # the shipped frames' own figures need no run
+            self.assertIn("`build/omniloc sweep scenarios/sweeps/paper_suite.json -j 2`", section)
+            self.assertIn("`build/omniloc sweep scenarios/sweeps/paper_suite_field_robot.json -j 2`", section)
+
+    def test_the_shipped_sweep_names_every_real_frame_and_localizer(self):
+        spec = json.loads((ROOT / "scenarios/sweeps/real_robots.json").read_text())
+        self.assertEqual(sorted(pathlib.Path(e["recording"]).name for e in spec["scenarios"]), ["robot1", "robot2", "robot4", "robot5"])
+        for e in spec["scenarios"]:
+            self.assertTrue((ROOT / "scenarios/sweeps" / e["recording"] / "recording.json").exists(), e)
+        labels = [l.get("label", l["type"]) for l in spec["localizers"]]
+        self.assertEqual(labels, ["mcl", "hybrid", "grid_global", "mcl_as_published"])
+        self.assertIs(spec["localizers"][3]["adapt_to_no_compass"], False)

@@ -127,6 +127,7 @@ class WrongTypes(unittest.TestCase):
             docs.append(dict(BASE, lighting={"lamps": [{"centre": [0, 0]}], "sun": [{"centre": [0, 0]}]}, camera={},
                              vision={"blobs": {}, "exposure_control": {}, "scan_lines": {}},
                              robots=[{"start": [0, 0, 0], "odometry": {}, "heading": {}, "motion": {"type": "still"}}]))
+            docs.append(dict(BASE, scoring={"recall": [{"position_m": 0.25, "heading_deg": 10}]}))
         else:
             docs.append({"scenarios": [{"file": "../paper/tracking.json", "localizers": [{"type": "mcl"}], "parameters": {"/duration": [1]}}],
                          "seeds": {"first": 1, "count": 1}})
