@@ -382,3 +382,12 @@ def noise_table(rep, real, sweeps):
              "the reference pose is the best fit of these same points, and a standing calibration frame has no camera vibration, latency "
              "or motion blur; the pixels also look cleaned (no robot or ball pixels), and none lies nearer than 2.3 m (so the first band "
              "is empty).")
+
+
+if __name__ == "__main__":
+    # A module of scripts/report.py, not a command: --help says so and does nothing else.
+    import sys
+    print(__doc__)
+    print("Usage: imported by scripts/report.py; run `omniloc report` (or scripts/report.py) on a results folder that holds the "
+          "real_robots sweep (omniloc sweep scenarios/sweeps/real_robots.json).")
+    sys.exit(0 if sys.argv[1:] in (["-h"], ["--help"]) else 2)
