@@ -35,6 +35,7 @@
 #include "localization/vision/scan_lines.hpp"
 #include "sim/render/panoramic_camera.hpp"
 #include "testing/scenes.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
@@ -154,7 +155,7 @@ std::map<std::string, Workload> workloads() {
                            return std::function<double()>([fr, det] { return static_cast<double>(det->detect(fr->image).size()); });
                          }};
   w["end_to_end"] = {1, "30 frames of the tracking scenario: physics, rendering (llvmpipe), vision, matching, scoring, writing", [] {
-                       Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+                       Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
                        j["duration"] = 29.0 / 30.0;  // frames at 0 .. 29/30 s: 30 frames
                        auto s = std::make_shared<harness::Scenario>(harness::parse_scenario(j, "icount_tracking"));
                        auto o = std::make_shared<harness::RunOptions>();

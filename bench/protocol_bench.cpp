@@ -14,6 +14,7 @@
 #include "external/external_localizer.hpp"
 #include "localization/odometry_only.hpp"
 #include "testing/scenes.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
@@ -54,7 +55,7 @@ BENCHMARK(BM_OdometryOnlyUpdate)->UseRealTime();
 
 static void BM_OlpRoundTrip(benchmark::State& state) {
   const bool python = state.range(0) == 1, image = state.range(1) == 1;
-  const std::string src = OMNILOC_SOURCE_DIR;
+  const std::string src = omniloc::source_dir().string();
   Json command = python ? Json{std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3",
                                src + "/clients/python/examples/dead_reckoning.py"}
                         : Json{OLP_BENCH_CLIENT};

@@ -12,6 +12,7 @@
 #include "harness/recording.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 namespace fs = std::filesystem;
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 harness::Scenario tracking(double duration) {
-  Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+  Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
   j["duration"] = duration;
   return harness::parse_scenario(j, "bench_replay_tracking");
 }

@@ -9,13 +9,14 @@
 
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
 namespace {
 
 void run_file(benchmark::State& state, const std::string& rel, double duration, const char* localizer = nullptr) {
-  const std::string path = std::string(OMNILOC_SOURCE_DIR) + "/" + rel;
+  const std::string path = std::string(omniloc::source_dir().string()) + "/" + rel;
   if (!std::filesystem::exists(path)) {
     state.SkipWithError(("missing scenario " + rel).c_str());
     return;

@@ -16,7 +16,9 @@ std::filesystem::path share_dir() {
     const fs::path installed = (exe.parent_path() / ".." / "share" / "omniloc").lexically_normal();
     if (fs::is_directory(installed / "data" / "fields", ec)) return installed;
   }
-  return fs::path(OMNILOC_SOURCE_DIR);
+  return source_dir();
 }
+
+std::filesystem::path source_dir() { return std::filesystem::path(OMNILOC_SOURCE_DIR); }
 
 }  // namespace omniloc

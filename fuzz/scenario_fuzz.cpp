@@ -26,6 +26,7 @@
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "batch/sweep.hpp"
+#include "core/install_paths.hpp"
 
 namespace {
 
@@ -35,7 +36,7 @@ const std::string& sweep_dir() {
   static const std::string dir = [] {
     const std::string d = (std::filesystem::temp_directory_path() / ("omniloc_fuzz_" + std::to_string(::getpid()))).string();
     std::filesystem::create_directories(d);
-    std::filesystem::copy_file(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/quickstart.json", d + "/quickstart.json",
+    std::filesystem::copy_file(std::string(omniloc::source_dir().string()) + "/scenarios/quickstart.json", d + "/quickstart.json",
                                std::filesystem::copy_options::overwrite_existing);
     return d;
   }();

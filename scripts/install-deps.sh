@@ -25,6 +25,7 @@ PKGS=(
   libssl-dev zlib1g-dev
   python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
+  ccache  # a compile cache (CMakeLists.txt OMNILOC_CCACHE): a fresh clone builds from earlier objects
   dpkg-dev file  # scripts/package.sh: dpkg-shlibdeps computes the .deb's Depends; cpack tests ELF files with file
   libxml2-utils python3-yaml  # tests: xmllint validates omniloc gate's JUnit XML; the CI recipe test reads docs/ci.md's YAML
 )

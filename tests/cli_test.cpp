@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/atomic_file.hpp"
+#include "core/install_paths.hpp"
 
 // Runs the real omniloc binary (the tests' working directory is the build folder); `out` and `err`
 // receive what it printed when given.
@@ -26,7 +27,7 @@ int run(const std::string& args, std::string* out = nullptr, std::string* err = 
   std::filesystem::remove(e);
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
-const std::string kScenario = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/quickstart.json";
+const std::string kScenario = std::string(omniloc::source_dir().string()) + "/scenarios/quickstart.json";
 }  // namespace
 
 TEST(Cli, ValidateGoodAndBad) {
@@ -55,7 +56,7 @@ TEST(Cli, UsageErrorsExitTwo) {
 // is a number in some command's --help must have a case here, so a new one cannot skip the strict parser.
 TEST(Cli, EveryNumberOptionRejectsAWordAndNamesIt) {
   const std::string q = kScenario;
-  const std::string sweep = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/sweeps/odometry_drift.json";
+  const std::string sweep = std::string(omniloc::source_dir().string()) + "/scenarios/sweeps/odometry_drift.json";
   const auto out = std::filesystem::temp_directory_path() / ("omniloc_cli_numbers_" + std::to_string(::getpid()));
   const std::string o = " -o " + out.string();
   struct Case {
@@ -144,7 +145,7 @@ TEST(Cli, ShippedInputsAreFoundFromAnyWorkingDirectory) {
     *err = omniloc::read_file(e);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   };
-  const fs::path source(OMNILOC_SOURCE_DIR);
+  const fs::path source(omniloc::source_dir().string());
   std::string err;
   EXPECT_EQ(in_dir("validate scenarios/quickstart.json", &err), 0) << err;
   EXPECT_NE(err.find("omniloc: using " + (source / "scenarios/quickstart.json").string()), std::string::npos) << err;

@@ -322,8 +322,8 @@ TEST(Cooperative001Experiment, QuickModeWritesFilesWithFiniteNumbers) {
   std::ostringstream out;
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(experiments::run_cooperative_001(a, out), 0);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  EXPECT_LT(seconds, 15.0);
+  // Recorded, not asserted: a wall-clock limit fails on a busy machine (speed lives in bench/).
+  RecordProperty("quick_run_s", std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
   for (const char* f : {"cooperative_001.json", "cooperative_001.md", "robots_vs_error.png", "robots_vs_error.csv", "field.png"}) {
     ASSERT_TRUE(fs::exists(d / f)) << f;
     EXPECT_GT(fs::file_size(d / f), 100u) << f;

@@ -16,6 +16,7 @@
 #include "external/external_localizer.hpp"
 #include "external/olp_framing.hpp"
 #include "external/sha256.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc::external {
 namespace {
@@ -23,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string python() { return fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3"; }
-const std::string kFaulty = std::string(OMNILOC_SOURCE_DIR) + "/tests/protocol_clients/faulty_client.py";
+const std::string kFaulty = std::string(omniloc::source_dir().string()) + "/tests/protocol_clients/faulty_client.py";
 
 // ---- framing --------------------------------------------------------------------------------------
 

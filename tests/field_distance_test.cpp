@@ -15,6 +15,7 @@
 
 #include "core/field.hpp"
 #include "omniloc_client.hpp"
+#include "core/install_paths.hpp"
 
 namespace {
 
@@ -67,7 +68,7 @@ TEST(FieldDistance, PythonClientEqualsOmnilocOnEveryPresetGrid) {
     const std::string py =
         "import json,sys; sys.path.insert(0, sys.argv[1]); import omniloc_client as o; j = json.load(open(sys.argv[2]));"
         "f = o.Field.from_json(j['field']); json.dump([f.distance_to_lines(x, y) for x, y in j['points']], open(sys.argv[3], 'w'))";
-    const std::string cmd = "/usr/bin/python3 -c \"" + py + "\" " + std::string(OMNILOC_SOURCE_DIR) + "/clients/python " +
+    const std::string cmd = "/usr/bin/python3 -c \"" + py + "\" " + std::string(omniloc::source_dir().string()) + "/clients/python " +
                             (dir / "in.json").string() + " " + (dir / "out.json").string();
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     const auto out = nlohmann::json::parse(std::ifstream(dir / "out.json")).get<std::vector<double>>();

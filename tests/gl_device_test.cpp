@@ -18,6 +18,7 @@
 #include "sim/render/gl_context.hpp"
 #include "sim/render/panoramic_camera.hpp"
 #include "testing/scenes.hpp"
+#include "core/install_paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace omniloc;
@@ -69,7 +70,7 @@ int shell(const std::string& cmd, std::string* err) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-const std::string kQuickstart = std::string(OMNILOC_SOURCE_DIR) + "/scenarios/quickstart.json";
+const std::string kQuickstart = std::string(omniloc::source_dir().string()) + "/scenarios/quickstart.json";
 
 }  // namespace
 

@@ -281,8 +281,8 @@ TEST(LandmarkMapsExperiment, QuickRunWritesItsFiles) {
   std::ostringstream out;
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(info->run(args, out), 0);
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  EXPECT_LT(secs, 20.0);
+  // Recorded, not asserted: a wall-clock limit fails on a busy machine (speed lives in bench/).
+  RecordProperty("quick_run_s", std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
   for (const char* f : {"landmark_maps.json", "maps_004.csv", "table1_004.json", "table1_004.md", "sim_003.json",
                         "sim_003_paper_consecutive.png", "sim_003_paper_memory.png", "sim_003_distractor_consecutive.png",
                         "sim_003_distractor_memory.png", "map_two_circle_004.png", "map_three_point_004.png", "map_circle_intersection_003.png",

@@ -13,6 +13,7 @@
 #include "harness/perception.hpp"
 #include "harness/scenario.hpp"
 #include "harness/simulation.hpp"
+#include "core/install_paths.hpp"
 
 namespace omniloc {
 namespace {
@@ -23,7 +24,7 @@ double quantile(std::vector<double> v, double q) {
 }
 
 TEST(LinePointAccuracy, DistanceToTheNearestLineCentreByRange) {
-  harness::Scenario sc = harness::load_scenario(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json");
+  harness::Scenario sc = harness::load_scenario(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json");
   const std::uint64_t seed = 1;
   harness::Simulation sim(sc, seed);
   const auto perception = harness::make_perception(sc, true, seed);

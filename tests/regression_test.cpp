@@ -10,6 +10,7 @@
 #include "core/atomic_file.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 namespace fs = std::filesystem;
@@ -18,12 +19,12 @@ TEST(Regression, SummariesMatchTheCommittedReference) {
   // The references are OSMesa's bytes; a GPU draws other pixels (docs/camera.md "GPUs"), so a
   // sweep-wide OMNILOC_GL_BACKEND=egl in the environment must not reach the gate.
   ::unsetenv("OMNILOC_GL_BACKEND");
-  const fs::path dir = fs::path(OMNILOC_SOURCE_DIR) / "scenarios" / "regression";
+  const fs::path dir = fs::path(omniloc::source_dir().string()) / "scenarios" / "regression";
   int checked = 0;
   for (const auto& e : fs::directory_iterator(dir)) {
     if (e.path().extension() != ".json") continue;
     const std::string name = e.path().stem().string();
-    const fs::path ref = fs::path(OMNILOC_SOURCE_DIR) / "results" / "reference" / "regression" / (name + ".summary.json");
+    const fs::path ref = fs::path(omniloc::source_dir().string()) / "results" / "reference" / "regression" / (name + ".summary.json");
     ASSERT_TRUE(fs::exists(ref)) << "no committed reference for " << name << " (run scripts/update_reference.sh)";
     const auto s = harness::load_scenario(e.path().string());
     harness::RunOptions o;

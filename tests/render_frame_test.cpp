@@ -12,6 +12,7 @@
 #include "harness/camera_perception.hpp"
 #include "harness/scenario.hpp"
 #include "testing/scenes.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;
@@ -57,7 +58,7 @@ TEST(RenderFrame, ShowsTheFrameTheRunSaw) {
 // pose up to 0.9 m off while the robot stood still; paper 002 sec. 5 stops the robot during the search
 // so that it need not localise on them.
 TEST(CameraPerceptionExposure, FramesAtTrialSettingsCarryNoObservations) {
-  const Scenario s = load_scenario(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/lighting_002_sun.json");
+  const Scenario s = load_scenario(std::string(omniloc::source_dir().string()) + "/scenarios/paper/lighting_002_sun.json");
   CameraPerception p(s, 1);
   ASSERT_TRUE(p.exposure_params().enabled);
   sim::WorldState w = scenes::one_robot(s.robots.at(0).spec.start);

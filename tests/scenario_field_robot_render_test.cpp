@@ -19,6 +19,7 @@
 
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
@@ -35,7 +36,7 @@ constexpr double kLineMean = 93.763, kLineSd = 0.268, kRmseMean = 0.0511, kRmseS
 
 TEST(ScenarioFieldRobotRender, TrackingStatisticsAsBeforeIssue38) {
   for (const Reference& ref : kOld) {
-    Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+    Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
     j["noise_profile"] = "field_robot";
     j["duration"] = 10.0;
     j["seed"] = ref.seed;

@@ -12,12 +12,13 @@
 
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
 namespace {
 Json kidnap_000(double duration) {
-  Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/kidnap_000.json"));
+  Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/kidnap_000.json"));
   j["duration"] = duration;
   Json kept = Json::array();
   for (const auto& e : j["events"])
@@ -75,7 +76,7 @@ TEST(ScenarioGlobal, AFastDriftingCompassIsCorrectedByGridGlobalAndFlaggedByHybr
 // odometry through the wall at x = 10 m to x = 15.6 m. Now no estimate leaves the floor, the
 // set pinned at the wall is drawn again, and the run ends localized.
 TEST(ScenarioGlobal, McLOnTheTrackingPathNeverLeavesTheFloorAndEndsLocalized) {
-  Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+  Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
   j["seed"] = 2;
   j["localizer"] = {{"type", "mcl"}};
   harness::RunOptions o;

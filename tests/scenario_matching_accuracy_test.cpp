@@ -11,6 +11,7 @@
 #include "harness/recording.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
@@ -37,7 +38,7 @@ Accuracy replay(const std::string& dir, const Json& localizer, const std::string
 }  // namespace
 
 TEST(MatchingAccuracy, RangeWeightsOnThePaperPath) {
-  Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+  Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
   j["duration"] = 20.0;  // four straight lines and three corners
   const auto sc = harness::parse_scenario(j, "tracking_accuracy");
   const auto tmp = std::filesystem::temp_directory_path() / "omniloc_matching_accuracy";

@@ -6,11 +6,12 @@
 
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "core/install_paths.hpp"
 
 using namespace omniloc;
 
 TEST(ScenarioTracking, IdealNoiseTracksUnder2cm) {
-  Json j = Json::parse(std::ifstream(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/paper/tracking.json"));
+  Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
   j["noise_profile"] = "ideal";
   j["duration"] = 15.0;  // the first two straight lines and a corner
   const auto s = harness::parse_scenario(j, "tracking_ideal");

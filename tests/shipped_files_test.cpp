@@ -11,6 +11,7 @@
 #include "experiments/experiment.hpp"
 #include "harness/scenario.hpp"
 #include "batch/sweep.hpp"
+#include "core/install_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -18,9 +19,9 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
   // As users run them: from the repository root (relative paths in scenario files, such as an
   // external localizer's command, are taken against omniloc's working directory; docs/protocol.md).
   const fs::path before = fs::current_path();
-  fs::current_path(OMNILOC_SOURCE_DIR);
+  fs::current_path(omniloc::source_dir().string());
   int n = 0;
-  for (const auto& e : fs::recursive_directory_iterator(fs::path(OMNILOC_SOURCE_DIR) / "scenarios")) {
+  for (const auto& e : fs::recursive_directory_iterator(fs::path(omniloc::source_dir().string()) / "scenarios")) {
     if (e.path().extension() != ".json") continue;
     const bool sweep = e.path().parent_path().filename() == "sweeps";
     const bool experiment = e.path().parent_path().filename() == "experiments";
@@ -54,10 +55,10 @@ TEST(ShippedFiles, EveryScenarioAndSweepValidates) {
 // The default main job runs scenarios/sweeps/paper_suite.json: every paper scenario must be in it,
 // and every published row's variant (occlusion fractions, auto-adjust off, other localizers) with it.
 TEST(ShippedFiles, PaperSuiteRunsEveryPaperScenario) {
-  const auto spec = omniloc::batch::load_sweep(std::string(OMNILOC_SOURCE_DIR) + "/scenarios/sweeps/paper_suite.json");
+  const auto spec = omniloc::batch::load_sweep(std::string(omniloc::source_dir().string()) + "/scenarios/sweeps/paper_suite.json");
   std::set<std::string> in_suite;
   for (const auto& r : spec.runs) in_suite.insert(r.scenario_name);
-  for (const auto& e : fs::directory_iterator(fs::path(OMNILOC_SOURCE_DIR) / "scenarios" / "paper")) {
+  for (const auto& e : fs::directory_iterator(fs::path(omniloc::source_dir().string()) / "scenarios" / "paper")) {
     if (e.path().extension() != ".json") continue;
     EXPECT_TRUE(in_suite.count(e.path().stem().string())) << e.path() << " is not in the paper suite";
   }
