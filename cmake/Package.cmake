@@ -19,7 +19,8 @@ install(DIRECTORY results/reference/ DESTINATION ${OMNILOC_SHARE}/results/refere
 # gate.py; gate.py imports compare.py), docs/ci.md's recipe runner, and the modules they import.
 install(PROGRAMS scripts/compare.py scripts/report.py scripts/gate.py scripts/ci_recipe.py scripts/paper_table.py
         scripts/global_start.py DESTINATION ${OMNILOC_SHARE}/scripts)
-install(FILES scripts/omniloc_results.py scripts/paper_claims.py DESTINATION ${OMNILOC_SHARE}/scripts)
+install(FILES scripts/omniloc_results.py scripts/paper_claims.py scripts/real_robots.py scripts/nubot_reference_pose.py
+        DESTINATION ${OMNILOC_SHARE}/scripts)
 # What users import to write an external localizer: the Python and C++ clients and their examples
 # (source only; the clients' own tests stay in the tree).
 install(DIRECTORY clients/python clients/cpp DESTINATION ${OMNILOC_SHARE}/clients

@@ -15,7 +15,8 @@ cmake --install "$build" --prefix "$tmp/usr" >"$tmp/install.log"
 share=$tmp/usr/share/omniloc
 [ "$(ls "$tmp/usr/bin")" = omniloc ] || fail "bin/ should hold omniloc only, holds: $(ls "$tmp/usr/bin")"
 for f in data/fields data/noise_profiles.json scenarios/quickstart.json results/reference/papers.json \
-         scripts/compare.py scripts/report.py scripts/omniloc_results.py clients/python/omniloc_client.py \
+         scripts/compare.py scripts/report.py scripts/omniloc_results.py scripts/real_robots.py scripts/nubot_reference_pose.py \
+         clients/python/omniloc_client.py \
          clients/cpp/omniloc_client.hpp; do
   [ -e "$share/$f" ] || fail "not installed: share/omniloc/$f"
 done
