@@ -119,7 +119,7 @@ Json recall_json(const std::vector<FrameError>& answered, std::size_t frames, co
   Json j = Json::object();
   for (const auto& t : scoring.recall) {
     std::size_t in = 0;
-    for (const auto& e : answered) in += std::hypot(e.ex, e.ey) <= t.position_m && std::fabs(e.eth) <= t.heading_rad;
+    for (const auto& e : answered) in += t.contains(e);
     j[t.key] = frames ? Json(static_cast<double>(in) / static_cast<double>(frames)) : Json(nullptr);
   }
   return j;
@@ -235,7 +235,7 @@ void add_first_fix(const RobotRecord& robot, const Scoring& scoring, Json& rj) {
   for (const auto& r : robot.frames) {
     if (!r.valid) continue;
     if (first.is_null()) first = r.t;
-    if (std::hypot(r.est.x - r.truth.x, r.est.y - r.truth.y) <= mid.position_m && std::fabs(angle_diff(r.est.theta, r.truth.theta)) <= mid.heading_rad) {
+    if (mid.contains({r.t, r.est.x - r.truth.x, r.est.y - r.truth.y, angle_diff(r.est.theta, r.truth.theta)})) {
       within = r.t;
       break;
     }

@@ -2,6 +2,7 @@
 // Scoring: the only place where ground truth meets estimates. Errors per frame, and the papers'
 // table layout (mean, std and max of |x|, |y| errors in cm and |theta| error in rad) plus position
 // mean, RMSE and percentiles.
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,8 @@ Json to_json(const ErrorSummary& s);
 struct RecallThreshold {
   double position_m = 0.25, heading_rad = 0.0;
   std::string key;
+  /// Whether an error (metres, metres, radians wrapped) lies within both limits.
+  bool contains(const FrameError& e) const { return std::hypot(e.ex, e.ey) <= position_m && std::fabs(e.eth) <= heading_rad; }
 };
 
 /// How a run is scored beyond the error statistics (scenario key "scoring", docs/results.md).
