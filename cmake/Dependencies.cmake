@@ -26,3 +26,5 @@ find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)
 # gzip of a recording's frames (harness/recording.cpp, docs/recording.md).
 find_package(ZLIB REQUIRED)
+# simdjson: the recording reader's fast path (harness/frames_reader.cpp; docs/performance.md "Replay").
+find_package(simdjson REQUIRED)

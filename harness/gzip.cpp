@@ -1,6 +1,8 @@
 #include "harness/gzip.hpp"
 
+#include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 #include <zlib.h>
 
@@ -52,6 +54,49 @@ std::string gzip_decompress(std::string_view gz, std::size_t max_bytes) {
   inflateEnd(&z);
   if (trailing) throw std::runtime_error("bytes after the end of the gzip stream");
   return out;
+}
+
+struct GzipFileReader::State {
+  std::FILE* f = nullptr;
+  z_stream z{};
+  std::vector<unsigned char> in = std::vector<unsigned char>(1 << 18);
+  bool ended = false;
+  ~State() {
+    inflateEnd(&z);
+    if (f) std::fclose(f);
+  }
+};
+
+GzipFileReader::GzipFileReader(const std::string& path) : s_(std::make_unique<State>()) {
+  s_->f = std::fopen(path.c_str(), "rb");
+  if (!s_->f) throw std::runtime_error("cannot open " + path);
+  if (inflateInit2(&s_->z, 15 + 16) != Z_OK) throw std::runtime_error("zlib: inflateInit2 failed");
+}
+
+GzipFileReader::~GzipFileReader() = default;
+
+std::size_t GzipFileReader::read(char* out, std::size_t n) {
+  State& s = *s_;
+  if (s.ended || n == 0) return 0;
+  s.z.next_out = reinterpret_cast<Bytef*>(out);
+  s.z.avail_out = static_cast<uInt>(n);
+  while (s.z.avail_out == n) {
+    if (s.z.avail_in == 0) {
+      const std::size_t got = std::fread(s.in.data(), 1, s.in.size(), s.f);
+      if (got == 0) throw std::runtime_error(std::ferror(s.f) ? "cannot read the gzip stream" : "the gzip stream is cut short");
+      s.z.next_in = s.in.data();
+      s.z.avail_in = static_cast<uInt>(got);
+    }
+    const int rc = inflate(&s.z, Z_NO_FLUSH);
+    if (rc == Z_STREAM_END) {
+      s.ended = true;
+      // Nothing may follow the stream: neither in the buffer nor in the file.
+      if (s.z.avail_in != 0 || std::fgetc(s.f) != EOF) throw std::runtime_error("bytes after the end of the gzip stream");
+      break;
+    }
+    if (rc != Z_OK && rc != Z_BUF_ERROR) throw std::runtime_error("not a valid gzip stream");
+  }
+  return n - s.z.avail_out;
 }
 
 }  // namespace omniloc::harness

@@ -20,6 +20,7 @@
 #include "external/external_localizer.hpp"
 #include "external/sha256.hpp"
 #include "harness/external_session.hpp"
+#include "harness/frames_reader.hpp"
 #include "harness/gzip.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/render_frame.hpp"
@@ -30,10 +31,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Frames a recording may hold (an hour at 200 Hz), and the largest frames.jsonl read (a frame with
-// thousands of line points is about 100 kB).
+// Frames a recording may hold (an hour at 200 Hz); the largest frames.jsonl is read by
+// harness/frames_reader.cpp.
 constexpr long long kMaxFrames = 720000;
-constexpr std::uintmax_t kMaxFramesBytes = 8ULL << 30;
 
 
 std::string image_name(int robot, long long k) {
@@ -203,17 +203,6 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
   if (const auto c = j.find("contact"); c != j.end()) r.contact = boolean(*c, json_child(at, "contact"));
   if (truth) r.truth = pose(member(j, "truth", at), json_child(at, "truth"));
   return r;
-}
-
-std::string read_text(const std::string& path, std::uintmax_t max_bytes) {
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  if (ec) throw ConfigError(path, "missing", "a readable file of the recording (docs/recording.md)");
-  if (size > max_bytes) throw ConfigError(path, std::to_string(size) + " bytes", "at most " + std::to_string(max_bytes) + " bytes");
-  std::ifstream in(path, std::ios::binary);
-  std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) throw ConfigError(path, "unreadable", "a readable file");
-  return s;
 }
 
 std::shared_ptr<const Image> read_png(const std::string& path) {
@@ -396,46 +385,11 @@ std::string recorded_with(const RecordingHeader& h) {
   return v != h.omniloc.end() && v->is_string() ? v->get<std::string>() : "unknown";
 }
 
-RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(header)) {
-  const std::string file = (fs::path(header_.dir) / header_.frames_file).string();
-  std::string text = read_text(file, kMaxFramesBytes);
-  if (header_.frames_file.size() > 3 && header_.frames_file.compare(header_.frames_file.size() - 3, 3, ".gz") == 0) {
-    try {
-      text = gzip_decompress(text, kMaxFramesBytes);
-    } catch (const std::exception& e) {
-      throw ConfigError(file, e.what(), "a whole gzip stream of frames.jsonl");
-    }
-  }
-  if (!header_.frames_sha256.empty() && external::sha256_hex(text) != header_.frames_sha256)
-    throw ConfigError(file, "SHA-256 " + external::sha256_hex(text),
-                      "the SHA-256 recording.json gives (" + header_.frames_sha256 + "): the file was changed or cut short");
-  frames_.reserve(static_cast<std::size_t>(header_.frames));
-  long long line_no = 0;
-  for (std::size_t a = 0; a < text.size();) {
-    std::size_t b = text.find('\n', a);
-    if (b == std::string::npos) throw ConfigError(file + " line " + std::to_string(line_no + 1), "a line without its newline", "whole lines (the file is cut short)");
-    ++line_no;
-    const std::string at = file + " line " + std::to_string(line_no);
-    if (line_no > header_.frames) throw ConfigError(at, "another frame", std::to_string(header_.frames) + " frames (recording.json)");
-    const Json j = parse_json_strict(std::string_view(text).substr(a, b - a), at);
-    FrameData f = frame_from_json(j, at + " ", header_.robots, header_.ground_truth);  // "frames.jsonl line 6 /robots/0/heading"
-    if (f.k != line_no - 1) throw ConfigError(at + " /k", std::to_string(f.k), "frame " + std::to_string(line_no - 1) + " (frames in order from 0)");
-    if (!frames_.empty() && !(f.t > frames_.back().t)) throw ConfigError(at + " /t", std::to_string(f.t), "a time after the previous frame's");
-    frames_.push_back(std::move(f));
-    a = b + 1;
-  }
-  if (line_no != header_.frames)
-    throw ConfigError(file, std::to_string(line_no) + " frames", std::to_string(header_.frames) + " frames (recording.json): the file is cut short");
+RecordingSource::RecordingSource(RecordingHeader header) : header_(std::move(header)), reader_(std::make_unique<FramesReader>(header_)) {
   read_timing();
-  if (header_.images) {
-    std::error_code ec;
-    for (const auto& f : frames_)
-      for (const auto& r : f.robots) {
-        const fs::path p = fs::path(header_.dir) / image_name(r.id, f.k);
-        if (!fs::is_regular_file(p, ec)) throw ConfigError(p.string(), "missing", "an image for every frame (recording.json says \"images\": true)");
-      }
-  }
 }
+
+RecordingSource::~RecordingSource() = default;
 
 // timing.csv (optional): the render and vision times the recording's frames cost, for the run's
 // timing.csv. A line that does not parse is ignored: these are wall-clock figures, never results.
@@ -443,25 +397,32 @@ void RecordingSource::read_timing() {
   std::ifstream in(fs::path(header_.dir) / "timing.csv");
   std::string line;
   if (!std::getline(in, line)) return;
-  std::map<std::pair<long long, int>, std::pair<double, double>> ms;
   while (std::getline(in, line)) {
     long long k = 0;
     int robot = 0;
     double render = 0, vision = 0;
-    if (std::sscanf(line.c_str(), "%lld,%d,%lf,%lf", &k, &robot, &render, &vision) == 4) ms[{k, robot}] = {render, vision};
+    if (std::sscanf(line.c_str(), "%lld,%d,%lf,%lf", &k, &robot, &render, &vision) == 4) timing_[{k, robot}] = {render, vision};
   }
-  for (auto& f : frames_)
-    for (auto& r : f.robots)
-      if (const auto it = ms.find({f.k, r.id}); it != ms.end()) std::tie(r.render_ms, r.vision_ms) = it->second;
 }
 
 std::optional<FrameData> RecordingSource::next() {
-  if (next_ >= frames_.size()) return std::nullopt;
-  FrameData f = std::move(frames_[next_++]);
-  if (header_.images)
-    for (auto& r : f.robots) r.obs.image = read_png((fs::path(header_.dir) / image_name(r.id, f.k)).string());
+  std::optional<FrameData> f = reader_->next();
+  if (!f) return f;
+  for (auto& r : f->robots)
+    if (const auto it = timing_.find({f->k, r.id}); it != timing_.end()) std::tie(r.render_ms, r.vision_ms) = it->second;
+  if (header_.images) {
+    std::error_code ec;
+    for (auto& r : f->robots) {
+      const fs::path p = fs::path(header_.dir) / image_name(r.id, f->k);
+      if (!fs::is_regular_file(p, ec)) throw ConfigError(p.string(), "missing", "an image for every frame (recording.json says \"images\": true)");
+      r.obs.image = read_png(p.string());
+    }
+  }
   return f;
 }
+
+long long RecordingSource::fast_lines() const { return reader_->fast_lines(); }
+long long RecordingSource::strict_lines() const { return reader_->strict_lines(); }
 
 Json RecordingSource::client_camera(int robot) const {
   for (const auto& r : header_.robots)

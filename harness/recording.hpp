@@ -8,6 +8,8 @@
 // recorded with images, images/r<robot>_<k>.png (lossless); timing.csv keeps what rendering cost. It is written like a run folder: staged
 // and renamed into place at the end, so an interrupted recording leaves nothing that looks whole.
 #include <cstdint>
+#include <map>
+#include <utility>
 #include <memory>
 #include <optional>
 #include <string>
@@ -84,12 +86,16 @@ struct RecordingHeader {
 /// an object without a string version reads "unknown", anything else "not omniloc".
 std::string recorded_with(const RecordingHeader& header);
 
-/// Frames read back from a recording: every line of frames.jsonl is parsed and checked (and the
-/// image files of a recording with images found) in the constructor, so a truncated or corrupted
-/// recording fails before any localizer starts. Images are read one frame at a time.
+class FramesReader;
+
+/// Frames read back from a recording, one at a time as the run asks for them (harness/frames_reader.hpp:
+/// memory flat in the recording's length, every check of docs/recording.md section 7). A damaged
+/// file is found while reading: next() throws ConfigError and the run writes nothing. Images are read
+/// one frame at a time.
 class RecordingSource : public FrameSource {
  public:
   explicit RecordingSource(RecordingHeader header);
+  ~RecordingSource() override;
   std::optional<FrameData> next() override;
   Json client_camera(int robot) const override;
   bool detects_blobs() const override;
@@ -97,12 +103,15 @@ class RecordingSource : public FrameSource {
   Json render_device() const override { return header_.render; }
   bool has_ground_truth() const override { return header_.ground_truth; }
   const RecordingHeader& header() const { return header_; }
+  /// Lines the fast path parsed and lines the strict reader parsed (harness/frames_reader.hpp).
+  long long fast_lines() const;
+  long long strict_lines() const;
 
  private:
   void read_timing();
   RecordingHeader header_;
-  std::vector<FrameData> frames_;
-  std::size_t next_ = 0;
+  std::unique_ptr<FramesReader> reader_;
+  std::map<std::pair<long long, int>, std::pair<double, double>> timing_;  ///< (k, robot) -> (render_ms, vision_ms)
 };
 
 /// JSON of one frame as frames.jsonl holds it, and back (`at`: where, for errors).
