@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Student t 0.975 quantiles for 1..30 degrees of freedom (the values scripts/omniloc_results.py's
+// Student t 0.975 quantiles for 1..30 degrees of freedom (the values python/omniloc/core/stats.py's
 // t_quantile_975 computes), then the Cornish-Fisher expansion (within 2e-6 of them above 30).
 double t975(std::size_t df) {
   static const double t[] = {0,        12.706205, 4.302653, 3.182446, 2.776445, 2.570582, 2.446912, 2.364624,

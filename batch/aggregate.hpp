@@ -13,7 +13,7 @@
 
 namespace omniloc::batch {
 
-/// The interval rule, the same as scripts/omniloc_results.py's interval() (docs/results.md
+/// The interval rule, the same as python/omniloc/core/stats.py's interval() (docs/results.md
 /// "Intervals", chosen by the coverage measured by scripts/interval_coverage.py): with n >= 5 seeds
 /// the 95 % Student t interval of the mean, its lower bound clipped at 0 when no value is negative
 /// ("t95"); with 2 to 4 seeds no interval is reliable, so low / high are the seeds' minimum and

@@ -27,9 +27,10 @@ static void BM_MatchingUpdate(benchmark::State& state) {
     iterations = e.extra.at("iterations");
     benchmark::DoNotOptimize(e.pose);
   }
-  // Issue 20's unit: time per line point and RPROP iteration (the peers' figure), and per point and
-  // data-term evaluation (each update also evaluates the error once and the gradient six times for
-  // the Hessian that gives the Kalman filter its covariance).
+  // The speed targets' unit (docs/performance.md "Targets and measured figures"): time per line
+  // point and RPROP iteration (the peers' figure), and per point and data-term evaluation (each
+  // update also evaluates the error once and the gradient six times for the Hessian that gives the
+  // Kalman filter its covariance).
   const double points = static_cast<double>(obs.line_points.size());
   state.counters["rprop_iterations"] = iterations;
   state.counters["s_per_point_iteration"] = benchmark::Counter(points * iterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);

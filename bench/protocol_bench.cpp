@@ -1,6 +1,6 @@
 // The cost of olp/1 (docs/protocol.md) per frame: one frame sent to an external client and its
 // estimate read back, beside the built-in odometry_only localizer on the same observations
-// (issue 28's targets on the 2-core machine: <= 0.3 ms per frame with observations only, <= 2 ms with a
+// (the protocol's targets on the 2-core machine: <= 0.3 ms per frame with observations only, <= 2 ms with a
 // 640 x 640 image). Wall time (UseRealTime): the client's work happens in another process.
 //   BM_OdometryOnlyUpdate           the built-in localizer, no protocol
 //   BM_OlpRoundTrip/<client>/<img>  client 0 = a minimal C++ client (bench/olp_bench_client.cpp),

@@ -1,7 +1,7 @@
 // One 640 x 640 panorama per iteration, per GL back-end and quality, on a realistic scene: the
 // MSL field, the observer, four other robots and the ball. Run with LP_NUM_THREADS=1 (one core).
 //
-// Issue 38: BM_RenderProfile draws the same scene with the observer driving at 1 m/s (the paper
+// BM_RenderProfile (docs/performance.md "The cost of a field_robot frame") draws the same scene with the observer driving at 1 m/s (the paper
 // tracking path's speed, no turn) under the camera settings of the `robot` and `field_robot` noise
 // profiles (data/noise_profiles.json), so that the ratio of the two is measured in one run;
 // `field_robot_turning` adds a 2 rad/s turn (the rotation smear), and the `field_robot_no_*`

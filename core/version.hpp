@@ -1,6 +1,6 @@
 #pragma once
 // Which build made a result: every summary.json, aggregate.json and report records it, so results
-// of two commits can be told apart and compared (`omniloc --version`, scripts/compare.py).
+// of two commits can be told apart and compared (`omniloc --version`, omniloc compare).
 #include <string>
 
 #include "core/json_reader.hpp"

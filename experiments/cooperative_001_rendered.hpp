@@ -1,5 +1,5 @@
 #pragma once
-// Rendered-image mode of the paper-001 simulation (issue 9): instead of "true ball + Gaussian noise",
+// Rendered-image mode of the paper-001 simulation (docs/cooperative.md "Rendered mode"): instead of "true ball + Gaussian noise",
 // every robot renders its own panorama with the simulated omnidirectional camera
 // (sim/render/panoramic_camera.hpp), finds the ball (the orange colour class) with the robot-side
 // BlobDetector through the calibration map and colour table of harness/vision_setup.hpp, and turns

@@ -304,7 +304,7 @@ Json budget_json(const ErrorBudgetResult& r) {
 
 void write_error_budget_report(const ErrorBudgetConfig& c, const ErrorBudgetResult& r, RunDirectory& dir, std::ostream& out) {
   const std::string md = budget_markdown(c, r);
-  dir.write("error_budget.json", budget_json(r).dump(2) + "\n");  // named after the experiment: scripts/report.py finds it so
+  dir.write("error_budget.json", budget_json(r).dump(2) + "\n");  // named after the experiment: omniloc report finds it so
   dir.write("budget.csv", budget_csv(r));
   dir.write("README.md", md);
   dir.commit();

@@ -1,5 +1,5 @@
 #pragma once
-// Error budget (issue 17): the tracking path with every error source off, then each source alone,
+// Error budget (docs/error_budget.md): the tracking path with every error source off, then each source alone,
 // then all together, for each localizer. Tells which error dominates on a real robot.
 // Description file: scenarios/experiments/error_budget.json.
 //
@@ -45,7 +45,7 @@ void validate_error_budget(const std::string& file);
 
 /// One cell of the table: one row (error source) and one localizer.
 /// One finished run (seed) of a cell: what the means are taken over, kept so that the report can
-/// give each row an interval over the seeds (issue 29) and a reader can see whether a seed matters.
+/// give each row an interval over the seeds (docs/error_budget.md "Full mode with seeds") and a reader can see whether a seed matters.
 struct ErrorBudgetSeed {
   std::uint64_t seed = 0;
   double rmse_cm = 0, p50_cm = 0, theta_rmse_deg = 0;

@@ -18,7 +18,7 @@ const std::vector<ExperimentInfo>& all() {
        "FBPF vs MFBPF growth model, trackers on the fixes (scenarios/experiments/cooperative_001.json)",
        run_cooperative_001, validate_cooperative_001},
       {"error_budget",
-       "issue 17: the tracking path with every error source off, each alone, and all together (robot, field_robot), for matching, "
+       "which error source dominates: the tracking path with every error source off, each alone, and all together (robot, field_robot), for matching, "
        "MCL and the hybrid (scenarios/experiments/error_budget.json)",
        run_error_budget, validate_error_budget},
       {"landmark_maps", "paper 004 solver error maps and table 1, paper 003 landmark groups with voting (simulation)", run_landmark_maps},

@@ -312,7 +312,7 @@ void report_table1(const LandmarkMapsConfig& cfg, const LandmarkMapsResult& r, R
     const std::string trend = table1_trend(t, pub);
     out << trend << "\n";
     md += "\n" + trend + ".\n";
-    // The trend as numbers too, for the report's scorecard (scripts/paper_claims.py).
+    // The trend as numbers too, for the report's scorecard (python/omniloc/paper/claims.py).
     table_json.push_back({{"bearing_sigma_deg", t.sigma_deg}, {"trials", cfg.table_trials}, {"rows", jrows}, {"trend", trend},
                           {"edge_centre_ratio", {{"two_circle", json_number(edge_centre_ratio(t, kTwoCircle))},
                                                  {"three_point", json_number(edge_centre_ratio(t, kThreePoint))}}}});

@@ -90,7 +90,7 @@ PerceptionOutput CameraPerception::observe(const sim::WorldState& world, int rob
     // A frame taken while a search is running was taken at a trial setting: it is for the entropy
     // only. Paper 002 sec. 5 stops the robot "till the optimization is finished" so that it need not
     // localise on such frames; fed to the tracker, an over-exposed trial frame (up to 2000 false line
-    // points under the sun) pulled the pose up to 0.9 m off while the robot stood still (issue 29).
+    // points under the sun) pulled the pose up to 0.9 m off while the robot stood still (docs/lighting.md "Auto-adjustment on was worse than off under field_robot").
     // The localizer coasts on odometry instead, which is exact for a robot standing still.
     const bool trial_frame = ct->second.searching();
     if (trial_frame) {

@@ -202,7 +202,7 @@ CalibrationMap exact_calibration(const sim::CameraConfig& cfg) {
 }
 
 std::string calibration_cache_file(const sim::CameraConfig& cfg) {
-  // v2: the mirror axis is estimated from the rim (issue 17); "calibration_<tag>" files took the
+  // v2: the mirror axis is estimated from the rim (docs/camera.md "The mirror centre"); "calibration_<tag>" files took the
   // image centre and are not reused.
   return std::string(kCache) + "/calibration_v2_" + camera_tag(cfg) + ".json";
 }

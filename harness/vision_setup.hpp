@@ -16,7 +16,7 @@ namespace omniloc::harness {
 /// Where the calibration takes the mirror axis from.
 enum class CentreSource {
   kRim,          ///< estimated from the mirror rim in the calibration images (the default)
-  kImageCentre,  ///< assumed at the image centre (before issue 17: a decentred mirror becomes error)
+  kImageCentre,  ///< assumed at the image centre (calibration before commit 0d6c7b9: a decentred mirror becomes error)
 };
 
 /// Renders the calibration patch in 36 directions while the robot turns on an empty floor, finds

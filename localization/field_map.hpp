@@ -25,7 +25,7 @@ class FieldMap {
   };
   /// The table as plain values: what a hot loop copies into a local (`const auto t = map.table()`)
   /// so the compiler keeps the geometry in registers instead of reloading it around every lookup
-  /// (issue 20: the matcher's loop reloaded seven members per point). Results are returned by
+  /// (before commit 8c2a23f the matcher's loop reloaded seven members per point). Results are returned by
   /// value for the same reason: an out-pointer into the loop would pin its variables to memory.
   struct Table {
     const double* cells;     // row-major, nx per row (metres)

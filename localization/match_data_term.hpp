@@ -3,7 +3,7 @@
 // e(t) = 1 - c^2 / (c^2 + t^2), where w_i(q) is line point i (robot frame, metres) placed at pose
 // q = (x, y, theta) (world frame, metres and radians) and d the field's distance map. RPROP, the
 // error reports and the Hessian behind the Kalman covariance evaluate it about twenty times per
-// update, so it is the matcher's whole cost (issue 20) and lives apart from the optimiser.
+// update, so it is the matcher's whole cost (docs/performance.md) and lives apart from the optimiser.
 #include <vector>
 
 #include <Eigen/Core>

@@ -129,7 +129,7 @@ MatchResult rprop_match(const FieldMap& map, const std::vector<Eigen::Vector2d>&
     const int end = last ? cap : std::min(cap, r.iterations + share);
     // A new error function: the last stage's gradient signs say nothing about this one's. The steps
     // carry over: the minimum moves by less than they have shrunk to (restarting them at step0 cost
-    // more iterations and lost cold starts on the test of issue 17).
+    // more iterations and lost cold starts in Matching.ConvergesFromColdStartsOnRandomPoses).
     prev.setZero();
     while (r.iterations < end) {
       Eigen::Vector3d g;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs a built omniloc .deb into a clean Debian 12 root and runs it there, with no source tree
-# (issue 39; docs/package.md). Called by .ci/run's package stage after scripts/package.sh.
+# (docs/package.md). Called by .ci/run's package stage after scripts/package.sh.
 # Usage: scripts/clean_root_check.sh DEB [LOG]   (LOG default: build/clean_root.log)
 # The root: `mmdebstrap --variant=apt bookworm` (apt and its essentials only, from deb.debian.org;
 # root, network), then `apt-get install /tmp/omniloc_*.deb` inside it, so the .deb's Depends alone

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Frames per second of the renderer alone and of whole runs, per GL back-end and device, with
-# 1 and several processes sharing the machine (and its GPU): issue 32, docs/performance.md "GPUs".
+# 1 and several processes sharing the machine (and its GPU): docs/performance.md "GPUs".
 #
 # Usage: scripts/render_throughput.sh [-b BIN_DIR] [-o OUT_DIR] [-p "1 4 8"] [-B "osmesa egl"] [-s SECONDS] [-e SCENARIO]
 #   -b  folder with omniloc and bench_render (default build)

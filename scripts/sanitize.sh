@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The unit tests under AddressSanitizer + UndefinedBehaviorSanitizer with leak detection (issue 19).
+# The unit tests under AddressSanitizer + UndefinedBehaviorSanitizer with leak detection (README "Bad input").
 # Builds only the unit-test programs and omniloc (the CLI tests run it) in build-asan/, never the
 # slow end-to-end scenario tests or the benchmarks, then runs ctest -LE 'scenario|cluster|mutation'.
 # Leaks inside Mesa (llvmpipe, OSMesa, LLVM) are suppressed by .ci/lsan-mesa.supp, nothing else.

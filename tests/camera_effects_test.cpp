@@ -1,4 +1,4 @@
-// What makes the simulated camera a real robot's camera (issue 17): the measured NuBot mirror,
+// What makes the simulated camera a real robot's camera (docs/camera.md "What a real camera adds"): the measured NuBot mirror,
 // motion blur over the exposure, defocus towards the rim, tilt from acceleration, and lamp light
 // without 8-bit banding. Truth-side tests: they use the simulator's own projection.
 #include <gtest/gtest.h>
@@ -32,7 +32,7 @@ TEST(MirrorPresets, NubotTanFollowsTheMeasuredLaw) {
   }
   // The body hides the floor within 0.44 m (NuBot's small_radius of 38 px at b = 0.0067311).
   EXPECT_NEAR(a * std::tan(b * cam.body_radius_px()), 0.4385, 1e-3);
-  // Floor per pixel at 1, 4, 6, 8 m: 1.14, 5.6, 11.6, 20.0 cm (issue 17's figures for this rim).
+  // Floor per pixel at 1, 4, 6, 8 m: 1.14, 5.6, 11.6, 20.0 cm (docs/camera.md's nubot_tan column for this rim).
   const double cm[] = {1.14, 5.62, 11.6, 20.0};
   int i = 0;
   for (double d : {1.0, 4.0, 6.0, 8.0}) {

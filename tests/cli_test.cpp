@@ -102,7 +102,7 @@ TEST(Cli, EveryNumberOptionRejectsAWordAndNamesIt) {
   }
 }
 
-// Issue 31: no command replaces a user's file or non-empty folder without --overwrite. Each command
+// No command replaces a user's file or non-empty folder without --overwrite. Each command
 // with -o is refused (exit 2, the file untouched, the message naming --overwrite) before any work,
 // and does its work when told --overwrite.
 TEST(Cli, NoCommandOverwritesWithoutBeingTold) {
@@ -130,7 +130,7 @@ TEST(Cli, NoCommandOverwritesWithoutBeingTold) {
   std::filesystem::remove_all(dir);
 }
 
-// Issue 39: a relative scenario or sweep path that is not there from the working directory but is a
+// A relative scenario or sweep path that is not there from the working directory but is a
 // shipped file (share_dir(); in a build tree the source tree) is used from there, with a note on
 // stderr; a file of that name in the working directory still wins, silently.
 TEST(Cli, ShippedInputsAreFoundFromAnyWorkingDirectory) {

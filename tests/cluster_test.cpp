@@ -192,7 +192,7 @@ TEST(Cluster, FailedTaskCancelsTheMergeAndResubmitMissingCompletes) {
   EXPECT_EQ(a.at(array + "_2"), "FAILED");
   EXPECT_EQ(a.at(array + "_0"), "COMPLETED");
   EXPECT_EQ(m.at(merge), "CANCELLED");  // --kill-on-invalid-dep=yes: not PENDING forever
-  // Three shards finished, one failed, no merge: nothing may look like the sweep's result (issue 31).
+  // Three shards finished, one failed, no merge: nothing may look like the sweep's result (only the merge writes it).
   for (const char* f : {"aggregate.json", "aggregate.csv", "runs.csv"}) EXPECT_FALSE(fs::exists(res / f)) << f;
   EXPECT_TRUE(fs::exists(res / "progress" / "shard-0-of-4.json"));
 
@@ -301,7 +301,7 @@ TEST(Cluster, DryRunWritesTheSubmissionFolderWithoutSlurm) {
   EXPECT_EQ(sh("bash -n " + (res / "slurm" / "array.sbatch").string() + " && bash -n " + (res / "slurm" / "merge.sbatch").string()).code, 0);
 }
 
-// --gpus-per-task (issue 32): the GPUs as a generic resource among the #SBATCH lines (sbatch reads
+// --gpus-per-task (docs/cluster.md "GPUs"): the GPUs as a generic resource among the #SBATCH lines (sbatch reads
 // none after the first command) and rendering on them with egl; no Slurm needed.
 TEST(Cluster, DryRunRequestsGpusPerTask) {
   const std::string sweep = make_sweep(3.0);

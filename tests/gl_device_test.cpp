@@ -1,4 +1,4 @@
-// The "egl" back-end's device choice (issue 32): the order "auto" tries devices in, OMNILOC_EGL_DEVICE
+// The "egl" back-end's device choice (docs/camera.md "GPUs"): the order "auto" tries devices in, OMNILOC_EGL_DEVICE
 // and OMNILOC_GL_BACKEND, and, on this machine's real libEGL (Mesa's device platform and surfaceless
 // display, no GPU), enumeration, selection, the fallback and the error path. The GPU side is
 // measured by scripts/gpu_check.sh (docs/performance.md), not here: CI has no GPU.

@@ -214,7 +214,7 @@ TEST(Landmarks, OnTheSingularSets) {
 }
 
 TEST(Landmarks, TotalLikeExactOnEveryLineThroughTwoLandmarks) {
-  // Issue 17: ToTal-like placed a robot on the line through landmarks 1 and 2 up to 4 mm wrong (the
+  // Before commit 16640f5, ToTal-like placed a robot on the line through landmarks 1 and 2 up to 4 mm wrong (the
   // clamped cotangent of that pair entered both factors of D). On each line the bearing difference
   // of its pair is 0 (beyond the landmarks) or pi (between them) to rounding, so that cotangent is
   // clamped (kCotMax = 1e14); the solver puts it in T31, where the position is a ratio of two terms

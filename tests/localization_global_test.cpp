@@ -209,7 +209,7 @@ TEST(McL, KldShrinksTheSetOnceConvergedAndStillConverges) {
   EXPECT_GE(e.extra.at("particles"), p.kld.min_particles);
 }
 
-// Issue 29: the map constraint. A cloud the odometry carries across the wall at x = +10 m
+// The map constraint (docs/global_localization.md). A cloud the odometry carries across the wall at x = +10 m
 // (msl2012: 18 m field, 1 m margin) keeps only its particles inside; a cloud wholly beyond the wall
 // is drawn again uniformly over the floor instead of being tracked out there.
 TEST(McL, ParticlesPushedThroughTheWallAreNotKept) {
@@ -253,7 +253,7 @@ TEST(McL, ParticlesPushedThroughTheWallAreNotKept) {
 
 // Augmented MCL (Probabilistic Robotics, table 8.3) with amcl's alpha_slow 0.001 / alpha_fast 0.1 at
 // 30 frames a second: no injection while the fit is steady, random particles within a few frames of
-// a kidnap. With the averages started at 0 (before issue 29) w_slow needed ~1000 frames to catch up
+// a kidnap. With the averages started at 0 (before commit 4ef602d) w_slow needed ~1000 frames to catch up
 // and nothing was injected for the first half minute of a run.
 TEST(McL, AugmentedInjectsSoonAfterTheLikelihoodDrops) {
   const Field f = Field::preset("msl2012");

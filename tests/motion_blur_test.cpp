@@ -1,4 +1,4 @@
-// How the field_robot camera effects are computed since issue 38 (docs/camera.md "What a real camera
+// How the field_robot camera effects are computed since commit 2b91411 (docs/camera.md "What a real camera
 // adds", "How the effects are computed"): the translation blur resampled from one render, defocus
 // in float, the rotation smear's own bilinear resampler. Each is compared with what it replaced:
 // the re-rendered sub-frames, and the code of commit 5e4c5e1 (copied below as the reference), on
@@ -45,7 +45,7 @@ std::vector<std::uint16_t> test_pattern(int w, int h) {
   return buf;
 }
 
-// The defocus of commit 5e4c5e1 (RadialDefocus before issue 38): OpenCV's fixed-point Gaussian on
+// The defocus of commit 5e4c5e1 (RadialDefocus before commit 2b91411): OpenCV's fixed-point Gaussian on
 // the 16-bit buffer at sigma_max / 2 and sigma_max, blended per pixel in 1/65536 steps.
 void old_defocus(std::vector<std::uint16_t>& buf, int w, int h, const Eigen::Vector2d& centre, double rim, const std::vector<double>& sigma) {
   const double sigma_max = *std::max_element(sigma.begin(), sigma.end());
@@ -127,7 +127,7 @@ TEST(CameraEffectsCost, TranslationBlurIsTheExposureIntegral) {
 
 TEST(CameraEffectsCost, OtherMoversStillReRender) {
   // Another robot moving: its own motion is not in the observer's image-motion field, so the
-  // sub-frames are drawn again (the path before issue 38); deterministic either way.
+  // sub-frames are drawn again (the path before commit 2b91411); deterministic either way.
   const Field field = Field::preset("msl2012");
   CameraConfig cfg = quiet_camera();
   cfg.motion_blur = true;

@@ -1,4 +1,4 @@
-// `omniloc render --t` shows exactly the frame the run saw (issue 21): the run's simulation and
+// `omniloc render --t` shows exactly the frame the run saw: the run's simulation and
 // perception are replayed, so exposure control's settings and pauses, the camera latency and the
 // camera's noise stream agree with the frames `omniloc run --frames` saves.
 #include <gtest/gtest.h>
@@ -53,9 +53,10 @@ TEST(RenderFrame, ShowsTheFrameTheRunSaw) {
   fs::remove_all(tmp);
 }
 
-// Issue 29: a frame taken at one of the entropy search's trial settings is for the entropy only. Fed
-// to the tracker, over-exposed trial frames under the sun (up to 2000 false line points) pulled the
-// pose up to 0.9 m off while the robot stood still; paper 002 sec. 5 stops the robot during the search
+// A frame taken at one of the entropy search's trial settings is for the entropy only
+// (docs/lighting.md "Auto-adjustment on was worse than off under field_robot"). Fed to the
+// tracker, over-exposed trial frames under the sun (up to 2000 false line points) pulled the pose
+// up to 0.9 m off while the robot stood still; paper 002 sec. 5 stops the robot during the search
 // so that it need not localise on them.
 TEST(CameraPerceptionExposure, FramesAtTrialSettingsCarryNoObservations) {
   const Scenario s = load_scenario(std::string(omniloc::source_dir().string()) + "/scenarios/paper/lighting_002_sun.json");

@@ -1,4 +1,4 @@
-// Regression tests for issue 19: one test per class of hostile input that used to crash, exit with
+// Regression tests for bad input (README "Bad input"): one test per class of hostile input that used to crash, exit with
 // the wrong code or destroy data. Most run the real omniloc binary (working directory: the build
 // folder), since the promise is about what the program does: exit 0 or 2, never a signal, nothing
 // written on bad input, nothing replaced that the user did not ask to replace.

@@ -1,6 +1,6 @@
 // Scenario test (label "scenario"): the paper tracking path under the field_robot noise profile
-// (defocus, motion blur, tilt, decentred mirror) must give the statistics it gave before issue 38
-// made those effects cheaper (docs/camera.md "How the effects are computed").
+// (defocus, motion blur, tilt, decentred mirror) must give the statistics it gave before commit
+// 2b91411 made those effects cheaper (docs/camera.md "How the effects are computed").
 //
 // Reference, measured with the renderer of commit 5e4c5e1 (sub-frames re-rendered, fixed-point
 // defocus): `omniloc run` of scenarios/paper/tracking.json with "noise_profile": "field_robot" and
@@ -34,7 +34,7 @@ constexpr double kLineMean = 93.763, kLineSd = 0.268, kRmseMean = 0.0511, kRmseS
 
 }  // namespace
 
-TEST(ScenarioFieldRobotRender, TrackingStatisticsAsBeforeIssue38) {
+TEST(ScenarioFieldRobotRender, TrackingStatisticsAsBeforeTheCheaperEffects) {
   for (const Reference& ref : kOld) {
     Json j = Json::parse(std::ifstream(std::string(omniloc::source_dir().string()) + "/scenarios/paper/tracking.json"));
     j["noise_profile"] = "field_robot";

@@ -70,7 +70,7 @@ TEST(ScenarioGlobal, AFastDriftingCompassIsCorrectedByGridGlobalAndFlaggedByHybr
   EXPECT_TRUE(std::isfinite(h["x_cm"]["mean"].get<double>()));
 }
 
-// Issue 29: MCL alone from a global start on the tracking path, seed 2. Its 600 particles settle
+// MCL alone from a global start on the tracking path, seed 2. Its 600 particles settle
 // 8.7 m off along x in the first second (no particle near the true start survives the first frames;
 // with 3000 the same seed converges right), and before the map constraint the set then followed the
 // odometry through the wall at x = 10 m to x = 15.6 m. Now no estimate leaves the floor, the

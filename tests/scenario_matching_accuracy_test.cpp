@@ -1,7 +1,7 @@
 // Scenario test (label "scenario"): matching's accuracy on the paper tracking path under the `robot`
-// noise profile, a committed reference that keeps it from drifting back (issue 37). One recording
-// (20 s, seed 1) is replayed by the default matching and by the matcher as paper 002 states it
-// (every line point weighs 1: `range_weights` off), so both see
+// noise profile, a committed reference that keeps it from drifting back (docs/vision_and_tracking.md
+// "Against NuBot's code"). One recording (20 s, seed 1) is replayed by the default matching and by
+// the matcher as paper 002 states it (every line point weighs 1: `range_weights` off), so both see
 // the same frames.
 #include <gtest/gtest.h>
 
@@ -50,7 +50,7 @@ TEST(MatchingAccuracy, RangeWeightsOnThePaperPath) {
   const Accuracy paper =
       replay(ro.out_dir, {{"type", "matching"}, {"range_weights", false}}, (tmp / "unweighted").string());
   std::filesystem::remove_all(tmp);
-  // The committed reference: the default measured 4.08 / 6.57 / 10.26 cm, 6.03 mrad (commit of issue 37, GCC 12.2
+  // The committed reference: the default measured 4.08 / 6.57 / 10.26 cm, 6.03 mrad (commit c5fed72, GCC 12.2
   // Release, 2-vCPU VM) (rmse / p95 /
   // max cm, heading mrad); the bounds leave 10 % for other compilers and CPUs (the regression test
   // holds the exact bits). The unweighted matcher measured 5.25 / 9.33 / 18.88 cm,

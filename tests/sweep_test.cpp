@@ -60,7 +60,7 @@ TEST(Sweep, AggregateIndependentOfWorkersResumeAndShards) {
   EXPECT_EQ(sweep_into(spec, "j2", 2).failed, 0u);
   EXPECT_EQ(aggregate("j1"), aggregate("j2"));
 
-  // Interrupted after 17 runs: no aggregate file exists that could pass for the result (issue 31);
+  // Interrupted after 17 runs: no aggregate file exists that could pass for the result;
   // resumed: only the rest runs, and then the same aggregate.
   const auto part = sweep_into(spec, "resumed", 2, false, 17);
   EXPECT_EQ(part.missing, 48u - 17u);
@@ -129,7 +129,7 @@ TEST(Sweep, BadSweepFailsBeforeAnyRun) {
     load_sweep(bad2);
     FAIL();
   } catch (const ConfigError& e) {
-    // Named by its place in the sweep file (issue 40), with the run it was checked for.
+    // Named by its place in the sweep file, with the run it was checked for.
     EXPECT_EQ(e.path().rfind("/localizers/0/type (sweep ", 0), 0u) << e.what();
     EXPECT_NE(e.path().find("localizer \"no_such_localizer\""), std::string::npos) << e.what();
   }
@@ -139,7 +139,7 @@ TEST(Sweep, BadSweepFailsBeforeAnyRun) {
 }
 
 TEST(Sweep, ConfidenceInterval) {
-  // The one rule (docs/results.md "Intervals"; scripts/omniloc_results.py interval() gives the same).
+  // The one rule (docs/results.md "Intervals"; python/omniloc/core/stats.py interval() gives the same).
   // n >= 5: Student t. 1..5: mean 3, sd 1.58114, t(4) = 2.776445: half width 1.963243.
   const Interval iv = mean_ci95({1.0, 2.0, 3.0, 4.0, 5.0});
   EXPECT_DOUBLE_EQ(iv.mean, 3.0);

@@ -130,7 +130,7 @@ TEST_F(VisionTest, TablesAndMapsOfAnotherFieldOrSizeAreRefused) {
   EXPECT_THROW(ColourTable::load((dir / "omniloc_missing.lut").string()), ConfigError);
 }
 
-// Issue 17: the calibration estimates the mirror axis from the rim, so a decentred mirror (NuBot's
+// The calibration estimates the mirror axis from the rim, so a decentred mirror (NuBot's
 // calibration files correct about 9 px) is calibrated instead of becoming map error. The renderer's
 // centre() is the truth, used here only.
 TEST(CalibrationCentre, RimFitGivesTheMirrorAxisWithin1PxAndTheMapKeepsItsBounds) {
@@ -216,7 +216,7 @@ TEST(CalibrationCentre, Version1MapsStillLoad) {
   EXPECT_NEAR(*m2.ground_distance(60.0, 0.3), 1.0, 1e-9);
 }
 
-// Issue 29, item 3: the error budget's "calibration map" row (the model-free map measured from
+// The error budget's "calibration map" row (the model-free map measured from
 // rendered images) tracked better than the baseline's exact map (the simulator's own mirror). This
 // measures line points of rendered frames at known poses, splitting each point's radial error into the
 // detector's part (where the pixel it reports truly looks, against the line's centre along the ray)
@@ -281,12 +281,12 @@ TEST_F(VisionTest, LinePointRadialErrorSplitsIntoDetectorAndMap) {
   // The exact map is the true mirror (up to its 5 cm tabulation and the pixel-centre lookup): its
   // mean radial error stays small. The detector reports the middle of the white run: its mean radial
   // offset is well under the half pixel (about 1.2 cm here) that taking the last white pixel's near
-  // edge as the run's end put on every point before issue 29 (measured -1.25 cm, now -0.26 cm).
+  // edge as the run's end put on every point before commit 6184583 (measured -1.25 cm, now -0.26 cm).
   EXPECT_LT(std::abs(s.exact_map_cm / n), 1.0);
   EXPECT_LT(std::abs(s.detector_cm / n), 0.6);
 }
 
-// Issue 29: a white run shorter than a painted line could be where it lies is not a line. Isolated
+// A white run shorter than a painted line could be where it lies is not a line. Isolated
 // white specks on the carpet (the salt-and-pepper classification of a colour near the table's
 // white/green boundary, e.g. inside a sun patch) gave a line point per speck.
 TEST_F(VisionTest, WhiteSpecksNarrowerThanALineGiveNoPoints) {
@@ -316,7 +316,7 @@ TEST_F(VisionTest, WhiteSpecksNarrowerThanALineGiveNoPoints) {
   ASSERT_GT(specks, 500);
   EXPECT_LE(det.detect(img).points.size(), lines_only + 3);  // the specks add (almost) nothing
   ScanLineParams old;
-  old.min_width_factor = 0.0;  // the detector before issue 29: no lower bound on the run
+  old.min_width_factor = 0.0;  // the detector before commit 6184583: no lower bound on the run
   const LineDetector lax(old, *map_, *table_);
   EXPECT_GT(lax.detect(img).points.size(), lines_only + 20);
 }

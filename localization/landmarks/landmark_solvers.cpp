@@ -229,7 +229,7 @@ Fix total_like(std::span<const BearingObs> obs) {
   // D and the numerator are linear in T31 = cot(alpha31), but c12 and c23 enter D twice (both
   // factors): a clamped, huge T12 or T23 makes D the difference of two products of size T^2 whose
   // difference is of size T, and the cancellation cost up to 4 mm on the line through the second
-  // and third landmarks (issue 17). As in ToTal, only T31 may be infinite: the landmarks are
+  // and third landmarks before commit 16640f5. As in ToTal, only T31 may be infinite: the landmarks are
   // renumbered cyclically (which keeps every signed angle) so that the pair whose bearing
   // difference is nearest 0 or pi is (3, 1). The robot is on at most one of the three lines
   // (two meet only at a landmark, refused by check_triple), so T12 and T23 stay finite and of

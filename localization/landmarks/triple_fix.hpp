@@ -1,7 +1,7 @@
 #pragma once
 // Internal to localization/landmarks: the parts every three-landmark closed form shares, inline so
 // that each solver's hot path is one function without calls, heap allocations or dynamic Eigen types
-// (issue 20). Same tests and same results as check_triple + finish_fix (landmark_fix.hpp); the
+// (docs/performance.md "Targets and measured figures"). Same tests and same results as check_triple + finish_fix (landmark_fix.hpp); the
 // refusal reasons are produced by those functions, off the hot path, when a test fails.
 #include <algorithm>
 #include <cmath>

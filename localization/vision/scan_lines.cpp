@@ -85,7 +85,7 @@ ScanResult LineDetector::detect(const Image& img) const {
             // the first 0.5 px step inside its pixel, on average kStep / 2 past the pixel's edge, so the
             // run's centre is the mean of the two entries less that. (Taking the last white pixel's
             // entry as the far end put every line point half a pixel, about 1.2 cm at 3 m, short of
-            // the line's centre: issue 29, tests/vision_test.cpp.)
+            // the line's centre until commit 6184583: tests/vision_test.cpp.)
             const double r_in = ray[white_start].r, r_out = ray[white_end + 1].r;
             const double len = r_out - r_in;
             const Sample& mid = ray[(white_start + white_end) / 2];

@@ -25,7 +25,8 @@ struct ScanLineParams {
   double width_slack_px = 2.0;   ///< ... plus this many pixels (blur)
   /// A white run must be at least this many times the expected width, less width_slack_px: a ray
   /// crosses a painted line over at least its width (the perpendicular crossing is the shortest), so a
-  /// shorter run is not a line (issue 29: the flicker of a colour near the table's white/green boundary).
+  /// shorter run is not a line (docs/lighting.md "Strong sun without auto-adjustment": the flicker of a
+  /// colour near the table's white/green boundary).
   double min_width_factor = 1.0;
   int max_gap = 2;               ///< unknown pixels allowed between green and white (anti-aliasing)
   double dark_mean = 15.0;       ///< mean grey below this: the camera is covered, no observation

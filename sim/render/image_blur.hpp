@@ -52,11 +52,12 @@ class RotationSmear {
   std::vector<float> frac_row_;
 };
 
-/// Translation blur of the static scene from one render at mid-exposure (issue 38; it replaced
-/// re-rendering the scene once per sub-frame when nothing but the observer moves). Every pixel sees
-/// a surface point at a known distance (the depth buffer; where nothing wrote depth, the floor the
-/// pixel's ray hits, or the far hall); while the robot translates at v, that point moves in the image
-/// at a velocity u(p) that follows from the mirror's profile: radially R'(e) sin(e) (u.v) / D and
+/// Translation blur of the static scene from one render at mid-exposure (docs/camera.md "How the
+/// effects are computed"; it replaced re-rendering the scene once per sub-frame when nothing but
+/// the observer moves). Every pixel sees a surface point at a known distance (the depth buffer;
+/// where nothing wrote depth, the floor the pixel's ray hits, or the far hall); while the robot
+/// translates at v, that point moves in the image at a velocity u(p) that follows from the mirror's
+/// profile: radially R'(e) sin(e) (u.v) / D and
 /// across r (u x v) / (D cos e). The sub-frame at time tau after mid-exposure is the render resampled
 /// at p - u(p) tau (bilinear), and the exposure is the mean of the sub-frames. The per-pixel
 /// geometry (bearing, R'(e) sin e, r / cos e, the floor's distance) depends on the camera only and

@@ -177,8 +177,8 @@ Image PanoramicCamera::render(const WorldState& world, int robot_id, const Camer
     m.ctx->read_rgba16(m.photometry.radiance());
   } else if (others_still) {
     // Only this robot moves: the scene once at mid-exposure, and the sub-frames (the same times as
-    // below) resampled from it along each pixel's image motion (issue 38: the re-renders were most
-    // of a field_robot frame's cost).
+    // below) resampled from it along each pixel's image motion (the re-renders were most of
+    // a field_robot frame's cost: docs/camera.md "How the effects are computed").
     const double mid = 0.5 * exposure_s;
     WorldState w = world;
     for (auto& r : w.robots) r.pose = Pose2(r.pose.x - mid * r.velocity.x(), r.pose.y - mid * r.velocity.y(), r.pose.theta);
