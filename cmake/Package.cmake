@@ -1,8 +1,9 @@
 # Install rules and the Debian package (docs/package.md; scripts/package.sh runs cpack). The layout
 # under the prefix mirrors the source tree's, so core/install_paths.cpp finds everything at
-# <bin>/../share/omniloc and the Python scripts find results/reference beside themselves, as in a clone:
+# <bin>/../share/omniloc and the results package (share/omniloc/python/omniloc) finds results/reference
+# two folders above itself (omniloc/core/paths.py), as in a clone:
 #   bin/omniloc
-#   share/omniloc/{data,scenarios,results/reference,scripts,clients}
+#   share/omniloc/{data,scenarios,results/reference,python/omniloc,scripts,clients}
 #   share/doc/omniloc/{README.md,*.md,img/}
 # Only the omniloc binary is installed: no tests, benchmarks or client examples' builds.
 include(GNUInstallDirs)
@@ -15,12 +16,13 @@ install(TARGETS omniloc RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # data/: field presets, noise profiles, recordings; scenarios/: every shipped scenario and sweep.
 install(DIRECTORY data scenarios DESTINATION ${OMNILOC_SHARE})
 install(DIRECTORY results/reference/ DESTINATION ${OMNILOC_SHARE}/results/reference)
-# The Python commands users run (`omniloc compare | report | gate` forward to compare.py, report.py,
-# gate.py; gate.py imports compare.py), docs/ci.md's recipe runner, and the modules they import.
-install(PROGRAMS scripts/compare.py scripts/report.py scripts/gate.py scripts/ci_recipe.py scripts/paper_table.py
-        scripts/global_start.py DESTINATION ${OMNILOC_SHARE}/scripts)
-install(FILES scripts/omniloc_results.py scripts/paper_claims.py scripts/real_robots.py scripts/nubot_reference_pose.py
-        DESTINATION ${OMNILOC_SHARE}/scripts)
+# The results package: `omniloc report | gate | compare | paper-table` run
+# `python3 -m omniloc.commands.<name>` with PYTHONPATH=share/omniloc/python (docs/architecture.md).
+# Its tests (python/tests) and mypy.ini stay in the tree.
+install(DIRECTORY python/omniloc DESTINATION ${OMNILOC_SHARE}/python
+        PATTERN __pycache__ EXCLUDE PATTERN *.pyc EXCLUDE)
+# docs/ci.md's recipe runner (the clean-root stage runs it against the installed package).
+install(PROGRAMS scripts/ci_recipe.py DESTINATION ${OMNILOC_SHARE}/scripts)
 # What users import to write an external localizer: the Python and C++ clients and their examples
 # (source only; the clients' own tests stay in the tree).
 install(DIRECTORY clients/python clients/cpp DESTINATION ${OMNILOC_SHARE}/clients
@@ -42,7 +44,7 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "simulation and benchmark harness for omni
 set(CPACK_PACKAGE_DESCRIPTION "Runs RoboCup MSL scenarios headless: a Box2D world, an off-screen renderer of each robot's
 catadioptric panorama, the papers' localization pipelines (or a user's external localizer over
 olp/1) and the scoring against ground truth; sweeps, comparisons and CI gates of the results.
-Ships the field presets, scenarios, reference results, the Python clients and the report scripts.")
+Ships the field presets, scenarios, reference results, the Python clients and the results package.")
 if(OMNILOC_PACKAGE_HOMEPAGE)
   set(CPACK_DEBIAN_PACKAGE_HOMEPAGE "${OMNILOC_PACKAGE_HOMEPAGE}")
 endif()

@@ -23,7 +23,8 @@ for b in build/bench_*; do
     && mv "$out/$name.json.tmp" "$out/$name.json"
 done
 # History: the medians of this run with the commit, one line appended to results/history/bench.jsonl
-# (scripts/report.py draws them over commits; compare only records measured in the same minutes).
+# (the report's history page, python/omniloc/report/history.py, draws them over commits; compare
+# only records measured in the same minutes).
 /usr/bin/python3 - "$out" "$commit$dirty" <<'EOF'
 import datetime, glob, json, os, sys
 out, commit = sys.argv[1:]

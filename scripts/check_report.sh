@@ -11,7 +11,7 @@ case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exi
 cd "$(dirname "$0")/.."
 html="${1:-results/report/report.html}"
 png="${2:-$(dirname "$html")/screenshot.png}"
-[ -f "$html" ] || { echo "check_report: no $html (run scripts/run.sh or scripts/report.py first)" >&2; exit 2; }
+[ -f "$html" ] || { echo "check_report: no $html (run scripts/run.sh or omniloc report first)" >&2; exit 2; }
 command -v chromium >/dev/null || scripts/install-deps.sh --report-check
 abs="$(cd "$(dirname "$html")" && pwd)/$(basename "$html")"
 # A tall window: the report is one long page.
@@ -30,7 +30,7 @@ keys = [k for k in papers if k not in ("comment", "claims")]
 missing = [k for k in keys if k not in doc]
 if 'id="scorecard"' not in doc:
     missing.append("the reproduction scorecard")
-# Issue 29: every verdict other than holds carries a cause whose evidence these results support.
+# Every verdict other than holds carries a cause whose evidence these results support.
 for status in ("no cause recorded", "evidence contradicts the cause"):
     if f">{status}<" in doc:
         missing.append(f"a cause (the scorecard's 'Why a claim does not hold' table has '{status}')")
@@ -39,6 +39,6 @@ if missing:
     sys.exit(1)
 print(f"check_report: all {len(keys)} published tables of papers.json and the scorecard are in the report")
 PY
-# What a reader sees (issue 30): rendered pictures, size, no raw markdown, no absolute paths,
+# What a reader sees: rendered pictures, size, no raw markdown, no absolute paths,
 # the scorecard first.
 /usr/bin/python3 scripts/check_report_html.py "$html"

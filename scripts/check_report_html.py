@@ -14,22 +14,28 @@ Checks, each printed with its result:
   - no negative bound of an interval of a non-negative quantity (an error, a count) in the report,
     nor in an aggregate.csv beside it (negative_bounds(); `--aggregate CSV` checks a sweep's alone);
   - a headline (id "headline") is the first thing after the title;
-  - reader's language: no issue numbers ("issue 29") and no raw identifiers with underscores
+  - reader's language: no tracker numbers (the word "issue" and a number) and no raw identifiers with underscores
     (JSON keys, claim ids, metric names) in the text a reader reads; <code>, <pre> and an
     experiment's own notes (class "quoted") are quoted material and exempt, and so are file names,
     paths and the names a reader types (scenarios, sweeps, experiments, localizers, noise profiles,
     fields: read from the repository) and the abbreviations E_k, N_th, N_eff;
   - no section heading (an <h2> or <h3> of the report's own) twice;
   - a bibliography ("References", the last section) lists the papers, each with a year, and every
-    citation [n] in the text names one of its entries.
---self-test builds a report of a small synthetic sweep (the fixtures of tests/report_test.py, with
-an outlying seed) with scripts/report.py in a temporary folder and checks that one; ctest runs it
+    citation [n] in the text names one of its entries;
+  - links (check_links()): the page is self-contained except for its relative links (no href to an
+    absolute path or file: URL); every link into viewers/ (the runs' viewer pages, in report.html
+    and in report.md beside it) resolves to a file inside viewers/ that exists and is a viewer page
+    (its data element), with no absolute path in it.
+--self-test builds a report of a small synthetic sweep (the fixtures of python/tests/helpers.py, with
+an outlying seed, and a run the viewer can draw, whose link it then requires) with
+`python3 -m omniloc.commands.report` in a temporary folder and checks that one; ctest runs it
 (report_html). Exit 0: all pass; 1: a check failed; 77: Chromium is missing (the check skips with a
 message; scripts/install-deps.sh --report-check installs Debian's chromium).
 """
 import argparse
 import html
 import html.parser
+import os
 import pathlib
 import re
 import shutil
@@ -38,6 +44,9 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+# A developer's tool, run from a checkout: its self-test writes synthetic results with the fixtures of
+# the results package's tests (python/tests/helpers.py) and reports them with the package (python/).
+sys.path[:0] = [str(ROOT / "python"), str(ROOT / "python" / "tests")]
 SKIP = 77
 # Folders a path on this machine or a CI runner starts with; the report must show none of them.
 ABSOLUTE = re.compile(r"(?<![\w.~-])/(home|work|tmp|root|usr|var|mnt|opt|srv|scratch|builds|Users)/[\w.-]+")
@@ -69,8 +78,8 @@ def visible_text(dom):
     return html.unescape(re.sub(r"<[^>]+>", " ", dom))
 
 
-# Issue 38: an error, a count or a fraction cannot be negative, so neither can a bound of its interval
-# (omniloc_results.interval clips the t interval at 0; the seeds' range of non-negative values is too).
+# An error, a count or a fraction cannot be negative, so neither can a bound of its interval
+# (omniloc.core.stats.interval clips the t interval at 0; the seeds' range of non-negative values is too).
 # The report prints intervals of such quantities only; aggregate.csv also holds signed ones, told by name.
 REPORT_INTERVAL = re.compile(r"(-?\d+(?:\.\d+)?) (?:\[(-?\d+(?:\.\d+)?), -?\d+(?:\.\d+)?\]|\(seeds' range (-?\d+(?:\.\d+)?) to )")
 NON_NEGATIVE_METRIC = re.compile(r"(^|/)(x_cm|y_cm|theta_rad|position_m|line_points|recovery|after_recovery|recall)(/|$)|"
@@ -173,7 +182,7 @@ def reader_names():
 
 
 def check_no_issue_numbers(dom):
-    """(ok, detail): no 'issue 29' in the text a reader reads (the tracker is the developers')."""
+    """(ok, detail): no tracker reference (the word and a number) in the text a reader reads (the tracker is the developers')."""
     text = reader_text(dom)
     hits = sorted({m.group(0) for m in ISSUE.finditer(text)})
     where = [text[max(0, text.find(h) - 40):text.find(h) + 40].replace("\n", " ") for h in hits[:1]]
@@ -225,7 +234,47 @@ def check_bibliography(dom):
                 + (f"; citations without an entry: {dangling}" if dangling else ""))
 
 
-def check(page, max_mb, browser):
+HREF = re.compile(r"""\bhref=(?:"([^"]*)"|'([^']*)')""")
+MD_LINK = re.compile(r"\]\((viewers/[^)\s]*)\)")
+VIEWER_MARK = 'id="omniloc-data"'  # the viewer page's data element (omniloc/view/viewer.html)
+
+
+def check_links(page, require_viewer=False):
+    """(ok, detail): every href of report.html relative (no absolute path, no file: URL), and every link
+    into viewers/ (report.html's and report.md's) a viewer page that exists inside viewers/, with no
+    absolute path in it. require_viewer: at least one such link (the self-test's report has one)."""
+    source = page.read_text()
+    hrefs = [html.unescape(a or b) for a, b in HREF.findall(source)]
+    md = page.with_suffix(".md")
+    md_links = MD_LINK.findall(md.read_text()) if md.exists() else []
+    bad = [h for h in hrefs if h.startswith(("/", "file:", "\\")) or re.match(r"^[A-Za-z]:[\\/]", h)]
+    folder = (page.parent / "viewers").resolve()
+    viewer_links = sorted({h.split("#", 1)[0].split("?", 1)[0] for h in hrefs + md_links if h.startswith("viewers/")})
+    broken, not_viewer, absolute = [], [], []
+    for link in viewer_links:
+        target = (page.parent / link).resolve()
+        if not target.is_relative_to(folder) or not target.is_file():
+            broken.append(link)
+            continue
+        text = target.read_text(errors="replace")
+        if VIEWER_MARK not in text:
+            not_viewer.append(link)
+        elif ABSOLUTE.search(text) or str(ROOT) in text:
+            absolute.append(link)
+    in_html = {h for h in hrefs if h.startswith("viewers/")}
+    missing_in_md = sorted(h for h in in_html if h not in set(md_links)) if md.exists() else []
+    ok = not (bad or broken or not_viewer or absolute or missing_in_md) and (viewer_links or not require_viewer)
+    detail = f"{len(hrefs)} links, {len(viewer_links)} viewer pages, each found" if ok else "; ".join(filter(None, (
+        f"absolute: {', '.join(bad[:3])}" if bad else "",
+        f"no such file in viewers/: {', '.join(broken[:3])}" if broken else "",
+        f"not a viewer page: {', '.join(not_viewer[:3])}" if not_viewer else "",
+        f"an absolute path inside: {', '.join(absolute[:3])}" if absolute else "",
+        f"linked from report.html, not report.md: {', '.join(missing_in_md[:3])}" if missing_in_md else "",
+        "no link to a viewer page (the self-test's report has a run the viewer draws)" if require_viewer and not viewer_links else "")))
+    return ok, detail
+
+
+def check(page, max_mb, browser, require_viewer=False):
     """[(name, ok, detail)] for one report."""
     results = []
     size = page.stat().st_size
@@ -252,21 +301,23 @@ def check(page, max_mb, browser):
     results.append(("no raw keys", *check_no_raw_keys(dom)))
     results.append(("headings once", *check_unique_headings(dom)))
     results.append(("bibliography", *check_bibliography(dom)))
+    results.append(("links", *check_links(page, require_viewer)))
     return results
 
 
 def self_test_report(tmp):
-    """A report of a synthetic occlusion sweep with one outlying seed, made by scripts/report.py."""
-    sys.path.insert(0, str(ROOT / "tests"))
-    import report_test as T
+    """A report of a synthetic occlusion sweep with one outlying seed, made by omniloc.commands.report."""
+    import helpers as T
     T.write_occlusion_sweep(tmp / "results" / "sweep", [0.0, 0.5])
     T.write_run(tmp / "results" / "mcl" / "s1", "tracking", "mcl", 1, {}, T.robot(3.0))
     T.write_run(tmp / "results" / "mcl" / "s2", "tracking", "mcl", 2, {}, T.robot(806.0))
     T.write_run(tmp / "results" / "mcl" / "s3", "tracking", "mcl", 3, {}, T.robot(3.1))
-    out = subprocess.run([sys.executable, str(ROOT / "scripts" / "report.py"), str(tmp / "results"), "-o", str(tmp / "report"),
-                          "--history", "none"], capture_output=True, text=True)
+    T.write_viewable_run(tmp / "results" / "quickstart")  # its viewer page: the links check requires one
+    out = subprocess.run([sys.executable, "-m", "omniloc.commands.report", str(tmp / "results"), "-o", str(tmp / "report"),
+                          "--history", "none"], capture_output=True, text=True,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (str(ROOT / "python"), os.environ.get("PYTHONPATH"))))})
     if out.returncode != 0:
-        raise RuntimeError("report.py failed: " + out.stderr[-2000:])
+        raise RuntimeError("omniloc.commands.report failed: " + out.stderr[-2000:])
     return tmp / "report" / "report.html"
 
 
@@ -289,9 +340,9 @@ def main():
         try:
             page = self_test_report(pathlib.Path(tmp)) if a.self_test else pathlib.Path(a.report)
             if not page.exists():
-                print(f"check_report_html: no {page} (run scripts/run.sh or scripts/report.py first)", file=sys.stderr)
+                print(f"check_report_html: no {page} (run scripts/run.sh or omniloc report first)", file=sys.stderr)
                 return 2
-            results = check(page, a.max_mb, browser)
+            results = check(page, a.max_mb, browser, require_viewer=a.self_test)
         except (RuntimeError, subprocess.TimeoutExpired) as e:
             print(f"check_report_html: FAILED: {e}", file=sys.stderr)
             return 1

@@ -10,7 +10,7 @@
 #   --update     write the counts as the new baseline and append them to
 #                results/reference/icount_history.jsonl (commit both with a message that says why)
 #   --only       a comma-separated subset (see build/icount --list)
-# Every run appends its counts, with the commit, to results/history/icount.jsonl (scripts/report.py
+# Every run appends its counts, with the commit, to results/history/icount.jsonl (omniloc report
 # --history draws them over commits).
 set -euo pipefail
 cd "$(dirname "$0")/.."

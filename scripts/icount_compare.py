@@ -110,7 +110,7 @@ def main():
         stored = {k: v for k, v in record.items() if k != "valgrind_seconds"}
         write_atomic(a.baseline, json.dumps(dict(stored, instructions=dict(sorted(merged.items())), threshold_percent=a.threshold),
                                             indent=2, sort_keys=True) + "\n")
-        # The committed history: one record per baseline change, drawn by scripts/report.py.
+        # The committed history: one record per baseline change, drawn by the report's history page (omniloc.report.history).
         append_jsonl(os.path.join(os.path.dirname(a.baseline) or ".", "icount_history.jsonl"), stored)
         print(f"baseline written: {a.baseline} (commit {a.commit}); commit it with a message that says why")
         return 0

@@ -28,6 +28,7 @@ PKGS=(
   ccache  # a compile cache (CMakeLists.txt OMNILOC_CCACHE): a fresh clone builds from earlier objects
   dpkg-dev file  # scripts/package.sh: dpkg-shlibdeps computes the .deb's Depends; cpack tests ELF files with file
   libxml2-utils python3-yaml  # tests: xmllint validates omniloc gate's JUnit XML; the CI recipe test reads docs/ci.md's YAML
+  python3-pytest mypy  # the results package's tests (python/tests, ctest results_pytest) and type check (results_mypy)
 )
 # --report-check: also Debian's chromium, for the headless check of report.html
 # (scripts/check_report_html.py; .ci/run). Not needed to build, test or run the suite.

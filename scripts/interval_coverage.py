@@ -2,7 +2,7 @@
 """Coverage of candidate 95 % intervals for the MEAN of a few seeds' non-negative errors.
 
 Why: the aggregate, the terminal's sweep table, compare and the report must use one interval method
-for one quantity (issue 38, item 4), chosen by how often each candidate actually contains the true
+for one quantity (docs/results.md "Intervals"), chosen by how often each candidate actually contains the true
 mean with the seed counts a sweep has (n = 3, 4, 5; 10 for reference). The errors of a run are
 non-negative and skewed (one seed on a wrong pose is far above the others), so the samples are drawn
 from lognormal distributions (mu = 0, sigma 0.25, 0.5, 1.0; true mean exp(sigma^2 / 2)) and, for

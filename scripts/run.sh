@@ -47,9 +47,11 @@ open(sys.argv[2],"w").write(json.dumps(j,indent=1))' "$1" "$3" "$2"
 }
 
 # The report of what has landed so far, rewritten after each part (the scorecard's totals and the
-# report's path are what report.py prints last). $1: what is still to come ("" at the end).
+# report's path are what the report command, python/omniloc/commands/report.py, prints last). $1: what
+# is still to come ("" at the end).
 report() {
-  "$PY" scripts/report.py "${results[@]}" -o results/report --title "omniloc paper suite" >results/logs/report.log 2>&1 ||
+  PYTHONPATH="python${PYTHONPATH:+:$PYTHONPATH}" "$PY" -m omniloc.commands.report "${results[@]}" -o results/report \
+    --title "omniloc paper suite" >results/logs/report.log 2>&1 ||
     { cat results/logs/report.log; exit 1; }
   # The whole report is in report.html / report.md (and results/logs/report.log); the terminal gets its
   # totals and where it is.

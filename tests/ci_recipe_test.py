@@ -1,4 +1,4 @@
-"""Every command of docs/ci.md's CI recipe runs here (issue 39): scripts/ci_recipe.py takes the
+"""Every command of docs/ci.md's CI recipe runs here: scripts/ci_recipe.py takes the
 GitHub Actions workflow and the GitLab CI job from the page and runs their commands in a throw-away
 team repository with the built omniloc (only the install lines are not run: network and root; the
 clean-root stage of .ci/run installs the .deb instead). GitHub's steps run on a pull request that

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""Mutation test of `omniloc validate` (issue 19): deterministic mutants of the shipped scenario,
-experiment and sweep files (sweeps since issue 40), each run through `omniloc validate`, which must
+"""Mutation test of `omniloc validate` (robust input: every input class exits 0 or 2): deterministic
+mutants of the shipped scenario, experiment and sweep files (sweeps since a sweep localizer's
+"label" of the wrong type was found to exit 1), each run through `omniloc validate`, which must
 exit 0 or 2 - never a signal, never another code, never hang.
 
 Usage: mutation_validate.py OMNILOC [--count N] [--seed S] [--jobs J] [--keep DIR]

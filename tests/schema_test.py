@@ -1,4 +1,4 @@
-"""`omniloc schema` (issue 21): the JSON Schema of scenario files and the generated parameter
+"""`omniloc schema`: the JSON Schema of scenario files and the generated parameter
 reference. The schema must accept every shipped scenario, reject misspelt keys and wrong types, and
 agree with the strict reader (`omniloc validate`) on every parameter key it lists.
 

@@ -1,5 +1,5 @@
 """Every key of every input file, every wrong JSON type: `omniloc validate` exits 2 and names the key's
-JSON path (issue 40: a sweep localizer's "label" of the wrong type once exited 1 with a raw library
+JSON path (a sweep localizer's "label" of the wrong type once exited 1 with a raw library
 message).
 
 The keys come from walking the JSON Schemas omniloc publishes (`omniloc schema` for scenario files,

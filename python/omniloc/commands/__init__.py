@@ -1,0 +1,1 @@
+"""Thin command modules: `omniloc <command>` runs `python3 -m omniloc.commands.<command>`."""

@@ -1,0 +1,65 @@
+"""The developers' page: instruction counts and benchmark wall times per workload over the commits.
+"""
+from __future__ import annotations
+
+import json
+import pathlib
+from typing import Any
+
+from omniloc.core import paths as PATHS
+from omniloc.core.stats import fnum
+from omniloc.tools import plot
+from omniloc.core.rundir import Run
+from omniloc.tools.markup import Writer
+
+
+def load_jsonl(path: Any) -> Any:
+    out = []
+    if path.exists():
+        for line in path.read_text().splitlines():
+            if line.strip():
+                try:
+                    out.append(json.loads(line))
+                except json.JSONDecodeError:
+                    pass  # a line cut by an interrupted append: the others still count
+    return out
+
+
+def history_plot(rep: Writer, records: Any, field: str, key: Any, ylabel: Any, caption: str, fmt: Any) -> None:
+    """One line per workload: `field` of every record, relative to the workload's first record, in
+    the order the records were appended (one point per measured commit)."""
+    series: dict[Any, Any] = {}
+    for i, rec in enumerate(records):
+        for w, v in rec.get(field, {}).items():
+            if isinstance(v, (int, float)) and v > 0:
+                series.setdefault(w, []).append((i, v))
+    if not series:
+        return
+    rep.figure(plot.history_figure(series, records, ylabel), key, caption)
+    rows = []
+    for w, pts in sorted(series.items()):
+        (i0, v0), (i1, v1) = pts[0], pts[-1]
+        rows.append([w, records[i0].get("commit", "?"), fmt(v0), records[i1].get("commit", "?"), fmt(v1), fnum(v1 / v0, 3)])
+    rep.table(["workload", "first commit", "first", "last commit", "last", "last / first"], rows)
+
+
+def report_history(rep: Writer, folder: Any, reference: Any = None) -> Any:
+    # The committed baseline history (one record per baseline change) first, then this machine's runs.
+    reference = pathlib.Path(reference or PATHS.ROOT / "results" / "reference" / "icount_history.jsonl")
+    icount = load_jsonl(reference) + load_jsonl(folder / "icount.jsonl")
+    bench = load_jsonl(folder / "bench.jsonl")
+    if not (icount or bench):
+        return False
+    rep.heading("Speed over commits", 2, "history")
+    rep.para(f"From {reference} (committed baselines) and {folder} (this machine): every run of scripts/icount.sh and scripts/bench.sh appends its figures with the commit. "
+             "Instruction counts (callgrind, fixed work) do not depend on the machine's load; wall times do, so compare "
+             "wall times only between records measured in the same minutes.")
+    if icount:
+        history_plot(rep, icount, "instructions", "history_icount", "instructions / first record",
+                     "instructions per workload (scripts/icount.sh), relative to each workload's first record",
+                     lambda v: f"{v:,.0f}")
+    if bench:
+        history_plot(rep, bench, "real_time_ns", "history_bench", "median wall time / first record",
+                     "Google Benchmark median wall time per benchmark (scripts/bench.sh), relative to its first record",
+                     lambda v: f"{v:,.1f} ns")
+    return True
