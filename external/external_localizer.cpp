@@ -1,6 +1,7 @@
 #include "external/external_localizer.hpp"
 
 #include <cmath>
+#include <functional>
 #include <regex>
 
 #include "core/angles.hpp"
@@ -121,6 +122,41 @@ Estimate ExternalLocalizer::parse_estimate(const Json& msg, long long expected_k
     }
   }
   return e;
+}
+
+// At most this many particles or points an estimate: what a viewer can draw (a client's own set is
+// usually larger; it sends a subsample).
+constexpr std::size_t kMaxDebugItems = 10000;
+
+DebugView ExternalLocalizer::parse_debug(const Json& msg) {
+  DebugView v;
+  const auto rows = [&](const char* key, std::size_t width, const std::function<void(const Json&)>& add) {
+    const auto it = msg.find(key);
+    if (it == msg.end() || it->is_null()) return;
+    if (!it->is_array() || it->size() > kMaxDebugItems)
+      throw ProtocolError(std::string("estimate: /") + key + ": expected an array of at most " + std::to_string(kMaxDebugItems) + " rows, got " +
+                          json_brief(*it));
+    for (std::size_t i = 0; i < it->size(); ++i) {
+      const Json& r = (*it)[i];
+      const std::string at = std::string("estimate: /") + key + "/" + std::to_string(i);
+      if (!r.is_array() || r.size() != width) throw ProtocolError(at + ": expected " + std::to_string(width) + " numbers, got " + json_brief(r));
+      for (std::size_t j = 0; j < width; ++j) (void)finite_number(r[j], at + "/" + std::to_string(j));
+      add(r);
+    }
+  };
+  rows("particles", 4, [&](const Json& r) {
+    if (r[3].get<double>() < 0) throw ProtocolError("estimate: /particles: a weight below 0: " + json_brief(r));
+    v.particles.push_back({r[0].get<double>(), r[1].get<double>(), r[2].get<double>(), r[3].get<double>()});
+  });
+  rows("points", 2, [&](const Json& r) { v.points.emplace_back(r[0].get<double>(), r[1].get<double>()); });
+  return v;
+}
+
+DebugView ExternalLocalizer::debug_view(std::size_t max_particles) const {
+  DebugView v;
+  v.points = debug_.points;
+  for (const std::size_t i : even_stride(debug_.particles.size(), max_particles)) v.particles.push_back(debug_.particles[i]);
+  return v;
 }
 
 Json blob_json(const Blob& b) {
@@ -269,7 +305,9 @@ Estimate ExternalLocalizer::update(const Observations& obs, const Odometry& odom
   send(encode_message(frame, parts), deadline, "frame");
   const Message m = receive(deadline, "estimate", "no estimate for frame " + std::to_string(k_) + " within " + fmt_s(cfg_.frame_timeout_s) + " s");
   try {
-    return parse_estimate(m.header, k_);
+    Estimate e = parse_estimate(m.header, k_);
+    debug_ = parse_debug(m.header);
+    return e;
   } catch (const ProtocolError& e) {
     fail(e.what());
   }

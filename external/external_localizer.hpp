@@ -52,6 +52,11 @@ class ExternalLocalizer : public Localizer {
   static Json frame_json(long long k, const Observations& obs, const Odometry& odometry, std::optional<double> heading);
   /// Reads an estimate message strictly; throws ProtocolError with the JSON path on a bad field.
   static Estimate parse_estimate(const Json& msg, long long expected_k);
+  /// The estimate's optional "particles" and "points" (docs/protocol.md section 6), read strictly:
+  /// what the client asks the run viewer to draw.
+  static DebugView parse_debug(const Json& msg);
+  /// The last estimate's particles and points, at most `max_particles` particles.
+  DebugView debug_view(std::size_t max_particles) const override;
   /// Reads a ready message strictly (name, version, flags).
   struct Ready {
     std::string name, version;
@@ -74,6 +79,7 @@ class ExternalLocalizer : public Localizer {
   std::string stage_ = "before ready";
   bool finished_ = false;
   Json files_;
+  DebugView debug_;  // of the last estimate
 };
 
 }  // namespace omniloc::external

@@ -26,6 +26,8 @@ class HybridLocalizer : public Localizer {
   std::string type() const override { return "hybrid"; }
   void reset(const std::optional<Pose2>& start) override;
   Estimate update(const Observations& obs, const Odometry& odometry, std::optional<double> heading) override;
+  /// The global search's particles while it searches; nothing while the matcher tracks.
+  DebugView debug_view(std::size_t max_particles) const override { return tracking_ ? DebugView{} : mcl_.debug_view(max_particles); }
 
  private:
   HybridParams p_;

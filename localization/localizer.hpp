@@ -2,6 +2,7 @@
 // The one interface every localizer implements. A localizer sees only robot-side data:
 // line points / blobs from the vision front end (robot frame), odometry and an optional absolute
 // heading. It never sees the simulator.
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -111,6 +112,23 @@ struct Estimate {
   std::optional<double> compute_ms;
 };
 
+/// What a localizer holds beyond its estimate, for the run viewer (`--debug-view`: view.jsonl,
+/// docs/viewer.md section 4). World frame, metres and radians.
+struct DebugView {
+  std::vector<std::array<double, 4>> particles;  ///< [x, y, theta, weight]: a subsample of its set
+  std::vector<Eigen::Vector2d> points;           ///< anything else worth drawing (match candidates...)
+};
+
+/// At most `max` of `n` items, taken at an even stride from the first (keeps the set's spread).
+inline std::vector<std::size_t> even_stride(std::size_t n, std::size_t max) {
+  std::vector<std::size_t> idx;
+  if (n == 0 || max == 0) return idx;
+  const std::size_t m = n < max ? n : max;
+  idx.reserve(m);
+  for (std::size_t i = 0; i < m; ++i) idx.push_back(i * n / m);
+  return idx;
+}
+
 class Localizer {
  public:
   virtual ~Localizer() = default;
@@ -133,6 +151,12 @@ class Localizer {
   /// Called once after the last frame, before the results are written; may throw RuntimeFailure
   /// (an external client that does not end cleanly fails the run).
   virtual void finish() {}
+  /// What it holds after the last update(), at most `max_particles` particles (asked only with
+  /// --debug-view; reading it must not change the localizer). Empty by default.
+  virtual DebugView debug_view(std::size_t max_particles) const {
+    (void)max_particles;
+    return {};
+  }
 };
 
 }  // namespace omniloc

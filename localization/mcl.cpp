@@ -126,7 +126,8 @@ double McLLocalizer::weigh(const std::vector<Eigen::Vector2d>* pts, std::optiona
   // proportional to p(x | u, x') p(x | m), and p(x | m) = 0 where the robot cannot be): a particle
   // the motion model carried beyond the walls weighs nothing. Without it a set that converged on a
   // wrong pose follows the odometry through the wall, every point there is clamped alike, and
-  // nothing ever tells the particles apart again (issue 29: tracked out to x = 15.6 m).
+  // nothing ever tells the particles apart again (seed 2 of the tracking path from a global start
+  // was tracked out to x = 15.6 m: docs/global_localization.md).
   // nav2_amcl draws its initial and injected poses from free map cells only, for the same reason.
   logw_.resize(ps_.size());
   std::size_t alive = 0;
@@ -232,6 +233,17 @@ Estimate McLLocalizer::update(const Observations& obs, const Odometry& odo, std:
     resample(sum, injection_rate(), heading);
   }
   return estimate(see, pts);
+}
+
+DebugView McLLocalizer::debug_view(std::size_t max_particles) const {
+  DebugView v;
+  double top = -std::numeric_limits<double>::infinity();
+  for (const auto& p : ps_) top = std::max(top, p.logw);
+  for (const std::size_t i : even_stride(ps_.size(), max_particles)) {
+    const Particle& p = ps_[i];
+    v.particles.push_back({p.pose.x, p.pose.y, p.pose.theta, std::isfinite(top) ? std::exp(p.logw - top) : 0.0});
+  }
+  return v;
 }
 
 }  // namespace omniloc

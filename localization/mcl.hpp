@@ -73,6 +73,8 @@ class McLLocalizer : public Localizer {
   };
   /// The current particle set (for pictures and tests).
   const std::vector<Particle>& particles() const { return ps_; }
+  /// An even-stride subsample of the set, weights relative to the heaviest particle.
+  DebugView debug_view(std::size_t max_particles) const override;
 
  private:
   // One update is: predict (motion model) -> weigh (sensor model) -> resample -> estimate.
