@@ -1,5 +1,6 @@
 // omniloc command line: validate, run, list, experiment (and more as capabilities land).
 // Exit codes: 0 success, 1 runtime failure, 2 bad input (scenario, arguments) — nothing written.
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "apps/cache_command.hpp"
 #include "core/cli_args.hpp"
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
@@ -29,6 +31,7 @@
 #include "external/external_config.hpp"
 #include "harness/recording.hpp"
 #include "harness/runner.hpp"
+#include "harness/world_cache.hpp"
 #include "harness/scenario.hpp"
 #include "batch/slurm.hpp"
 #include "batch/sweep.hpp"
@@ -48,12 +51,14 @@ constexpr std::uint64_t kMaxSeed = 1ULL << 53;
 const char* kUsage = R"(usage: omniloc <command> [options]
 
 commands:
-  run FILE [--seed N] [-o DIR [--overwrite]] [--frames DIR] [--frames-every N] [--quiet]
-                         run a scenario; results in results/runs/<scenario>/<seed>/
+  run FILE [--seed N] [-o DIR [--overwrite]] [--frames DIR] [--frames-every N] [--debug-view] [--quiet]
+      [--draw-each | --cache DIR | --no-cache]
+                         run a scenario; results in results/runs/<scenario>/<seed>/; its world comes
+                         from the world cache when it was drawn before (docs/recording.md "World cache")
   record FILE [--seed N] [--images] [-o DIR [--overwrite]] [--quiet]
                          simulate and perceive a scenario once, no localizer: a recording of every
                          frame a localizer is given (docs/recording.md), in results/recordings/<scenario>/<seed>/
-  replay RECORDING --localizer JSON|FILE [--seed N] [-o DIR [--overwrite]] [--quiet]
+  replay RECORDING --localizer JSON|FILE [--seed N] [-o DIR [--overwrite]] [--debug-view] [--quiet]
                          run any localizer on a recording: the same run folder as `run` gives
   render FILE --t SECONDS [--robot ID] [--seed N] [--labels | --points] -o frame.png
                          the panorama robot ID (default: the first localized) sees at time t
@@ -71,7 +76,7 @@ commands:
                          the JSON Schema of scenario files (for editors), or the parameter
                          reference docs/localizers.md generated from the same lists
   sweep SWEEP.json [-j N] [--shard I/N] [--resume] [--aggregate-only] [--draw-each]
-        [--localizer JSON|FILE]... [-o DIR]
+        [--cache DIR | --no-cache] [--localizer JSON|FILE]... [-o DIR]
                          scenarios x localizers x parameters x seeds, in parallel; aggregate
                          with mean and interval (docs/results.md "Intervals": t95 from 5 seeds,
                          else the seeds' range) in results/sweeps/<name>/aggregate.{csv,json}
@@ -85,15 +90,26 @@ commands:
   experiment NAME [--seed N] [-o DIR] [--quick] [--config FILE]
                          run a named experiment (solver maps, cooperative simulation, ...);
                          --config: its description file instead of scenarios/experiments/NAME.json
+  cache list|size|prune [--older-than DAYS] [--max-size SIZE] [--cache DIR]
+                         the world cache: what it holds, its size, and removing old entries
   compare A B [--markdown] [--alpha P]
                          two result sets (runs, sweeps or folders of them, e.g. two commits) side by
                          side per metric: difference and whether it exceeds the seed-to-seed spread
-                         (Welch's t); runs scripts/compare.py
+                         (Welch's t)
   gate RESULTS --rules FILE [--baseline DIR] [--alpha P] [--junit FILE] [--benchmark-json FILE]
                          pass or fail results against limits and a baseline (docs/ci.md): exit 0 all
-                         hold, 1 a rule or regression failed, 2 bad input; runs scripts/gate.py
+                         hold, 1 a rule or regression failed, 2 bad input
   report RESULTS... -o DIR [--baseline RESULTS] [--title TEXT]
-                         report.md and a self-contained report.html; runs scripts/report.py
+                         report.md and a self-contained report.html
+  paper-table RESULTS --paper ID [--rows ROWS]
+                         one published table beside ours (results/reference/papers.json)
+  global-start RESULTS [--markdown]
+                         global starts judged per run: found, wrong, none (docs/global_localization.md)
+  view RUN_DIR [-o FILE.html] [--recording DIR]
+                         one self-contained HTML page to step through a run frame by frame
+                         (docs/viewer.md)
+  (compare, gate, report, paper-table, global-start and view are the Python results package, python/omniloc:
+   docs/architecture.md)
   COMMAND --help         that command's options
   --version              the build: git describe, compiler, build type (also in every summary.json)
 )";
@@ -108,6 +124,12 @@ const cli::Command kRun{"run", "FILE", 1, 1, "Run a scenario; results in results
                          {"--overwrite", "", "replace what is at -o DIR (a previous result, or anything else)"},
                          {"--frames", "DIR", "write the camera frames as PNG into DIR"},
                          {"--frames-every", "N", "with --frames: every N-th frame (integer in [1, 1000000])"},
+                         {"--debug-view", "", "also write view.jsonl: per frame, the line points and blobs the localizer was given and the\n"
+                                             "covariance and particles it held, for `omniloc view` (docs/viewer.md)"},
+                         {"--draw-each", "", "simulate and render this run itself instead of replaying its world from the world cache\n"
+                                             "(the results are the same byte for byte: docs/recording.md \"World cache\")"},
+                         {"--cache", "DIR", "the world cache's folder (default: OMNILOC_CACHE, else results/cache/worlds)"},
+                         {"--no-cache", "", "neither read nor fill the world cache (as OMNILOC_CACHE=off)"},
                          {"--quiet", "", "no progress log on stderr"}}};
 const cli::Command kRecord{"record", "FILE", 1, 1,
                            "Simulate and perceive a scenario once, without a localizer, and write a recording of everything\n"
@@ -122,6 +144,8 @@ const cli::Command kReplay{"replay", "RECORDING", 1, 1,
                            "scenario and seed with that localizer, without simulating or rendering (docs/recording.md).",
                            {{"--localizer", "JSON|FILE", "the localizer, as a scenario's \"localizer\" object: inline JSON or a file holding it (required)"},
                             {"--seed", "N", "seed of the localizer's random stream (default: the recording's seed)"},
+                            {"--debug-view", "", "also write view.jsonl: per frame, the line points and blobs the localizer was given and the\n"
+                                              "covariance and particles it held, for `omniloc view` (docs/viewer.md)"},
                             {"-o", "DIR", "results folder; must not exist or be empty unless --overwrite"},
                             {"--overwrite", "", "replace what is at -o DIR"},
                             {"--quiet", "", "no progress log on stderr"}}};
@@ -138,7 +162,7 @@ const cli::Command kCalibrate{"calibrate", "FILE", 1, 1,
                               {{"-o", "MAP.json", "output map (default results/cache/calibration_v2_<camera>.json); an existing file only with --overwrite"},
                                {"--overwrite", "", "replace an existing -o file"},
                                {"--seed", "N", "seed (default 1)"},
-                               {"--image-centre", "", "assume the mirror axis at the image centre (before issue 17; saved only with -o)"}}};
+                               {"--image-centre", "", "assume the mirror axis at the image centre instead of estimating it from the rim (saved only with -o)"}}};
 const cli::Command kColourCalibrate{"colour-calibrate", "FILE", 1, 1, "Learn the colour look-up table from labelled renders of the scenario's field.",
                                     {{"-o", "TABLE.lut", "output table (default results/cache/colour_<camera>_<field>.lut); an existing file only with --overwrite"},
                                      {"--overwrite", "", "replace an existing -o file"},
@@ -166,9 +190,13 @@ const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                            {"--shard", "I/N", "run only runs with index % N == I (0 <= I < N)"},
                            {"--resume", "", "skip runs already finished; runs another live process holds are skipped too"},
                            {"--aggregate-only", "", "run nothing, aggregate what is in the folder"},
-                           {"--draw-each", "", "simulate and render every run itself (by default runs that differ only in a built-in\n"
-                                               "vision localizer share one recording of their world: docs/recording.md)"},
+                           {"--draw-each", "", "simulate and render every run itself (by default each world is drawn once per machine,\n"
+                                               "kept in the world cache and replayed into every run of it: docs/recording.md)"},
+                           {"--cache", "DIR", "the world cache's folder (default: OMNILOC_CACHE, else results/cache/worlds)"},
+                           {"--no-cache", "", "no world cache: runs that differ only in a built-in vision localizer share one\n"
+                                              "recording in the sweep folder (recordings/), the others draw their own"},
                            {"--stop-after", "N", "run at most N runs (integer >= 0; 0: all)"},
+                           {"--debug-view", "", "every run also writes view.jsonl for `omniloc view` (docs/viewer.md)"},
                            {"--localizer", "JSON|FILE", "run these localizers instead of the file's (repeatable; inline JSON or a file holding\n"
                                                         "one localizer object or an array of them; give it again with --resume)"},
                            {"-o", "DIR", "sweep folder (default results/sweeps/<name>)"},
@@ -307,8 +335,13 @@ int cmd_run(const cli::Args& a) {
   check_output_target(a);
   o.frames_dir = a.value("--frames");
   o.frames_every = static_cast<int>(a.integer("--frames-every", o.frames_every, 1, 1000000));
+  o.debug_view = a.has("--debug-view");
   if (!a.has("--quiet")) o.log = &std::cerr;
-  const auto r = harness::run_scenario(s, o);
+  if (a.has("--draw-each") && (a.has("--cache") || a.has("--no-cache"))) throw UsageError("--draw-each uses no cache: leave out --cache / --no-cache");
+  harness::WorldCacheOptions co = app::cache_options(a);
+  co.log = o.log;
+  harness::WorldCache cache(co);
+  const auto r = a.has("--draw-each") ? harness::run_scenario(s, o) : harness::run_with_world_cache(s, o, cache);
   std::cout << "scenario " << s.name << ", seed " << r.seed << ", localizer " << r.summary["localizer"].get<std::string>()
             << ", noise " << s.noise.name << "\n"
             << r.table << "results: " << r.out_dir << "\n";
@@ -364,6 +397,7 @@ int cmd_replay(const cli::Args& a) {
   o.seed = a.has("--seed") ? a.unsigned_integer("--seed", 0, kMaxSeed) : source.header().seed;
   o.out_dir = a.value("-o");
   o.replay = true;
+  o.debug_view = a.has("--debug-view");
   if (!a.has("--quiet")) o.log = &std::cerr;
   Json provenance = Json::object();
   if (!source.header().render.is_null()) provenance["render"] = source.header().render;
@@ -436,7 +470,13 @@ int cmd_sweep(const cli::Args& a) {
   o.resume = a.has("--resume");
   o.aggregate_only = a.has("--aggregate-only");
   o.share_worlds = !a.has("--draw-each");
+  if (a.has("--draw-each") && (a.has("--cache") || a.has("--no-cache"))) throw UsageError("--draw-each uses no cache: leave out --cache / --no-cache");
+  // The runs (child processes) find the cache through the environment, by an absolute path.
+  const harness::WorldCacheOptions co = app::cache_options(a);
+  o.world_cache = o.share_worlds && !co.dir.empty();
+  ::setenv("OMNILOC_CACHE", co.dir.empty() ? "off" : co.dir.c_str(), 1);
   o.stop_after = static_cast<std::size_t>(a.integer("--stop-after", 0, 0, 1000000000));
+  o.debug_view = a.has("--debug-view");
   o.out_dir = a.value("-o");
   const auto spec = batch::load_sweep(a.positional[0], sweep_localizers(a));
   o.progress = &std::cerr;
@@ -540,21 +580,25 @@ int cmd_list() {
   return 0;
 }
 
-// Commands written in Python (compare; gate) live in share_dir()/scripts, beside the report: the CLI
-// only forwards, so both entry points behave the same. `prog` ("omniloc compare") goes to the script
-// in OMNILOC_<NAME>_PROG so its --help and errors name the command the user typed. Returns only when
-// the interpreter cannot be started.
-int exec_python_script(const std::string& script_name, const std::string& prog, int argc, char** argv) {
-  const std::string script = (share_dir() / "scripts" / script_name).string();
+// Commands written in Python (compare, gate, report, paper-table, view) are the results package
+// (share_dir()/python/omniloc, docs/architecture.md): the CLI only forwards, so both entry points
+// behave the same. `prog` ("omniloc compare") goes to the module in OMNILOC_<NAME>_PROG so its --help
+// and errors name the command the user typed. Returns only when the interpreter cannot be started.
+int exec_python_module(const std::string& module, const std::string& prog, int argc, char** argv) {
+  const std::string python_dir = (share_dir() / "python").string();
   const char* py = ::access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-  std::vector<char*> args{const_cast<char*>(py), const_cast<char*>(script.c_str())};
+  const std::string dotted = "omniloc.commands." + module;
+  std::vector<char*> args{const_cast<char*>(py), const_cast<char*>("-m"), const_cast<char*>(dotted.c_str())};
   for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
   args.push_back(nullptr);
-  std::string var = script_name.substr(0, script_name.rfind('.'));  // "compare.py" -> OMNILOC_COMPARE_PROG
+  const char* old_path = std::getenv("PYTHONPATH");
+  const std::string path = old_path && *old_path ? python_dir + ":" + old_path : python_dir;
+  ::setenv("PYTHONPATH", path.c_str(), 1);
+  std::string var = module;  // "paper_table" -> OMNILOC_PAPER_TABLE_PROG
   for (char& c : var) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   ::setenv(("OMNILOC_" + var + "_PROG").c_str(), prog.c_str(), 1);
   ::execvp(py, args.data());
-  std::cerr << "failed: cannot run " << py << " " << script << "\n";
+  std::cerr << "failed: cannot run " << py << " -m " << dotted << "\n";
   return 1;
 }
 
@@ -599,9 +643,12 @@ int main(int argc, char** argv) {
     std::cout << version_line() << "\n";
     return 0;
   }
-  if (cmd == "compare") return exec_python_script("compare.py", "omniloc compare", argc, argv);
-  if (cmd == "gate") return exec_python_script("gate.py", "omniloc gate", argc, argv);
-  if (cmd == "report") return exec_python_script("report.py", "omniloc report", argc, argv);
+  for (const char* py_cmd : {"compare", "gate", "report", "paper-table", "global-start", "view"})
+    if (cmd == py_cmd) {
+      std::string module = cmd;
+      std::replace(module.begin(), module.end(), '-', '_');
+      return exec_python_module(module, "omniloc " + cmd, argc, argv);
+    }
   struct Entry {
     const cli::Command* spec;
     int (*run)(const cli::Args&);
@@ -617,7 +664,8 @@ int main(int argc, char** argv) {
                             {&kColourCalibrate, cmd_colour_calibrate},
                             {&kRender, cmd_render},
                             {&kSweep, cmd_sweep},
-                            {&kExperiment, cmd_experiment}};
+                            {&kExperiment, cmd_experiment},
+                            {&app::kCache, app::cmd_cache}};
   try {
     for (const auto& c : commands) {
       if (c.spec->name != cmd) continue;

@@ -211,12 +211,18 @@ class SweepWorkers {
       const std::string out = (folder_.dir / "runs" / r.id).string();
       // --overwrite: the sweep owns runs/<id>/ and replaces a previous result of the same run.
       std::vector<std::string> args = {"run", spec_path, "-o", out, "--overwrite", "--quiet"};
-      const std::string recording = r.recording.empty() && !r.world.empty() && o_.share_worlds ? world_recording(r) : r.recording;
+      // Every world once per machine: the run looks in the world cache (drawing it there, under its
+      // lock, if no run did before); without the cache, once per sweep folder for runs that share it.
+      if (!o_.share_worlds) args.push_back("--draw-each");
+      if (o_.debug_view) args.push_back("--debug-view");
+      const bool folder_world = r.recording.empty() && !r.world.empty() && o_.share_worlds && !o_.world_cache;
+      const std::string recording = folder_world ? world_recording(r) : r.recording;
       if (!recording.empty()) {
         // The localizer alone, as replay takes it; the rest of the run is the recording's.
         const std::string loc_path = (folder_.dir / "specs" / (r.id + ".localizer.json")).string();
         write_file_atomic(loc_path, r.scenario.value("localizer", Json::object()).dump(2) + "\n");
         args = {"replay", recording, "--localizer", loc_path, "--seed", std::to_string(r.seed), "-o", out, "--overwrite", "--quiet"};
+        if (o_.debug_view) args.push_back("--debug-view");
       }
       const int st = spawn(folder_.exe, args, log, lock_fd);
       secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();

@@ -3,6 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
 #include <ostream>
 
 #include "core/version.hpp"
@@ -72,8 +75,8 @@ void without_vision(RobotFrame& r) {
   r.render_ms = r.vision_ms = 0.0;
 }
 
-// One camera frame of one localized robot: localize, record.
-void robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOptions& opt, EventLog& log) {
+// One camera frame of one localized robot: localize, record; returns the estimate.
+Estimate robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOptions& opt, EventLog& log) {
   const int id = tr.record.id;
   const double t = rf.obs.t;
   if (!opt.frames_dir.empty() && rf.obs.image && k % opt.frames_every == 0) {
@@ -98,6 +101,37 @@ void robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOption
     log.add(Json{{"t", t}, {"type", "mode"}, {"robot", id}, {"mode", mode}});
     tr.last_mode = mode;
   }
+  return est;
+}
+
+// One line of view.jsonl (docs/viewer.md section 4, omniloc-view/1).
+std::string view_line(const Tracked& tr, const RobotFrame& rf, long long k, const Estimate& est, std::size_t max_particles) {
+  Json pts = Json::array();
+  for (const auto& p : rf.obs.line_points) pts.push_back(Json::array({p.x(), p.y()}));
+  Json j = {{"k", k}, {"t", rf.obs.t}, {"robot", tr.record.id}, {"line_points", std::move(pts)}};
+  if (!rf.obs.blobs.empty()) {
+    Json blobs = Json::array();
+    for (const auto& b : rf.obs.blobs) blobs.push_back(external::blob_json(b));
+    j["blobs"] = std::move(blobs);
+  }
+  // Estimate's default (the identity) and an external client's "none" (NaN) mean no covariance given.
+  if (est.covariance.allFinite() && !est.covariance.isIdentity(0.0)) {
+    Json cov = Json::array();
+    for (int r = 0; r < 3; ++r) cov.push_back(Json::array({est.covariance(r, 0), est.covariance(r, 1), est.covariance(r, 2)}));
+    j["covariance"] = std::move(cov);
+  }
+  const DebugView dv = tr.localizer->debug_view(max_particles);
+  if (!dv.particles.empty()) {
+    Json ps = Json::array();
+    for (const auto& p : dv.particles) ps.push_back(Json::array({p[0], p[1], p[2], p[3]}));
+    j["particles"] = std::move(ps);
+  }
+  if (!dv.points.empty()) {
+    Json ps = Json::array();
+    for (const auto& p : dv.points) ps.push_back(Json::array({p.x(), p.y()}));
+    j["points"] = std::move(ps);
+  }
+  return j.dump() + "\n";
 }
 
 // Scores every robot and writes the result files; the table rows go to `result`.
@@ -171,6 +205,11 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
 }  // namespace
 
 RunResult run_frames(const Scenario& sc, std::uint64_t seed, FrameSource& source, const RunOptions& opt, const Json& provenance) {
+  return run_frames_after_hello(sc, seed, source, [&source](bool, Json&) -> FrameSource& { return source; }, opt, provenance);
+}
+
+RunResult run_frames_after_hello(const Scenario& sc, std::uint64_t seed, const FrameSource& hello, const FramesFor& frames, const RunOptions& opt,
+                                 Json provenance) {
   RunResult result;
   result.seed = seed;
   RunDirectory dir(opt.out_dir.empty() ? "results/runs/" + sc.name + "/" + std::to_string(seed) : opt.out_dir);
@@ -179,13 +218,19 @@ RunResult run_frames(const Scenario& sc, std::uint64_t seed, FrameSource& source
   Json effective = sc.effective;
   effective["seed"] = seed;
   const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
-  std::vector<Tracked> tracked = make_tracked(sc, seed, info, source, dir.staging(), effective);
-  for (auto& tr : tracked) tr.record.has_truth = source.has_ground_truth();
+  std::vector<Tracked> tracked = make_tracked(sc, seed, info, hello, dir.staging(), effective);
+  bool wants_images = false;
   for (const auto& tr : tracked)
-    if (const auto* ext = dynamic_cast<const external::ExternalLocalizer*>(tr.localizer.get()); ext && ext->wants_image() && !source.has_images())
-      throw ConfigError("/localizer", "a client that asked for images (ready.wants_image)",
-                        "frames with images: this recording was made without them (omniloc record --images)");
+    if (const auto* ext = dynamic_cast<const external::ExternalLocalizer*>(tr.localizer.get()); ext && ext->wants_image()) wants_images = true;
+  FrameSource& source = frames(wants_images, provenance);
+  for (auto& tr : tracked) tr.record.has_truth = source.has_ground_truth();
+  if (wants_images && !source.has_images())
+    throw ConfigError("/localizer", "a client that asked for images (ready.wants_image)",
+                      "frames with images: this recording was made without them (omniloc record --images)");
   const bool strip = opt.replay && !info.needs_vision;
+  // Streamed into the staging folder: 60 s with 200 particles a frame is about 38 MB.
+  std::unique_ptr<std::ofstream> view;
+  if (opt.debug_view) view = std::make_unique<std::ofstream>(std::filesystem::path(dir.staging()) / "view.jsonl", std::ios::binary);
 
   // perceive (the source) -> localize -> record, at every camera frame (the first at t = 0 before any motion).
   while (auto frame = source.next()) {
@@ -195,12 +240,17 @@ RunResult run_frames(const Scenario& sc, std::uint64_t seed, FrameSource& source
                            std::to_string(tracked.size()));
     for (std::size_t i = 0; i < tracked.size(); ++i) {
       if (strip) without_vision(frame->robots[i]);
-      robot_frame(tracked[i], frame->robots[i], frame->k, opt, log);
+      const Estimate est = robot_frame(tracked[i], frame->robots[i], frame->k, opt, log);
+      if (view) *view << view_line(tracked[i], frame->robots[i], frame->k, est, opt.debug_particles);
     }
     if (opt.log && frame->k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && frame->k > 0)
       *opt.log << "  t = " << frame->t << " s\n";
   }
   for (auto& tr : tracked) tr.localizer->finish();  // an external client must end cleanly, or the run fails
+  if (view) {
+    view->close();
+    if (!*view) throw RuntimeFailure("cannot write view.jsonl into " + dir.staging());
+  }
   const std::string name = tracked.empty() ? info.type : tracked.front().localizer->name();
   const Json external = tracked.empty() ? Json(nullptr) : tracked.front().localizer->provenance();
   const bool start_pose_given = !tracked.empty() && tracked.front().start_pose_given;

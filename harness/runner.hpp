@@ -4,6 +4,7 @@
 // end metrics score the records against truth and run_writer writes the results directory atomically
 // (everything goes to a temporary folder that is renamed at the end).
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -23,6 +24,11 @@ struct RunOptions {
   /// The frames come from a recording: a localizer without vision gets what a live run without a
   /// camera would give it (no line points, no camera settings, no perception events).
   bool replay = false;
+  /// Also write view.jsonl: per frame and robot, what the localizer was given (line points, blobs)
+  /// and what it held (covariance, particles, points): docs/viewer.md section 4. The other files
+  /// are the same with or without it.
+  bool debug_view = false;
+  std::size_t debug_particles = 200;  ///< at most this many particles a line
 };
 
 struct RobotResult {
@@ -47,5 +53,13 @@ class FrameSource;
 /// The run loop over any frame source: `scenario` gives the localizer, the scoring events and the
 /// effective configuration; `provenance` is added to summary.json's "omniloc" block.
 RunResult run_frames(const Scenario& scenario, std::uint64_t seed, FrameSource& source, const RunOptions& options, const Json& provenance);
+
+/// The frames of a run whose source is chosen once its localizers are started: an external client's
+/// `ready` says whether it wants images. Called once with that answer and the provenance to complete.
+using FramesFor = std::function<FrameSource&(bool wants_images, Json& provenance)>;
+/// As run_frames; `hello` gives what olp/1's hello announces (each robot's camera, blob detection)
+/// and must agree with the source `frames` returns.
+RunResult run_frames_after_hello(const Scenario& scenario, std::uint64_t seed, const FrameSource& hello, const FramesFor& frames,
+                                 const RunOptions& options, Json provenance);
 
 }  // namespace omniloc::harness

@@ -51,8 +51,12 @@ class ExternalCli(unittest.TestCase):
         p.write_text(json.dumps(obj, indent=1))
         return str(p)
 
+    def env(self):
+        # A world cache of this test's own (docs/recording.md section 9), never the source tree's.
+        return dict(os.environ, OMNILOC_CACHE=str(self.tmp / "world_cache"))
+
     def omniloc(self, *args, check=True):
-        r = subprocess.run([BIN, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
+        r = subprocess.run([BIN, *args], cwd=ROOT, capture_output=True, text=True, timeout=600, env=self.env())
         if check and r.returncode != 0:
             self.fail(f"omniloc {' '.join(args)} exited {r.returncode}:\n{r.stdout}\n{r.stderr}")
         return r
@@ -186,7 +190,8 @@ class ExternalCli(unittest.TestCase):
         pids = self.tmp / f"pids_{sig}"
         f = self.write(f"slow_{sig}.json", scenario({"type": "external", "command": [PY, FAULTY, "slow:0.05", str(pids)]}, duration=30))
         out = self.tmp / f"out_{sig}"
-        p = subprocess.Popen([BIN, "run", f, "-o", str(out)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        p = subprocess.Popen([BIN, "run", f, "-o", str(out)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                             env=self.env())
         deadline = time.time() + 60
         while time.time() < deadline and not (pids.exists() and pids.read_text().strip()):
             time.sleep(0.1)
@@ -232,7 +237,9 @@ class ExternalCli(unittest.TestCase):
     def test_ctrl_c_removes_a_built_in_run_staging_folder(self):
         f = self.write("long.json", scenario({"type": "matching"}, duration=60))
         out = self.tmp / "out_builtin"
-        p = subprocess.Popen([BIN, "run", f, "-o", str(out)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        # --draw-each: a live run, interrupted while it draws (a world from the cache would be done first).
+        p = subprocess.Popen([BIN, "run", f, "-o", str(out), "--draw-each"], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                             env=self.env())
         deadline = time.time() + 60
         while time.time() < deadline and not any(x.startswith(".out_builtin.partial-") for x in os.listdir(self.tmp)):
             time.sleep(0.05)

@@ -13,8 +13,9 @@ the localizers instead of stopping at the checksum; some keep the old one, and s
 stream itself.
 
 A mutant that replays with one localizer is replayed with every other built-in one too (a value a
-reader lets through reaches all of them); a mutant refused (exit 2) was refused before any frame
-reached a localizer (docs/recording.md section 7), whichever localizer was named.
+reader lets through reaches all of them); a mutant refused (exit 2) is refused whichever localizer
+was named, and leaves no run folder (the frames are read as the replay consumes them:
+docs/recording.md section 7).
 
 Usage: mutation_recording.py OMNILOC [--count N] [--seed S] [--jobs J] [--keep DIR]
 Exit 1 (listing the first bad inputs, kept under --keep) when any replay misbehaves.
@@ -136,10 +137,14 @@ def replay(omniloc, folder, localizer, out, timeout):
     try:
         r = subprocess.run([omniloc, "replay", str(folder), "--localizer", json.dumps({"type": localizer}), "-o", str(out), "--quiet"],
                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=timeout)
+        # A refused recording writes nothing: no run folder, no staging folder beside it.
+        left = out.exists() or any(p.name.startswith("." + out.name) for p in out.parent.iterdir())
     except subprocess.TimeoutExpired:
         return None, "timeout"
     finally:
         shutil.rmtree(out, ignore_errors=True)
+    if r.returncode == 2 and left:
+        return 99, "exit 2 but a run folder was left: " + r.stderr.decode(errors="replace")[-300:]
     return r.returncode, r.stderr.decode(errors="replace")[-400:]
 
 

@@ -63,8 +63,10 @@ class Recording(unittest.TestCase):
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def omniloc(self, *args, check=True):
-        r = subprocess.run([BIN, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    def omniloc(self, *args, check=True, cache="cache"):
+        # A world cache of this test's own (docs/recording.md section 9), never the source tree's.
+        env = dict(os.environ, OMNILOC_CACHE=str(self.tmp / cache))
+        r = subprocess.run([BIN, *args], cwd=ROOT, capture_output=True, text=True, timeout=600, env=env)
         if check and r.returncode != 0:
             self.fail(f"omniloc {' '.join(args)} exited {r.returncode}:\n{r.stdout}\n{r.stderr}")
         return r
@@ -74,7 +76,7 @@ class Recording(unittest.TestCase):
         f = self.tmp / f"{name}_{tag}.json"
         f.write_text(json.dumps(s))
         live, rep = self.tmp / f"live_{name}_{tag}", self.tmp / f"replay_{name}_{tag}"
-        self.omniloc("run", str(f), "-o", str(live), "--quiet")
+        self.omniloc("run", str(f), "-o", str(live), "--quiet", "--draw-each")  # live: simulated and rendered
         self.omniloc("replay", str(self.recordings[name]), "--localizer", json.dumps(localizer), "-o", str(rep), "--quiet")
         return live, rep
 
@@ -127,7 +129,7 @@ class Recording(unittest.TestCase):
                         s = dict(self.scenarios["tracking"], localizer=loc)
                         f = self.tmp / f"tracking_{tag}.json"
                         f.write_text(json.dumps(s))
-                        self.omniloc("run", str(f), "-o", str(self.tmp / f"live_ext_{tag}"), "--quiet")
+                        self.omniloc("run", str(f), "-o", str(self.tmp / f"live_ext_{tag}"), "--quiet", "--draw-each")
                     else:
                         self.omniloc("replay", str(self.recordings["tracking"]), "--localizer", json.dumps(loc), "-o",
                                      str(self.tmp / f"replay_ext_{tag}"), "--quiet")
@@ -165,20 +167,39 @@ class Recording(unittest.TestCase):
         sweep.write_text(json.dumps({"name": "share", "scenarios": [str(self.files["kidnap"])], "seeds": [1, 2],
                                      "localizers": [{"type": "matching"}, {"type": "hybrid"}, {"type": "odometry_only"},
                                                     {"type": "external", "command": [PY, str(EXAMPLES / "dead_reckoning.py")], "label": "py_dr"}]}))
-        shared, each = self.tmp / "sweep_shared", self.tmp / "sweep_each"
-        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(shared))
-        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(each), "--draw-each")
-        # One recording per seed, shared by matching and hybrid; odometry_only and the client run live.
-        self.assertEqual(len(list((shared / "recordings").iterdir())), 2)
+        shared, each, folder = self.tmp / "sweep_shared", self.tmp / "sweep_each", self.tmp / "sweep_folder_worlds"
+        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(shared), cache="sweep_cache")
+        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(each), "--draw-each", cache="sweep_cache")
+        self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(folder), "--no-cache", cache="sweep_cache")
+        # The world cache: one world per seed, drawn once and replayed into matching, hybrid and the
+        # client (which wants no images); odometry_only runs live. Nothing in the sweep folder.
+        entries = sorted(p.name for p in (self.tmp / "sweep_cache").iterdir() if not p.name.startswith("."))
+        self.assertEqual(len(entries), 2)
+        self.assertFalse((shared / "recordings").exists())
+        # Without the cache: one recording per seed in the sweep folder, shared by matching and hybrid.
+        self.assertEqual(len(list((folder / "recordings").iterdir())), 2)
         self.assertFalse((each / "recordings").exists())
         runs = sorted(p.name for p in (each / "runs").iterdir())
         self.assertEqual(len(runs), 8)
         for run in runs:
             with self.subTest(run=run):
                 self.assert_same_run(each / "runs" / run, shared / "runs" / run)
+                self.assert_same_run(each / "runs" / run, folder / "runs" / run)
         self.assertEqual((shared / "aggregate.csv").read_bytes(), (each / "aggregate.csv").read_bytes())
-        replayed = [r for r in runs if "replay" in json.loads((shared / "runs" / r / "summary.json").read_text())["omniloc"]]
+        self.assertEqual((folder / "aggregate.csv").read_bytes(), (each / "aggregate.csv").read_bytes())
+        prov = {r: json.loads((shared / "runs" / r / "summary.json").read_text())["omniloc"] for r in runs}
+        self.assertEqual(sorted(r for r in runs if prov[r].get("world_cache") in entries), sorted(r for r in runs if "__odometry_only__" not in r))
+        replayed = [r for r in runs if "replay" in json.loads((folder / "runs" / r / "summary.json").read_text())["omniloc"]]
         self.assertEqual(sorted(replayed), sorted(r for r in runs if "__matching__" in r or "__hybrid__" in r))
+        # A second sweep of the same worlds with other localizers, into another folder: nothing drawn.
+        stamps = {e: (self.tmp / "sweep_cache" / e / "last_used").stat().st_mtime_ns for e in entries}
+        again = self.tmp / "sweep_again"
+        r = self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(again), "--localizer", '{"type": "mcl", "particles": 200}', cache="sweep_cache")
+        self.assertEqual(sorted(p.name for p in (self.tmp / "sweep_cache").iterdir() if not p.name.startswith(".")), entries)
+        for e in entries:
+            self.assertGreaterEqual((self.tmp / "sweep_cache" / e / "last_used").stat().st_mtime_ns, stamps[e])
+        for run in (again / "runs").iterdir():
+            self.assertIn(json.loads((run / "summary.json").read_text())["omniloc"].get("world_cache"), entries, run.name)
 
         # A stored recording as a sweep's scenario: replayed into each localizer at its seed.
         stored = self.tmp / "stored.json"
