@@ -29,6 +29,9 @@ such folders (searched recursively). The report is laid out for a reader with te
   - every sweep's aggregate and per-seed table, each run's table and plots (collapsed), error
     CDFs, timing per stage;
   - every experiment's pictures and notes (tables a section above shows are not repeated);
+  - each run the report shows links to its run viewer page, written beside the report in
+    DIR/viewers/ (`omniloc view`, docs/viewer.md: the run frame by frame, its line points and, with
+    --debug-view runs, its particles);
   - on a page of its own (history.html, linked), for developers: instruction counts and benchmark
     wall times per workload over the commits (--history DIR, default results/history);
   - the references: the five papers, cited in the text as 'Lu et al. 2013 [3]' (omniloc.paper.data.BIBLIOGRAPHY).

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import html
+import os
 import pathlib
 import sys
 
@@ -45,7 +46,7 @@ def build(a: argparse.Namespace) -> None:
     papers = PR.load_papers()
     runs, sweeps, experiments = RD.discover(a.results, a.accept_incomplete)
     if not (runs or sweeps or experiments):
-        sys.exit("report.py: no results (summary.json, aggregate.json or experiment pictures) under " + " ".join(a.results))
+        sys.exit(os.environ.get("OMNILOC_REPORT_PROG", "omniloc report") + ": no results (summary.json, aggregate.json or experiment pictures) under " + " ".join(a.results))
     # Each run the report shows links to its viewer page (viewers/ beside the report; omniloc.report.viewers).
     rep = ViewerReport(a.out, a.title, a.results, len(runs))
     for x in a.results + (a.baseline or []):

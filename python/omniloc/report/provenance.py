@@ -47,4 +47,4 @@ def provenance(rep: Writer, runs: list[Run], sweeps: list[Any]) -> None:
     rep.table(["omniloc version (git describe)", "compiler", "build type", "machine", "runs dated (UTC)", "runs"], rows,
               f"Builds that made these results. This report: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} on {machine_text()}.")
     if len(versions) > 1:
-        rep.para("Warning: the results come from more than one build; compare like with like (scripts/compare.py).")
+        rep.para("Warning: the results come from more than one build; compare like with like (omniloc compare).")

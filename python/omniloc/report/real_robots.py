@@ -326,7 +326,7 @@ def section(rep: Writer, runs: list[Run], sweeps: list[Any]) -> Any:
              "well and is an equally correct answer.")
     if not real:
         rep.para(f"**Not run**: no replay of a real recording among these results. Run `{RUN_REAL}` (a few seconds; it writes "
-                 "results/sweeps/real_robots) and give that folder to scripts/report.py; scripts/run.sh does both.")
+                 "results/sweeps/real_robots) and give that folder to omniloc report; scripts/run.sh does both.")
     else:
         groups: dict[Any, Any] = {}
         for x in real:
@@ -403,7 +403,7 @@ def noise_table(rep: Writer, real: Any, sweeps: list[Any]) -> None:
               "the sweeps' recordings of the tracking path (the sweep folder's recordings/, docs/recording.md), at the true pose"
               + ("; " + "; ".join(t for _, _, t in sim_cols) if sim_cols else "") + ".")
     if missing:
-        rep.para("Not run: " + "; ".join(f"the {p} profile's figures need the recordings of `{RUN_SIM[p]}` (its folder given to scripts/report.py)"
+        rep.para("Not run: " + "; ".join(f"the {p} profile's figures need the recordings of `{RUN_SIM[p]}` (its folder given to omniloc report)"
                                          for p in missing) + ".")
     rep.para("The real figures are a **lower bound** on real line-point noise: NuBot fitted each mirror law (and a pose) to these very pixels, "
              "the reference pose is the best fit of these same points, and a standing calibration frame has no camera vibration, latency "

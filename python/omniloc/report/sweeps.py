@@ -143,7 +143,7 @@ def global_start_section(rep: Writer, sweeps: list[Any]) -> None:
         rep.table(["localizer"] + ([head, "answered", "first within it: median s"] if with_recall else []) +
                   ["ended right", "Wilson 95 %", "first correct convergence median s", "while right: mean x cm", "mean y cm",
                    "mean th rad", "wrong frames %", "mean position error over all valid frames cm"], rows,
-                  "scripts/global_start.py (definitions there and in docs/global_localization.md). Paper 002's 'MCL alone 15-40 cm' "
+                  "omniloc global-start (definitions in docs/global_localization.md). Paper 002's 'MCL alone 15-40 cm' "
                   "is to be read on the success rate and the error while right, not on the mean over all frames."
                   + (f" '{head}': the share of all frames within it (a frame without an estimate counts as outside), mean over runs; "
                      "'answered': the share of frames with an estimate." if with_recall else ""))
