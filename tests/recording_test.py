@@ -121,20 +121,30 @@ class Recording(unittest.TestCase):
         for client, tag, images in clients:
             with self.subTest(client=tag):
                 wire = {}
-                for mode in ("live", "replay"):
+                # live; a stored recording; the world cache, first drawing the world (with images when
+                # the client's ready asks for them) and then replaying it.
+                for mode in ("live", "replay", "cache_cold", "cache_warm"):
                     log = self.tmp / f"wire_{tag}_{mode}.bin"
                     wire[mode] = log
                     loc = {"type": "external", "command": ["sh", "-c", f"tee '{log}' | {client}"], "label": tag}
-                    if mode == "live":
+                    if mode != "replay":
                         s = dict(self.scenarios["tracking"], localizer=loc)
-                        f = self.tmp / f"tracking_{tag}.json"
+                        f = self.tmp / f"tracking_{tag}_{mode}.json"
                         f.write_text(json.dumps(s))
-                        self.omniloc("run", str(f), "-o", str(self.tmp / f"live_ext_{tag}"), "--quiet", "--draw-each")
+                        self.omniloc("run", str(f), "-o", str(self.tmp / f"{mode}_ext_{tag}"), "--quiet",
+                                     *(["--draw-each"] if mode == "live" else []), cache=f"ext_cache_{tag}")
                     else:
                         self.omniloc("replay", str(self.recordings["tracking"]), "--localizer", json.dumps(loc), "-o",
                                      str(self.tmp / f"replay_ext_{tag}"), "--quiet")
                 live, rep = (wire[m].read_bytes() for m in ("live", "replay"))
                 self.assertEqual(live.split(b"\n", 1)[1], rep.split(b"\n", 1)[1], "frame messages differ")
+                for mode in ("cache_cold", "cache_warm"):  # the same program: every byte, hello included
+                    self.assertEqual(live, wire[mode].read_bytes(), f"{mode}: messages differ")
+                    self.assertTrue(json.loads((self.tmp / f"{mode}_ext_{tag}" / "summary.json").read_text())["omniloc"]["world_cache"])
+                    self.assert_same_run(self.tmp / f"live_ext_{tag}", self.tmp / f"{mode}_ext_{tag}", command_differs=True)
+                cached = [p for p in (self.tmp / f"ext_cache_{tag}").iterdir() if not p.name.startswith(".")]
+                self.assertEqual(len(cached), 1)
+                self.assertEqual(json.loads((cached[0] / "entry.json").read_text())["images"], images)
                 self.assertGreater(live.count(b'"type":"frame"'), 80)
                 if images:
                     self.assertGreater(len(live), 90 * 640 * 640 * 3)
