@@ -1,5 +1,5 @@
 """Writes the viewer page: one self-contained HTML file (no network, no server) holding the run as
-JSON and the page's JavaScript and CSS (viewer.js, viewer.css beside this file) inlined.
+JSON and the page's JavaScript and CSS (viewer.js + viewer_controls.js, viewer.css beside this file) inlined.
 
 Size (docs/viewer.md "Size"): poses and per-frame values are JSON numbers at the run files' own
 precision; the bulky per-frame point sets are packed as little-endian int16 in base64 (2.7
@@ -163,7 +163,8 @@ def render(run: RunData, max_particles: int = 100, particles_every: int = 1) -> 
     data = json.dumps(page_json(run, max_particles, particles_every), separators=(",", ":"), allow_nan=False)
     template = (HERE / "viewer.html").read_text(encoding="utf-8")
     css = (HERE / "viewer.css").read_text(encoding="utf-8")
-    js = (HERE / "viewer.js").read_text(encoding="utf-8")
+    # One script in two files (each under 500 lines): viewer.js opens it, viewer_controls.js closes it.
+    js = (HERE / "viewer.js").read_text(encoding="utf-8") + (HERE / "viewer_controls.js").read_text(encoding="utf-8")
     head, rest = template.split("{{DATA}}", 1)
     head = head.replace("{{TITLE}}", html.escape(run["title"])).replace("{{CSS}}", css)
     rest = rest.replace("{{JS}}", _script_safe(js))
