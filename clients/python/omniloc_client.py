@@ -374,7 +374,10 @@ class Estimate:
     covariance: 9 numbers, row-major 3x3 over (x, y, theta), m^2/rad^2. mode: a short word
     ([a-z0-9_], <= 32) written to frames.csv. extra: up to 32 named numbers, columns of frames.csv.
     compute_ms: your own computation time for this frame in milliseconds (timing.csv, beside the round
-    trip); run() fills in the time update() took when you leave it None."""
+    trip); run() fills in the time update() took when you leave it None.
+    particles: optional rows (x, y, theta, weight >= 0), world frame, at most 10000 (send a subsample),
+    and points: optional rows (x, y), world frame: what the run viewer draws at this frame when the run
+    is made with --debug-view (view.jsonl; docs/protocol.md section 6, docs/viewer.md)."""
 
     pose: Sequence[float]
     valid: bool = True
@@ -382,6 +385,8 @@ class Estimate:
     mode: Optional[str] = None
     extra: Optional[Dict[str, float]] = None
     compute_ms: Optional[float] = None
+    particles: Optional[Sequence[Sequence[float]]] = None
+    points: Optional[Sequence[Sequence[float]]] = None
 
     def to_message(self, k: int) -> Dict[str, Any]:
         """The `estimate` message for frame k; ProtocolError when a field would be rejected."""
@@ -415,6 +420,15 @@ class Estimate:
             if not math.isfinite(ms) or ms < 0:
                 raise ProtocolError(f"estimate for frame {k}: compute_ms must be a finite number >= 0, got {self.compute_ms!r}")
             m["compute_ms"] = ms
+        for key, rows, width in (("particles", self.particles, 4), ("points", self.points, 2)):
+            if rows is None:
+                continue
+            out = [[float(v) for v in row] for row in rows]
+            if len(out) > 10000 or not all(len(r) == width and all(math.isfinite(v) for v in r) for r in out):
+                raise ProtocolError(f"estimate for frame {k}: {key} must be at most 10000 rows of {width} finite numbers")
+            if key == "particles" and any(r[3] < 0 for r in out):
+                raise ProtocolError(f"estimate for frame {k}: a particle weight below 0")
+            m[key] = out
         return m
 
 

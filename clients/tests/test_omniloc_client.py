@@ -298,6 +298,13 @@ class HelperTest(unittest.TestCase):
             olp.Estimate((0, 0, 0), covariance=[1, 2]).to_message(0)
         with self.assertRaises(olp.ProtocolError):
             olp.Estimate((0, 0, 0), extra={"line_points": 3}).to_message(0)  # a frames.csv column
+        # What the run viewer draws (docs/protocol.md section 6): particles and points, checked.
+        m = olp.Estimate((0, 0, 0), particles=[(1, 2, 0.5, 0.25)], points=[(3, 4)]).to_message(1)
+        self.assertEqual((m["particles"], m["points"]), ([[1.0, 2.0, 0.5, 0.25]], [[3.0, 4.0]]))
+        for bad in ({"particles": [(1, 2, 3)]}, {"particles": [(1, 2, 3, -1)]}, {"points": [(1, float("nan"))]},
+                    {"points": [(0, 0)] * 10001}):
+            with self.assertRaises(olp.ProtocolError):
+                olp.Estimate((0, 0, 0), **bad).to_message(0)
 
 
 if __name__ == "__main__":

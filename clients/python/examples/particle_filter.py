@@ -45,8 +45,12 @@ class LinePointParticleFilter(olp.Localizer):
         pose, cov = self.pf.estimate()
         resampled = self.pf.resample_if_needed()
         spread = float(np.sqrt(cov[0, 0] + cov[1, 1]))
+        # 50 of the particles, for the run viewer (omniloc run --debug-view; otherwise dropped).
+        step = max(1, self.pf.n // 50)
+        w = np.exp(self.pf.logw - self.pf.logw.max())
+        shown = [(float(x), float(y), float(th), float(wi)) for (x, y, th), wi in zip(self.pf.p[::step][:50], w[::step][:50])]
         return olp.Estimate(pose, valid=True, covariance=cov, mode="tracking",
-                            extra={"points_used": len(pts), "spread_m": spread, "resampled": int(resampled)})
+                            extra={"points_used": len(pts), "spread_m": spread, "resampled": int(resampled)}, particles=shown)
 
 
 if __name__ == "__main__":
