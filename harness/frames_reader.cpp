@@ -14,6 +14,7 @@
 #include "external/sha256.hpp"
 #include "harness/gzip.hpp"
 #include "harness/recording.hpp"
+#include "harness/recording_limits.hpp"
 
 namespace omniloc::harness {
 
@@ -21,14 +22,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The limits of harness/recording.cpp (docs/recording.md section 7); the fast path only accepts a
-// value the strict reader accepts too, so they must be the same numbers.
-constexpr double kMaxLength = 50.0;
-constexpr double kMaxAngle = 1000.0;
-constexpr double kMaxTime = 3600.0;
-constexpr double kMaxExposureMs = 1e4;
-constexpr double kMaxGain = 1e3;
-constexpr std::uintmax_t kMaxFramesBytes = 8ULL << 30;
+// The fast path accepts only values the strict reader accepts: the same limits.
+using namespace recording_limits;
 // Decompressed bytes read at a time; a line longer than the buffer grows it.
 constexpr std::size_t kChunk = 1 << 18;
 

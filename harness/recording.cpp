@@ -22,6 +22,7 @@
 #include "harness/external_session.hpp"
 #include "harness/frames_reader.hpp"
 #include "harness/gzip.hpp"
+#include "harness/recording_limits.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/render_frame.hpp"
 
@@ -31,9 +32,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Frames a recording may hold (an hour at 200 Hz); the largest frames.jsonl is read by
-// harness/frames_reader.cpp.
-constexpr long long kMaxFrames = 720000;
 
 
 std::string image_name(int robot, long long k) {
@@ -84,21 +82,7 @@ double finite(const Json& v, const std::string& at) {
   return v.get<double>();
 }
 
-// The physical limits of a recording's numbers (docs/recording.md section 7). A value outside them
-// cannot come from a robot on a field omniloc accepts, and huge ones overflow a localizer's sums
-// (a line point at -1e308 m became -inf cells in the distance map lookup).
-// - Lengths, metres: the largest field omniloc reads is 22 x 14 m with 5 m margins, a 32 x 24 m floor
-//   (40 m diagonal); nothing on it, and no robot's step between two frames, is farther than 50 m.
-// - Angles, radians: need not be wrapped; 1000 rad (159 turns) keeps a double angle to 1e-13 rad.
-// - Times, seconds from the start of the recording: at most an hour, the longest scenario omniloc
-//   runs (its duration_s, and 720,000 frames at the highest camera rate, 200 Hz).
-constexpr double kMaxLength = 50.0;
-constexpr double kMaxAngle = 1000.0;
-constexpr double kMaxTime = 3600.0;
-// Camera settings (frames.csv's columns only; the simulated camera's range is 1-60 ms and 1-60 gain
-// units by default): exposure at most 10 s, longer than any frame a moving robot uses; gain at most 1000.
-constexpr double kMaxExposureMs = 1e4;
-constexpr double kMaxGain = 1e3;
+using namespace recording_limits;  // harness/recording_limits.hpp: docs/recording.md section 7
 
 double within(const Json& v, const std::string& at, double lo, double hi, const char* unit) {
   const double x = finite(v, at);
