@@ -481,7 +481,9 @@ int cmd_sweep(const cli::Args& a) {
   const auto spec = batch::load_sweep(a.positional[0], sweep_localizers(a));
   o.progress = &std::cerr;
   std::cerr << "sweep " << spec.name << ": " << spec.runs.size() << " runs, " << o.jobs << " worker(s)"
-            << (o.shard_count > 1 ? ", shard " + shard : std::string()) << "\n";
+            << (o.shard_count > 1 ? ", shard " + shard : std::string())
+            << (o.world_cache ? ", worlds from the cache in " + co.dir : !o.share_worlds ? ", every run draws its world" : ", no world cache")
+            << "\n";
   const auto r = batch::run_sweep(spec, o);
   std::cout << r.table << "ran " << r.ran << ", skipped " << r.skipped << ", failed " << r.failed << ", missing " << r.missing
             << "\nresults: " << r.out_dir << (r.aggregate_written ? " (final aggregate: aggregate.json, aggregate.csv, runs.csv)" : "") << "\n";
