@@ -432,6 +432,14 @@ int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
   so.dry_run = a.has("--dry-run");
   so.resubmit_missing = a.has("--resubmit-missing");
   so.out_dir = a.value("-o");
+  // The tasks' worlds: one world cache for the whole submission (its absolute path), unless none.
+  if (a.has("--draw-each") && (a.has("--cache") || a.has("--no-cache"))) throw UsageError("--draw-each uses no cache: leave out --cache / --no-cache");
+  if (a.has("--draw-each")) {
+    so.task_args = {"--draw-each"};
+  } else {
+    const harness::WorldCacheOptions co = app::cache_options(a);
+    so.task_args = co.dir.empty() ? std::vector<std::string>{"--no-cache"} : std::vector<std::string>{"--cache", co.dir};
+  }
   const auto r = batch::submit_slurm(spec, a.positional[0], so);
   std::cout << r.message;
   return 0;

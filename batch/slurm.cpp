@@ -393,7 +393,9 @@ std::string common_header(const SlurmOptions& o, const SubmitPaths& p) {
 }
 
 std::string shard_command_tail(const SlurmOptions& o, const SubmitPaths& p) {
-  return " --resume -j " + std::to_string(o.cpus_per_task) + " -o " + shq(p.dir.string());
+  std::string tail = " --resume -j " + std::to_string(o.cpus_per_task) + " -o " + shq(p.dir.string());
+  for (const auto& a : o.task_args) tail += " " + shq(a);
+  return tail;
 }
 
 // --gpus-per-task: the GPUs as a generic resource, and rendering on them through EGL. Slurm sets

@@ -32,6 +32,10 @@ struct SlurmOptions {
   bool resubmit_missing = false;         ///< only the shards with missing or failed runs, N as first submitted
   std::string out_dir;                   ///< the sweep's results folder (default results/sweeps/<name>)
   std::string omniloc_exe;               ///< binary the tasks run (default: this one, /proc/self/exe)
+  /// Options every task's sweep gets besides its shard: where its worlds come from (`--cache DIR`
+  /// with the submitting machine's absolute path, `--no-cache` or `--draw-each`), so the tasks of one
+  /// submission share one world cache (docs/recording.md section 9).
+  std::vector<std::string> task_args;
 };
 
 /// Checks the options against the sweep (before anything is written); throws ConfigError naming

@@ -286,6 +286,8 @@ TEST(Cluster, DryRunWritesTheSubmissionFolderWithoutSlurm) {
   EXPECT_NE(array.find("#SBATCH --partition=short\n#SBATCH --time=01:30:00\n#SBATCH --mem=2G\n"), std::string::npos) << array;
   EXPECT_NE(array.find("N=3\n"), std::string::npos) << array;
   EXPECT_NE(array.find("--shard \"${SLURM_ARRAY_TASK_ID}/${N}\" --resume -j 2"), std::string::npos) << array;
+  // One world cache for every task of the submission, named by its absolute path.
+  EXPECT_NE(array.find(" --cache /"), std::string::npos) << array;
   EXPECT_EQ(array.find("SLURM_ARRAY_TASK_COUNT}"), std::string::npos);
   const std::string merge = read_file((res / "slurm" / "merge.sbatch").string());
   EXPECT_NE(merge.find("--aggregate-only"), std::string::npos);
