@@ -89,24 +89,26 @@ void flock_retry(int fd, int op) {
     if (errno != EINTR) throw RuntimeFailure(std::string("world cache: cannot lock: ") + std::strerror(errno));
 }
 
-// The files of a recording folder the manifest covers (images are counted and sized, not hashed:
-// a damaged PNG fails to decode when it is read).
-Json manifest_files(const fs::path& dir, long long& images, std::uint64_t& image_bytes) {
-  Json files = Json::object();
+// The images of an entry: how many, how many bytes (they are counted and sized, not hashed: a
+// damaged PNG fails to decode when it is read).
+void count_images(const fs::path& dir, long long& images, std::uint64_t& image_bytes) {
   images = 0;
   image_bytes = 0;
   std::error_code ec;
+  for (const auto& i : fs::directory_iterator(dir / "images", ec)) {
+    ++images;
+    image_bytes += i.file_size(ec);
+  }
+}
+
+// The manifest's files: every regular file of the recording folder, sized and hashed.
+Json manifest_files(const fs::path& dir) {
+  Json files = Json::object();
+  std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
-    if (name == kManifest || name == kLastUsed) continue;
-    if (e.is_directory(ec) && name == "images") {
-      for (const auto& i : fs::directory_iterator(e.path(), ec)) {
-        ++images;
-        image_bytes += i.file_size(ec);
-      }
-      continue;
-    }
-    if (e.is_regular_file(ec)) files[name] = {{"bytes", e.file_size(ec)}, {"sha256", external::sha256_file(e.path().string())}};
+    if (name == kManifest || name == kLastUsed || !e.is_regular_file(ec)) continue;
+    files[name] = {{"bytes", e.file_size(ec)}, {"sha256", external::sha256_file(e.path().string())}};
   }
   return files;
 }
@@ -223,7 +225,7 @@ std::string WorldCache::damage(const std::string& key) const {
   }
   long long images = 0;
   std::uint64_t image_bytes = 0;
-  (void)manifest_files(dir, images, image_bytes);
+  count_images(dir, images, image_bytes);
   if (images != m.value("image_files", 0LL) || image_bytes != m.value("image_bytes", std::uint64_t{0}))
     return "images/ holds " + std::to_string(images) + " files, " + std::to_string(image_bytes) + " bytes; the manifest " +
            m.value("image_files", Json(0)).dump() + ", " + m.value("image_bytes", Json(0)).dump();
@@ -280,7 +282,8 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
     const RecordResult rec = record_scenario(world, ro);
     long long n_images = 0;
     std::uint64_t image_bytes = 0;
-    const Json files = manifest_files(dir, n_images, image_bytes);
+    count_images(dir, n_images, image_bytes);
+    const Json files = manifest_files(dir);
     const Json manifest = {{"format", kManifestFormat}, {"key", key},           {"scenario", sc.name},
                            {"seed", seed},              {"images", images},     {"frames", rec.frames},
                            {"files", files},            {"image_files", n_images}, {"image_bytes", image_bytes}};
