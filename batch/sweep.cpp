@@ -18,6 +18,7 @@
 #include <fstream>
 #include <mutex>
 #include <ostream>
+#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -96,6 +97,26 @@ std::string tail_of(const std::string& path, std::size_t max_chars) {
     return "";
   }
   return s.size() > max_chars ? s.substr(s.size() - max_chars) : s;
+}
+
+// Why a run's process failed, in one line for the progress output: its exit or signal and the last
+// line its log has (the whole log stays in logs/, its tail in failed/<id>.json).
+std::string failure_line(int status, const std::string& log) {
+  std::string why = status < 0                              ? std::string("could not be started")
+                    : WIFEXITED(status) && WEXITSTATUS(status) == 0 ? std::string("exit 0 but no summary.json")
+                    : WIFEXITED(status)                      ? "exit " + std::to_string(WEXITSTATUS(status))
+                    : WIFSIGNALED(status)                    ? "signal " + std::to_string(WTERMSIG(status))
+                                                             : std::string("stopped");
+  // The head of the log's last message: its last line that is not an indented continuation.
+  std::istringstream lines(tail_of(log, 4000));
+  std::string line, tail;
+  while (std::getline(lines, line)) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    if (!line.empty() && (line[0] != ' ' || tail.empty())) tail = line;
+  }
+  if (tail.size() > 200) tail = tail.substr(0, 200) + "...";
+  why += "; " + fs::path(log).parent_path().filename().string() + "/" + fs::path(log).filename().string();
+  return tail.empty() ? why + " is empty" : why + ": " + tail;
 }
 
 }  // namespace
@@ -185,19 +206,22 @@ class SweepWorkers {
         if (o_.progress) *o_.progress << readable(r) << ": skipped, another process is running it\n";
         continue;
       }
-      const Result result = run_locked(r, fail_marker, lock_path, lock_fd, secs);
+      std::string why;
+      const Result result = run_locked(r, fail_marker, lock_path, lock_fd, secs, why);
       if (lock_fd >= 0) ::close(lock_fd);
       if (result == Result::finished_elsewhere) {
         std::lock_guard<std::mutex> lock(mu_);
         ++busy_;
         continue;
       }
-      report(r, result == Result::ok, secs);
+      report(r, result == Result::ok, secs, why);
     }
   }
 
-  // Runs `r` holding its lock `lock_fd` (-1: the lock could not be created); `secs` gets the run's time.
-  Result run_locked(const SweepRun& r, const fs::path& fail_marker, const std::string& lock_path, int lock_fd, double& secs) {
+  // Runs `r` holding its lock `lock_fd` (-1: the lock could not be created); `secs` gets the run's time,
+  // `why` the reason of a failed process (empty when the failure was reported here already).
+  Result run_locked(const SweepRun& r, const fs::path& fail_marker, const std::string& lock_path, int lock_fd, double& secs,
+                    std::string& why) {
     // Any exception here (a full disk while writing the spec or the failure record) becomes a
     // recorded failure of this run: an exception escaping a std::thread would abort the sweep.
     try {
@@ -231,6 +255,7 @@ class SweepWorkers {
         std::error_code ec;
         fs::remove(fail_marker, ec);
       } else {
+        why = failure_line(st, log);
         Json f{{"id", r.id}, {"log", tail_of(log, 2000)}};
         if (st >= 0 && WIFEXITED(st)) f["exit_code"] = WEXITSTATUS(st);
         if (st >= 0 && WIFSIGNALED(st)) f["signal"] = WTERMSIG(st);
@@ -282,7 +307,7 @@ class SweepWorkers {
     return dir.string();
   }
 
-  void report(const SweepRun& r, bool ok, double secs) {
+  void report(const SweepRun& r, bool ok, double secs, const std::string& why) {
     std::lock_guard<std::mutex> lock(mu_);
     ++done_;
     if (!ok) ++failed_;
@@ -290,12 +315,14 @@ class SweepWorkers {
     const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
     const double eta = el / done_ * (todo_.size() - done_);
     if (tty_) {
+      // A failure keeps its own line above the bar, so its reason is not overwritten.
+      if (!ok) *o_.progress << "\r" << readable(r) << ": FAILED" << (why.empty() ? "" : " (" + why + ")") << "\n";
       const int width = 30, filled = static_cast<int>(width * done_ / std::max<std::size_t>(1, todo_.size()));
       *o_.progress << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done_ << "/" << todo_.size()
                    << " failed " << failed_ << " ETA " << fmt_duration(eta) << "   " << std::flush;
     } else {
       *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << readable(r, ok ? run_localizer_name(folder_.dir, r) : "")
-                   << (ok ? ": ok " : ": FAILED ") << fmt(secs) << " s, ETA "
+                   << (ok ? ": ok " : ": FAILED ") << fmt(secs) << " s" << (why.empty() ? "" : " (" + why + ")") << ", ETA "
                    << fmt_duration(eta) << "\n";
     }
   }
