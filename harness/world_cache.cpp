@@ -24,6 +24,7 @@
 #include "harness/localizer_registry.hpp"
 #include "harness/recording.hpp"
 #include "harness/run_directory.hpp"
+#include "harness/shared_library.hpp"
 #include "omniloc_world_fingerprint.hpp"
 
 namespace omniloc::harness {
@@ -39,28 +40,19 @@ constexpr const char* kLastUsed = "last_used";
 // sweep runs' worlds; images take 915 MiB a minute, so a cache of image worlds fills it in 22 minutes.
 constexpr std::uint64_t kDefaultMaxBytes = 20ULL << 30;
 
-// The OSMesa library sim/render/gl_context.cpp loads: its path, size and time, found where the
-// dynamic loader looks (LD_LIBRARY_PATH, then the system's directories). A Mesa update draws other
-// pixels, so it must miss the cache; LLVM, which Mesa links, is not checked (docs/recording.md).
-std::string osmesa_identity() {
-  std::vector<std::string> dirs;
-  if (const char* ld = std::getenv("LD_LIBRARY_PATH"))
-    for (std::string s = ld; !s.empty();) {
-      const auto c = s.find(':');
-      dirs.push_back(s.substr(0, c));
-      s = c == std::string::npos ? "" : s.substr(c + 1);
-    }
-  for (const char* d : {"/usr/lib/x86_64-linux-gnu", "/lib/x86_64-linux-gnu", "/usr/lib/aarch64-linux-gnu", "/usr/local/lib", "/usr/lib", "/lib"})
-    dirs.push_back(d);
-  for (const auto& d : dirs) {
-    std::error_code ec;
-    const fs::path p = fs::canonical(fs::path(d) / "libOSMesa.so.8", ec);
-    if (ec) continue;
-    struct stat st {};
-    if (::stat(p.c_str(), &st) != 0) continue;
-    return p.string() + " " + std::to_string(st.st_size) + " " + std::to_string(st.st_mtime);
-  }
-  return "none";
+// The OSMesa library sim/render/gl_context.cpp loads and every library it links (LLVM, whose code
+// generator llvmpipe draws with, glapi, libc, ...), each by path, size and time: a Mesa or LLVM update
+// may draw other pixels, so it must miss the cache. Libraries those link in turn are not followed.
+// Computed once a process: the files do not change under a running program.
+const std::string& osmesa_identity() {
+  static const std::string id = [] {
+    const std::string osmesa = find_shared_library("libOSMesa.so.8");
+    if (osmesa.empty()) return std::string("none");
+    std::string s = file_identity(osmesa);
+    for (const auto& needed : elf_needed(osmesa)) s += "; " + needed + " " + file_identity(find_shared_library(needed));
+    return s;
+  }();
+  return id;
 }
 
 std::uint64_t folder_bytes(const fs::path& dir) {
