@@ -6,8 +6,8 @@ files: the estimate est.tum's row of that frame, the truth gt.tum's, the line po
 view.jsonl's count for the frame (or the recording's). Draw times over 200 slider steps are
 measured and written, with screenshots, to $OMNILOC_ARTIFACTS (default: a temporary folder).
 Also: a run with a kidnap (events on the timeline, invalid frames, the "no line points" message),
-line points and images from a recording, two robots, the page's size, and bad input (exit 2, one
-line naming the file, nothing written).
+line points and images from a recording, images from `omniloc run --frames`, two robots, the page's
+size, and bad input (exit 2, one line naming the file, nothing written).
 
     OMNILOC_BIN=build/omniloc PYTHONPATH=python /usr/bin/python3 tests/viewer_test.py
 
@@ -16,6 +16,7 @@ recording of the same scenario and seed (line points and blobs as recorded; cova
 particles and extra points synthesized around the estimate). Without Chromium the browser tests skip
 and the file exits 77 (ctest: SKIP_RETURN_CODE 77) after running the others.
 """
+import base64
 import gzip
 import json
 import math
@@ -164,6 +165,10 @@ class Viewer(unittest.TestCase):
         omniloc("record", sc_img, "--images", "-o", cls.rec_img, "--quiet")
         cls.run_img = cls.tmp / "run_img"
         omniloc("replay", cls.rec_img, "--localizer", '{"type": "matching"}', "-o", cls.run_img, "--quiet")
+        # The same 2 s run live, its camera frames written as PNG every 7th frame (omniloc run --frames).
+        cls.frames = cls.tmp / "frames"
+        cls.run_f = cls.tmp / "run_frames"
+        omniloc("run", sc_img, "--frames", cls.frames, "--frames-every", "7", "-o", cls.run_f, "--quiet")
         # A kidnap with the camera covered (invalid frames, mode changes) and an occlusion: events.
         sc_k = cls.tmp / "kidnap.json"
         sc_k.write_text(json.dumps(scenario("paper/kidnap_002.json", 8.0, "viewer_kidnap", events=[
@@ -296,8 +301,22 @@ class Viewer(unittest.TestCase):
         for step in state["steps"]:
             k = step["k"]
             self.assertEqual(step["robots"][0]["lineEst"], len(rec[k]["robots"][0]["line_points"]))
+        # The image shown is the last embedded one at or before the frame.
+        self.assertEqual([step["imageFrame"] for step in state["steps"]], [0, 10, 40])
         small = self.build(self.run_img, self.tmp / "no_images.html", "--recording", self.rec_img, "--no-images")
         self.assertNotIn("iVBORw0KGgo", small.read_text())
+
+    def test_images_of_a_live_run_written_with_frames(self):
+        # PNGs every 7th frame (0, 7, 14, ...); --image-every 10 embeds the first and then each at least
+        # 10 frames after the last embedded: 0, 14, 28, 42, 56 of the 61 frames.
+        page = self.build(self.run_f, self.tmp / "frames.html", "--frames", self.frames, "--image-every", "10")
+        text = page.read_text()
+        self.assertEqual(text.count("iVBORw0KGgo"), 5)
+        first = (self.frames / "r0_000000.png").read_bytes()
+        self.assertIn(base64.b64encode(first).decode("ascii"), text, "the PNG embedded byte for byte")
+        self.need_browser()
+        state = page_state(page, "test=0,13,14,30,60")
+        self.assertEqual([step["imageFrame"] for step in state["steps"]], [0, 0, 14, 28, 56])
 
     def test_two_robots(self):
         self.need_browser()
@@ -336,7 +355,7 @@ class Viewer(unittest.TestCase):
         r = view("--help", prog="omniloc view")
         self.assertEqual(r.returncode, 0)
         self.assertTrue(r.stdout.startswith("usage: omniloc view"), r.stdout[:200])
-        for word in ("--recording", "--image-every", "--particles", "view.jsonl", "MB"):
+        for word in ("--recording", "--frames", "--image-every", "--particles", "view.jsonl", "MB"):
             self.assertIn(word, r.stdout)
         self.assertEqual(r.stderr, "")
 
@@ -387,6 +406,9 @@ class Viewer(unittest.TestCase):
         self.assert_bad([d], ["gt.tum line 5", "8 numbers"], out)
         self.assert_bad([self.run_k, "--recording", self.rec], ["recording.json", "frames"], out)
         self.assert_bad([self.run_t, "--recording", self.tmp / "no_rec"], ["no_rec", "recording"], out)
+        (self.tmp / "no_frames").mkdir(exist_ok=True)
+        self.assert_bad([self.run_t, "--frames", self.tmp / "no_frames"], ["no_frames", "r0_NNNNNN.png"], out)
+        self.assert_bad([self.run_t, "--frames", self.tmp / "absent_frames"], ["absent_frames", "--frames"], out)
         self.assert_bad([self.run_t, "--image-every", "0"], ["--image-every", "integer >= 1"], out)
         # a page already there is left as it was
         out.write_text("old")

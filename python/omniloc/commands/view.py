@@ -28,15 +28,17 @@ step a frame (shift: 10), space plays and pauses.
 
 Line points, blobs, covariance and particles come from RUN_DIR/view.jsonl (`omniloc run
 --debug-view`), else line points and blobs from the recording given by --recording; without
-either the page says so."""
+either the page says so. Camera images come from that recording (made with --images) or from the
+PNGs `omniloc run --frames DIR` wrote (--frames DIR)."""
 
 EPILOG = """\
 size: a 60 s run at 30 Hz (1801 frames) is about 1 MB with line points, about 3 MB with 100
 particles a frame (docs/viewer.md). Line points are kept to the millimetre, particles to the
 millimetre and milliradian, at most --particles a frame (an even stride through the localizer's
-list) on every --particles-every-th frame. Camera images are the recording's PNGs embedded as
-base64: each adds about 0.7 MB (a 640 x 640 panorama), so a 60 s run at 30 Hz with --image-every 30
-(one a second) adds about 42 MB and --image-every 1 about 1.2 GB; --no-images leaves them out.
+list) on every --particles-every-th frame. Camera images are the recording's (or the --frames
+folder's) PNGs embedded as base64: each adds about 0.7 MB (a 640 x 640 panorama), so a 60 s run at
+30 Hz with --image-every 30 (one a second) adds about 42 MB and --image-every 1 about 1.2 GB;
+--no-images leaves them out.
 
 exit status: 0 written; 2 bad input (one line naming the file and what was expected; nothing is
 written). The output is written to a temporary file beside FILE and renamed into place."""
@@ -72,8 +74,12 @@ def parser(prog: str) -> argparse.ArgumentParser:
                    help="a recording of the run's scenario and seed (the one it was replayed from, or omniloc record of the "
                         "same scenario and seed): its line points and blobs when the run has no view.jsonl, and its camera "
                         "images when recorded with --images")
+    p.add_argument("--frames", metavar="DIR",
+                   help="the camera frames omniloc run --frames DIR wrote for this run (PNG): its images, in place of a "
+                        "recording's")
     p.add_argument("--image-every", type=_positive, default=30, metavar="N",
-                   help="embed every N-th frame's camera image (default 30: one a second at 30 Hz); the page shows the last "
+                   help="embed every N-th frame's camera image (default 30: one a second at 30 Hz; with --frames, the "
+                        "first PNG and then each at least N frames after the last one embedded); the page shows the last "
                         "embedded image at or before the frame")
     p.add_argument("--no-images", action="store_true", help="embed no camera images")
     p.add_argument("--particles", type=_count, default=100, metavar="N",
@@ -112,7 +118,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         if not out.parent.is_dir() and run_dir.is_dir():
             raise ViewInputError(out.parent, "missing: expected an existing folder to write the page into")
         run = load_run(run_dir, Path(args.recording) if args.recording else None, image_every=args.image_every,
-                       images=not args.no_images)
+                       images=not args.no_images, frames_dir=Path(args.frames) if args.frames else None)
         page = render(run, max_particles=args.particles, particles_every=args.particles_every)
         _write_atomically(out, page)
     except ViewInputError as e:

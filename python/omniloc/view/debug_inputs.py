@@ -1,10 +1,12 @@
 """The viewer's optional inputs beside the run folder: view.jsonl (`--debug-view`, docs/viewer.md
-section 4), a recording's frames (line points, blobs) and its images (docs/recording.md)."""
+section 4), a recording's frames (line points, blobs) and its images (docs/recording.md), and the
+camera frames `omniloc run --frames DIR` wrote."""
 from __future__ import annotations
 
 import base64
 import gzip
 import json
+import os
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -171,4 +173,29 @@ def read_images(folder: Path, ids: Sequence[int], frames: int, every: int) -> Di
             if not data.startswith(b"\x89PNG\r\n\x1a\n"):
                 raise ViewInputError(p, "expected a PNG image")
             out[rid][k] = base64.b64encode(data).decode("ascii")
+    return out
+
+
+def read_frame_images(folder: Path, ids: Sequence[int], frames: int, every: int) -> Dict[int, Dict[int, str]]:
+    """The PNGs `omniloc run --frames DIR` wrote (r<id>_<frame, 6 digits>.png, every --frames-every-th
+    frame), base64: of each robot the first one and then each at least `every` frames after the last
+    one embedded. Frames without a file are skipped; a folder with none of the run's is an error."""
+    if not folder.is_dir():
+        raise ViewInputError(folder, "missing: expected the folder omniloc run --frames DIR wrote the camera frames into")
+    names = set(os.listdir(folder))
+    out: Dict[int, Dict[int, str]] = {rid: {} for rid in ids}
+    for rid in ids:
+        last = -every
+        for k in range(frames):
+            name = f"r{rid}_{k:06d}.png"
+            if k - last < every or name not in names:
+                continue
+            p = folder / name
+            data = p.read_bytes()
+            if not data.startswith(b"\x89PNG\r\n\x1a\n"):
+                raise ViewInputError(p, "expected a PNG image")
+            out[rid][k] = base64.b64encode(data).decode("ascii")
+            last = k
+    if not any(out.values()):
+        raise ViewInputError(folder, f"no r{ids[0]}_NNNNNN.png of this run's frames: expected the PNGs omniloc run --frames DIR writes")
     return out

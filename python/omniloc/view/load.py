@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple
 
 from omniloc.view.model import (FRAMES_COLUMNS, REQUIRED_COLUMNS, T_TOLERANCE, ViewInputError, Pose, Debug, RobotRun, Event, RunData, _finite, _read_text, _cell, Blob)
-from omniloc.view.debug_inputs import read_images, read_recording, read_view_jsonl
+from omniloc.view.debug_inputs import read_frame_images, read_images, read_recording, read_view_jsonl
 
 def tum_yaw(qz: float, qw: float) -> float:
     """Yaw (rad, in (-pi, pi]) of a rotation about z given as the quaternion (0, 0, qz, qw)."""
@@ -164,7 +164,10 @@ def _check_field(field: Dict[str, Any], path: Path) -> None:
             raise ViewInputError(path, f"`{key}`: expected a list of {width}-number lists")
 
 
-def load_run(run_dir: Path, recording: Optional[Path] = None, image_every: int = 30, images: bool = True) -> RunData:
+def load_run(run_dir: Path, recording: Optional[Path] = None, image_every: int = 30, images: bool = True,
+             frames_dir: Optional[Path] = None) -> RunData:
+    """The run folder and what is given beside it: a recording (line points, blobs, images) and the
+    PNGs of `omniloc run --frames DIR` (images; they win over a recording's)."""
     if not run_dir.exists():
         raise ViewInputError(run_dir, "missing: expected a run folder (omniloc run / replay -o DIR)")
     if not run_dir.is_dir():
@@ -249,12 +252,16 @@ def load_run(run_dir: Path, recording: Optional[Path] = None, image_every: int =
                 if key in markings and key not in field:
                     field[key] = markings[key]
         rec_images = head.get("images") is True
-        if images and rec_images:
+        if images and rec_images and frames_dir is None:
             imgs = read_images(recording, ids, frames, image_every)
             for r in robots:
                 r["images"] = imgs[r["id"]]
-        elif images:
+        elif images and frames_dir is None:
             notes.append("the recording holds no images (record with --images)")
+    if images and frames_dir is not None:
+        imgs = read_frame_images(frames_dir, ids, frames, image_every)
+        for r in robots:
+            r["images"] = imgs[r["id"]]
     if debug is not None:
         for r in robots:
             r["debug"] = debug[r["id"]]

@@ -2,6 +2,7 @@
   // script inside viewer.js's function): the side panel, rendering, the controls, the test hook.
   // ------------------------------------------------------------------------- side panel, labels
   var img = $('camera-img'), caption = $('camera-caption'), info = $('info');
+  var shownImage = null;  // the frame whose camera image is shown (null: none)
   var extraNames = Object.keys(focusRobot().raw.extra || {});
   function row(name, value, cls) { return '<tr><td>' + esc(name) + '</td><td' + (cls ? ' class="' + cls + '"' : '') + '>' + value + '</td></tr>'; }
   function eventsNear(r, k) {
@@ -40,18 +41,21 @@
     var ev = eventsNear(r, k);
     if (ev.length) h += row('events', ev.map(function (x) { return esc(x.label); }).join('<br>'), 'msg');
     info.innerHTML = h;
-    // the camera image: the last embedded one at or before k
-    var ims = raw.images, every = D.imageEvery || 1;
-    if (Object.keys(ims).length) {
-      var kk = k - (k % every);
-      while (kk >= 0 && !ims[kk]) kk -= every;
-      if (kk >= 0) {
-        var src = 'data:image/png;base64,' + ims[kk];
-        if (img.getAttribute('data-k') !== String(kk) || img.getAttribute('data-r') !== String(r.id)) {
-          img.src = src; img.setAttribute('data-k', kk); img.setAttribute('data-r', r.id);
-        }
-        caption.textContent = 'camera of r' + r.id + ', frame ' + kk + (kk !== k ? ' (every ' + every + ' frames embedded)' : '');
+    // the camera image: the last embedded one at or before k (a recording's every N-th frame, or the
+    // PNGs omniloc run --frames wrote, which may be at any frames)
+    var ims = raw.images;
+    if (r.imageKeys === undefined) r.imageKeys = Object.keys(ims).map(Number).sort(function (a, b) { return a - b; });
+    var keys = r.imageKeys, kk = -1, lo = 0, hi = keys.length - 1;
+    while (lo <= hi) {
+      var mid = (lo + hi) >> 1;
+      if (keys[mid] <= k) { kk = keys[mid]; lo = mid + 1; } else hi = mid - 1;
+    }
+    shownImage = kk >= 0 ? kk : null;
+    if (kk >= 0) {
+      if (img.getAttribute('data-k') !== String(kk) || img.getAttribute('data-r') !== String(r.id)) {
+        img.src = 'data:image/png;base64,' + ims[kk]; img.setAttribute('data-k', kk); img.setAttribute('data-r', r.id);
       }
+      caption.textContent = 'camera of r' + r.id + ', frame ' + kk + (kk !== k ? ' (the last embedded image before this frame)' : '');
     }
     $('time').textContent = 't = ' + fmt(raw.t[k], 3) + ' s  frame ' + k + ' / ' + (K - 1);
   }
@@ -216,7 +220,7 @@
     return out;
   }
   function median(a) { var s = a.slice().sort(function (x, y) { return x - y; }); return s.length ? s[(s.length - 1) >> 1] : null; }
-  function snapshot() { return JSON.parse(JSON.stringify(S.drawn)); }
+  function snapshot() { var s = JSON.parse(JSON.stringify(S.drawn)); s.imageFrame = shownImage; return s; }
   var H = parseHash();
   if (H.robot !== undefined) R.forEach(function (r, i) { if (String(r.id) === H.robot) S.focus = i; });
   if (H.truth === '1') S.show.truthPoints = true;
