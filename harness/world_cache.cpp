@@ -240,55 +240,63 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
   const std::string key = world_key(sc, seed, images);
   const fs::path dir = entry_dir(key);
   const int fd = lock(key);
-  try {
+  // flock turns an exclusive lock into a shared one by dropping it first: in between, a prune in
+  // another process may take the key and remove the entry. Then the entry is looked up again.
+  auto still_there_shared = [&] {
     flock_retry(fd, LOCK_SH);
-    if (fs::exists(dir) && damage(key).empty()) {
-      touch(dir / kLastUsed);
-      if (o_.log) *o_.log << "  world cache: " << sc.name << ", seed " << seed << " from " << dir.string() << "\n";
-      return WorldLease(dir.string(), key, false, fd);
-    }
-    // Drawing needs the key alone; whoever holds it may be drawing the same world right now.
-    flock_retry(fd, LOCK_UN);
-    flock_retry(fd, LOCK_EX);
-    if (fs::exists(dir)) {
-      const std::string why = damage(key);
-      if (why.empty()) {
+    return fs::exists(dir / kManifest);
+  };
+  try {
+    for (;;) {
+      flock_retry(fd, LOCK_SH);
+      if (fs::exists(dir) && damage(key).empty()) {
         touch(dir / kLastUsed);
-        flock_retry(fd, LOCK_SH);
         if (o_.log) *o_.log << "  world cache: " << sc.name << ", seed " << seed << " from " << dir.string() << "\n";
         return WorldLease(dir.string(), key, false, fd);
       }
-      // Always said, even by a quiet run: the cache was not what it claimed to be.
-      std::cerr << "omniloc: world cache entry " << dir.string() << " is damaged (" << why << "): removed, drawing it again\n";
-      fs::remove_all(dir);
+      // Drawing needs the key alone; whoever holds it may be drawing the same world right now.
+      flock_retry(fd, LOCK_UN);
+      flock_retry(fd, LOCK_EX);
+      if (fs::exists(dir)) {
+        const std::string why = damage(key);
+        if (why.empty()) {
+          touch(dir / kLastUsed);
+          if (!still_there_shared()) continue;
+          if (o_.log) *o_.log << "  world cache: " << sc.name << ", seed " << seed << " from " << dir.string() << "\n";
+          return WorldLease(dir.string(), key, false, fd);
+        }
+        // Always said, even by a quiet run: the cache was not what it claimed to be.
+        std::cerr << "omniloc: world cache entry " << dir.string() << " is damaged (" << why << "): removed, drawing it again\n";
+        fs::remove_all(dir);
+      }
+      fs::create_directories(o_.dir);
+      remove_stale_partials(o_.dir);
+      Scenario world = sc;
+      world.input.erase("localizer");  // the recording keeps no localizer; every run replays it with its own
+      RecordOptions ro;
+      ro.seed = seed;
+      ro.out_dir = dir.string();
+      ro.images = images;
+      if (o_.log) *o_.log << "  world cache: drawing " << sc.name << ", seed " << seed << (images ? " with images" : "") << " into " << dir.string() << "\n";
+      const RecordResult rec = record_scenario(world, ro);
+      long long n_images = 0;
+      std::uint64_t image_bytes = 0;
+      count_images(dir, n_images, image_bytes);
+      const Json files = manifest_files(dir);
+      const Json manifest = {{"format", kManifestFormat}, {"key", key},           {"scenario", sc.name},
+                             {"seed", seed},              {"images", images},     {"frames", rec.frames},
+                             {"files", files},            {"image_files", n_images}, {"image_bytes", image_bytes}};
+      write_file_atomic((dir / kManifest).string(), manifest.dump(2) + "\n");
+      touch(dir / kLastUsed);
+      if (!still_there_shared()) continue;
+      if (o_.max_bytes > 0) {
+        const PruneResult p = prune(std::nullopt, o_.max_bytes);
+        if (p.removed > 0 && o_.log)
+          *o_.log << "  world cache: evicted " << p.removed << " least recently used entries (" << format_bytes(p.freed) << ") to stay under "
+                  << format_bytes(o_.max_bytes) << "\n";
+      }
+      return WorldLease(dir.string(), key, true, fd);
     }
-    fs::create_directories(o_.dir);
-    remove_stale_partials(o_.dir);
-    Scenario world = sc;
-    world.input.erase("localizer");  // the recording keeps no localizer; every run replays it with its own
-    RecordOptions ro;
-    ro.seed = seed;
-    ro.out_dir = dir.string();
-    ro.images = images;
-    if (o_.log) *o_.log << "  world cache: drawing " << sc.name << ", seed " << seed << (images ? " with images" : "") << " into " << dir.string() << "\n";
-    const RecordResult rec = record_scenario(world, ro);
-    long long n_images = 0;
-    std::uint64_t image_bytes = 0;
-    count_images(dir, n_images, image_bytes);
-    const Json files = manifest_files(dir);
-    const Json manifest = {{"format", kManifestFormat}, {"key", key},           {"scenario", sc.name},
-                           {"seed", seed},              {"images", images},     {"frames", rec.frames},
-                           {"files", files},            {"image_files", n_images}, {"image_bytes", image_bytes}};
-    write_file_atomic((dir / kManifest).string(), manifest.dump(2) + "\n");
-    touch(dir / kLastUsed);
-    flock_retry(fd, LOCK_SH);
-    if (o_.max_bytes > 0) {
-      const PruneResult p = prune(std::nullopt, o_.max_bytes);
-      if (p.removed > 0 && o_.log)
-        *o_.log << "  world cache: evicted " << p.removed << " least recently used entries (" << format_bytes(p.freed) << ") to stay under "
-                << format_bytes(o_.max_bytes) << "\n";
-    }
-    return WorldLease(dir.string(), key, true, fd);
   } catch (...) {
     ::close(fd);
     throw;
