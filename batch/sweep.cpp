@@ -102,11 +102,10 @@ std::string tail_of(const std::string& path, std::size_t max_chars) {
 // Why a run's process failed, in one line for the progress output: its exit or signal and the last
 // line its log has (the whole log stays in logs/, its tail in failed/<id>.json).
 std::string failure_line(int status, const std::string& log) {
-  std::string why = status < 0                              ? std::string("could not be started")
-                    : WIFEXITED(status) && WEXITSTATUS(status) == 0 ? std::string("exit 0 but no summary.json")
-                    : WIFEXITED(status)                      ? "exit " + std::to_string(WEXITSTATUS(status))
-                    : WIFSIGNALED(status)                    ? "signal " + std::to_string(WTERMSIG(status))
-                                                             : std::string("stopped");
+  std::string why = "stopped";
+  if (status < 0) why = "could not be started";
+  else if (WIFEXITED(status)) why = WEXITSTATUS(status) == 0 ? "exit 0 but no summary.json" : "exit " + std::to_string(WEXITSTATUS(status));
+  else if (WIFSIGNALED(status)) why = "signal " + std::to_string(WTERMSIG(status));
   // The head of the log's last message: its last line that is not an indented continuation.
   std::istringstream lines(tail_of(log, 4000));
   std::string line, tail;

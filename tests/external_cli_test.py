@@ -166,6 +166,10 @@ class ExternalCli(unittest.TestCase):
         self.assertEqual(len(failed), 1, r.stdout + r.stderr)
         record = json.loads(failed[0].read_text())
         self.assertIn("exited with status 3", json.dumps(record))
+        # The progress line says why in one line: the run's exit and its log's last message.
+        lines = [x for x in (r.stdout + r.stderr).splitlines() if "FAILED" in x]
+        self.assertEqual(len(lines), 1, r.stdout + r.stderr)
+        self.assertRegex(lines[0], r"FAILED [0-9.]+ s \(exit [1-9][0-9]*; logs/[^ ]+\.log: .*exited with status 3")
         self.assertEqual(len(list((out / "runs").iterdir())), 3)  # the other runs went on
         r = self.omniloc("sweep", sweep, "-o", str(out), "--resume")
         self.assertEqual(list((out / "failed").glob("*.json")), [])
