@@ -160,6 +160,13 @@ def read_recording(folder: Path, ids: Sequence[int], times: Dict[int, List[float
     return out, head
 
 
+def _png_base64(p: Path, data: bytes) -> str:
+    """A camera image's bytes as the page embeds them; anything but a PNG is refused."""
+    if not data.startswith(b"\x89PNG\r\n\x1a\n"):
+        raise ViewInputError(p, "expected a PNG image")
+    return base64.b64encode(data).decode("ascii")
+
+
 def read_images(folder: Path, ids: Sequence[int], frames: int, every: int) -> Dict[int, Dict[int, str]]:
     """Every `every`-th frame's PNG of each robot, base64."""
     out: Dict[int, Dict[int, str]] = {rid: {} for rid in ids}
@@ -170,9 +177,7 @@ def read_images(folder: Path, ids: Sequence[int], frames: int, every: int) -> Di
                 data = p.read_bytes()
             except OSError:
                 raise ViewInputError(p, "missing: expected the frame's image (the recording says it holds every image)") from None
-            if not data.startswith(b"\x89PNG\r\n\x1a\n"):
-                raise ViewInputError(p, "expected a PNG image")
-            out[rid][k] = base64.b64encode(data).decode("ascii")
+            out[rid][k] = _png_base64(p, data)
     return out
 
 
@@ -191,10 +196,10 @@ def read_frame_images(folder: Path, ids: Sequence[int], frames: int, every: int)
             if k - last < every or name not in names:
                 continue
             p = folder / name
-            data = p.read_bytes()
-            if not data.startswith(b"\x89PNG\r\n\x1a\n"):
-                raise ViewInputError(p, "expected a PNG image")
-            out[rid][k] = base64.b64encode(data).decode("ascii")
+            try:
+                out[rid][k] = _png_base64(p, p.read_bytes())
+            except OSError as err:
+                raise ViewInputError(p, f"unreadable ({err.strerror}): expected the frame's PNG") from None
             last = k
     if not any(out.values()):
         raise ViewInputError(folder, f"no r{ids[0]}_NNNNNN.png of this run's frames: expected the PNGs omniloc run --frames DIR writes")
