@@ -1,39 +1,48 @@
 #include "apps/cache_command.hpp"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <iostream>
 
+#include "core/cache_root.hpp"
 #include "core/error.hpp"
 
 namespace omniloc::app {
 
+namespace fs = std::filesystem;
+
 const cli::Command kCache{
     "cache", "list|size|prune", 1, 1,
-    "The world cache: recordings of the worlds runs and sweeps drew, kept once per machine and replayed\n"
-    "into every later run of the same world with any localizer (docs/recording.md \"World cache\").\n"
-    "Folder: results/cache/worlds, or OMNILOC_CACHE (\"off\": none); size limit 20G, or OMNILOC_CACHE_MAX_SIZE.\n"
-    "  list   each entry: key, scenario, seed, images, frames, size, last used (newest first)\n"
-    "  size   the cache's folder, entries and bytes\n"
+    "Every cache omniloc keeps, under one root: recorded worlds (worlds/: each world a run or sweep drew,\n"
+    "replayed into every later run of it with any localizer), distance maps (fieldmaps/), mirror\n"
+    "calibration maps and colour tables (vision/). Docs: docs/recording.md \"World cache\".\n"
+    "Root: OMNILOC_CACHE (\"off\": none), else $XDG_CACHE_HOME/omniloc, else ~/.cache/omniloc.\n"
+    "Size limit of worlds/ while runs fill it: 20G, or OMNILOC_CACHE_MAX_SIZE.\n"
+    "  list   each entry: kind, key or file, what it is, size, last used (newest first)\n"
+    "  size   the root, and entries and bytes of each kind\n"
     "  prune  remove entries unused for longer than --older-than, then the least recently used ones\n"
-    "         until the cache holds at most --max-size; entries in use by a run are kept",
-    {{"--cache", "DIR", "the cache folder (default: OMNILOC_CACHE, else results/cache/worlds)"},
+    "         until the cache holds at most --max-size; worlds in use by a run are kept",
+    {{"--cache", "DIR", "the cache root (default: OMNILOC_CACHE, else $XDG_CACHE_HOME/omniloc or ~/.cache/omniloc)"},
      {"--older-than", "DAYS", "prune: entries not used for more than DAYS days (a number >= 0)"},
-     {"--max-size", "SIZE", "prune: keep at most SIZE bytes (e.g. 500M, 20G; 0 empties the cache)"}}};
+     {"--max-size", "SIZE", "prune: keep at most SIZE bytes in all (e.g. 500M, 20G; 0 empties the cache)"}}};
 
 harness::WorldCacheOptions cache_options(const cli::Args& a) {
-  harness::WorldCacheOptions o = harness::world_cache_from_env();
+  if (a.has("--cache") && a.has("--no-cache")) throw cli::UsageError("--cache and --no-cache contradict each other");
+  // Through the environment, so that every cache of this process (and of the runs it starts) uses it.
   if (a.has("--cache")) {
     const std::string d = a.value("--cache");
     if (d.empty()) throw cli::UsageError("--cache needs a folder");
-    o.dir = std::filesystem::absolute(d).lexically_normal().string();
+    std::error_code ec;
+    const fs::path p = fs::absolute(d, ec);
+    ::setenv("OMNILOC_CACHE", (ec ? fs::path(d) : p).lexically_normal().c_str(), 1);
   }
-  if (a.has("--no-cache")) {
-    if (a.has("--cache")) throw cli::UsageError("--cache and --no-cache contradict each other");
-    o.dir.clear();
-  }
-  return o;
+  if (a.has("--no-cache")) ::setenv("OMNILOC_CACHE", "off", 1);
+  return harness::world_cache_from_env();
 }
 
 namespace {
@@ -46,6 +55,61 @@ std::string when(std::time_t t) {
   return b;
 }
 
+// One entry of any kind: a world (a folder under worlds/) or a file (a distance map, a calibration
+// map, a colour table).
+struct Entry {
+  std::string kind;  ///< "world", "fieldmap", "calibration", "colour"
+  std::string name;  ///< the world's key, or the file's name
+  std::string what;  ///< scenario and seed of a world; empty for files (the name says it)
+  std::uint64_t bytes = 0;
+  std::time_t last_used = 0;
+};
+
+// The files of the root's fieldmaps/<build>/ and vision/<build>/ folders (harness/cache_dirs.hpp),
+// named "<build>/<file>". A file being written (name.tmp.<pid>) is not an entry yet.
+std::vector<Entry> file_entries(const std::string& root) {
+  std::vector<Entry> out;
+  for (const char* kind : {"fieldmaps", "vision"}) {
+    std::error_code ec;
+    for (fs::directory_iterator b(fs::path(root) / kind, ec), end; !ec && b != end; b.increment(ec)) {
+      std::error_code e1;
+      if (!b->is_directory(e1)) continue;
+      for (fs::directory_iterator it(b->path(), e1); !e1 && it != end; it.increment(e1)) {
+        const std::string n = it->path().filename().string();
+        std::error_code e2;
+        if (!it->is_regular_file(e2) || n.find(".tmp.") != std::string::npos) continue;
+        struct stat st {};
+        if (::stat(it->path().c_str(), &st) != 0) continue;
+        Entry e;
+        e.kind = std::string(kind) == "fieldmaps" ? "fieldmap" : n.rfind("colour", 0) == 0 ? "colour" : "calibration";
+        e.name = b->path().filename().string() + "/" + n;
+        e.bytes = static_cast<std::uint64_t>(st.st_size);
+        e.last_used = std::max(st.st_mtime, st.st_atime);
+        out.push_back(std::move(e));
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<Entry> all_entries(const harness::WorldCache& worlds, const std::string& root) {
+  std::vector<Entry> out;
+  for (const auto& w : worlds.list()) {
+    Entry e{"world", w.key, "", w.bytes, w.last_used};
+    if (!w.complete) e.what = "(incomplete: being drawn or interrupted)";
+    else {
+      char s[512];
+      std::snprintf(s, sizeof s, "%s, seed %llu, %lld frames%s", w.scenario.c_str(), static_cast<unsigned long long>(w.seed), w.frames,
+                    w.images ? ", images" : "");
+      e.what = s;
+    }
+    out.push_back(std::move(e));
+  }
+  for (auto& e : file_entries(root)) out.push_back(std::move(e));
+  std::sort(out.begin(), out.end(), [](const Entry& a, const Entry& b) { return a.last_used != b.last_used ? a.last_used > b.last_used : a.name < b.name; });
+  return out;
+}
+
 }  // namespace
 
 int cmd_cache(const cli::Args& a) {
@@ -53,33 +117,38 @@ int cmd_cache(const cli::Args& a) {
   if (what != "list" && what != "size" && what != "prune") throw cli::UsageError("cache needs list, size or prune, got \"" + what + "\"");
   if (what != "prune" && (a.has("--older-than") || a.has("--max-size"))) throw cli::UsageError("--older-than and --max-size go with prune");
   harness::WorldCacheOptions o = cache_options(a);
-  if (o.dir.empty()) {
-    std::cout << "world cache: off (OMNILOC_CACHE=" << (std::getenv("OMNILOC_CACHE") ? std::getenv("OMNILOC_CACHE") : "") << ")\n";
+  const std::string root = cache::root();
+  if (root.empty()) {
+    const char* env = std::getenv("OMNILOC_CACHE");
+    std::cout << "cache: off (" << (env ? "OMNILOC_CACHE=" + std::string(env) : std::string("no OMNILOC_CACHE, XDG_CACHE_HOME or HOME")) << ")\n";
     return 0;
   }
-  harness::WorldCache cache(o);
+  harness::WorldCache worlds(o);
   if (what == "list") {
-    const auto entries = cache.list();
-    std::printf("%-32s  %-28s %6s %6s %7s %11s  %s\n", "key", "scenario", "seed", "images", "frames", "size", "last used");
+    const auto entries = all_entries(worlds, root);
+    std::printf("%-11s  %-56s %11s  %-20s  %s\n", "kind", "key or file", "size", "last used", "what");
     std::uint64_t total = 0;
     for (const auto& e : entries) {
       total += e.bytes;
-      if (!e.complete) {
-        std::printf("%-32s  %-28s %6s %6s %7s %11s  %s\n", e.key.c_str(), "(incomplete: being drawn or interrupted)", "", "", "",
-                    harness::format_bytes(e.bytes).c_str(), when(e.last_used).c_str());
-        continue;
-      }
-      std::printf("%-32s  %-28s %6llu %6s %7lld %11s  %s\n", e.key.c_str(), e.scenario.c_str(), static_cast<unsigned long long>(e.seed),
-                  e.images ? "yes" : "no", e.frames, harness::format_bytes(e.bytes).c_str(), when(e.last_used).c_str());
+      std::printf("%-11s  %-56s %11s  %-20s  %s\n", e.kind.c_str(), e.name.c_str(), harness::format_bytes(e.bytes).c_str(), when(e.last_used).c_str(),
+                  e.what.c_str());
     }
-    std::cout << entries.size() << " entries, " << harness::format_bytes(total) << " in " << o.dir << "\n";
+    std::cout << entries.size() << " entries, " << harness::format_bytes(total) << " in " << root << "\n";
     return 0;
   }
   if (what == "size") {
-    const auto entries = cache.list();
+    const auto entries = all_entries(worlds, root);
     std::uint64_t total = 0;
-    for (const auto& e : entries) total += e.bytes;
-    std::cout << o.dir << ": " << entries.size() << " entries, " << harness::format_bytes(total) << " (" << total << " bytes); limit "
+    std::cout << root << ":\n";
+    for (const char* kind : {"world", "fieldmap", "calibration", "colour"}) {
+      std::size_t n = 0;
+      std::uint64_t bytes = 0;
+      for (const auto& e : entries)
+        if (e.kind == kind) ++n, bytes += e.bytes;
+      total += bytes;
+      std::printf("  %-11s %6zu entries %11s\n", kind, n, harness::format_bytes(bytes).c_str());
+    }
+    std::cout << "  in all: " << entries.size() << " entries, " << harness::format_bytes(total) << " (" << total << " bytes); worlds' limit "
               << (o.max_bytes ? harness::format_bytes(o.max_bytes) : std::string("none")) << "\n";
     return 0;
   }
@@ -88,10 +157,40 @@ int cmd_cache(const cli::Args& a) {
   if (a.has("--older-than")) older = a.number("--older-than", 0.0, 0.0, 1e6) * 86400.0;
   if (a.has("--max-size")) max = harness::parse_byte_size(a.value("--max-size"), "--max-size");
   if (!older && !max) throw cli::UsageError("prune needs --older-than DAYS and/or --max-size SIZE");
-  const auto r = cache.prune(older, max);
-  std::cout << "removed " << r.removed << " entries (" << harness::format_bytes(r.freed) << "), kept " << r.kept
-            << (r.busy ? " (" + std::to_string(r.busy) + " in use)" : std::string()) << "; " << harness::format_bytes(r.left) << " left in "
-            << o.dir << "\n";
+  // Oldest use first, every kind together: what was used last is kept longest.
+  std::vector<Entry> entries = all_entries(worlds, root);
+  std::reverse(entries.begin(), entries.end());
+  std::uint64_t total = 0, freed = 0;
+  for (const auto& e : entries) total += e.bytes;
+  std::size_t removed = 0, kept = 0, busy = 0;
+  const std::time_t now = std::time(nullptr);
+  for (const auto& e : entries) {
+    const bool old = older && static_cast<double>(now - e.last_used) > *older;
+    const bool over = max && total > *max;
+    bool gone = false;
+    if (old || over) {
+      if (e.kind == "world") {
+        const auto r = worlds.remove(e.name);
+        gone = r == harness::WorldCache::Removal::kRemoved;
+        if (r == harness::WorldCache::Removal::kBusy) ++busy;
+      } else {
+        std::error_code ec;
+        const fs::path file = fs::path(root) / (e.kind == "fieldmap" ? "fieldmaps" : "vision") / e.name;
+        gone = fs::remove(file, ec) && !ec;
+        if (gone && fs::is_empty(file.parent_path(), ec)) fs::remove(file.parent_path(), ec);  // the build's folder, once empty
+      }
+    }
+    if (!gone) {
+      ++kept;
+      continue;
+    }
+    ++removed;
+    freed += e.bytes;
+    total -= e.bytes;
+  }
+  std::cout << "removed " << removed << " entries (" << harness::format_bytes(freed) << "), kept " << kept
+            << (busy ? " (" + std::to_string(busy) + " in use)" : std::string()) << "; " << harness::format_bytes(total) << " left in " << root
+            << "\n";
   return 0;
 }
 

@@ -17,6 +17,7 @@
 #include <cstring>
 
 #include "apps/cache_command.hpp"
+#include "core/cache_root.hpp"
 #include "core/cli_args.hpp"
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
@@ -128,8 +129,8 @@ const cli::Command kRun{"run", "FILE", 1, 1, "Run a scenario; results in results
                                              "covariance and particles it held, for `omniloc view` (docs/viewer.md)"},
                          {"--draw-each", "", "simulate and render this run itself instead of replaying its world from the world cache\n"
                                              "(the results are the same byte for byte: docs/recording.md \"World cache\")"},
-                         {"--cache", "DIR", "the world cache's folder (default: OMNILOC_CACHE, else results/cache/worlds)"},
-                         {"--no-cache", "", "neither read nor fill the world cache (as OMNILOC_CACHE=off)"},
+                         {"--cache", "DIR", "the cache root (default: OMNILOC_CACHE, else $XDG_CACHE_HOME/omniloc or ~/.cache/omniloc)"},
+                         {"--no-cache", "", "neither read nor fill any cache (as OMNILOC_CACHE=off)"},
                          {"--quiet", "", "no progress log on stderr"}}};
 const cli::Command kRecord{"record", "FILE", 1, 1,
                            "Simulate and perceive a scenario once, without a localizer, and write a recording of everything\n"
@@ -159,12 +160,12 @@ const cli::Command kRender{"render", "FILE", 1, 1, "Render the panorama robot ID
                             {"--overwrite", "", "replace an existing -o file"}}};
 const cli::Command kCalibrate{"calibrate", "FILE", 1, 1,
                               "Model-free mirror calibration with the scenario's camera; prints the map's error against the true mirror.",
-                              {{"-o", "MAP.json", "output map (default results/cache/calibration_v2_<camera>.json); an existing file only with --overwrite"},
+                              {{"-o", "MAP.json", "output map (default: the cache's vision/calibration_v2_<camera>.json, which runs use); an existing file only with --overwrite"},
                                {"--overwrite", "", "replace an existing -o file"},
                                {"--seed", "N", "seed (default 1)"},
                                {"--image-centre", "", "assume the mirror axis at the image centre instead of estimating it from the rim (saved only with -o)"}}};
 const cli::Command kColourCalibrate{"colour-calibrate", "FILE", 1, 1, "Learn the colour look-up table from labelled renders of the scenario's field.",
-                                    {{"-o", "TABLE.lut", "output table (default results/cache/colour_<camera>_<field>.lut); an existing file only with --overwrite"},
+                                    {{"-o", "TABLE.lut", "output table (default: the cache's vision/colour_v2_<camera>_<field>.lut, which runs use); an existing file only with --overwrite"},
                                      {"--overwrite", "", "replace an existing -o file"},
                                      {"--seed", "N", "seed (default 1)"}}};
 const cli::Command kValidate{"validate", "FILE...", 1, 1000000,
@@ -192,9 +193,9 @@ const cli::Command kSweep{"sweep", "SWEEP.json", 1, 1,
                            {"--aggregate-only", "", "run nothing, aggregate what is in the folder"},
                            {"--draw-each", "", "simulate and render every run itself (by default each world is drawn once per machine,\n"
                                                "kept in the world cache and replayed into every run of it: docs/recording.md)"},
-                           {"--cache", "DIR", "the world cache's folder (default: OMNILOC_CACHE, else results/cache/worlds)"},
-                           {"--no-cache", "", "no world cache: runs that differ only in a built-in vision localizer share one\n"
-                                              "recording in the sweep folder (recordings/), the others draw their own"},
+                           {"--cache", "DIR", "the cache root (default: OMNILOC_CACHE, else $XDG_CACHE_HOME/omniloc or ~/.cache/omniloc)"},
+                           {"--no-cache", "", "no cache at all (as OMNILOC_CACHE=off): runs that differ only in a built-in vision\n"
+                                              "localizer share one recording in the sweep folder (recordings/), the others draw their own"},
                            {"--stop-after", "N", "run at most N runs (integer >= 0; 0: all)"},
                            {"--debug-view", "", "every run also writes view.jsonl for `omniloc view` (docs/viewer.md)"},
                            {"--localizer", "JSON|FILE", "run these localizers instead of the file's (repeatable; inline JSON or a file holding\n"
@@ -438,7 +439,7 @@ int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
     so.task_args = {"--draw-each"};
   } else {
     const harness::WorldCacheOptions co = app::cache_options(a);
-    so.task_args = co.dir.empty() ? std::vector<std::string>{"--no-cache"} : std::vector<std::string>{"--cache", co.dir};
+    so.task_args = co.dir.empty() ? std::vector<std::string>{"--no-cache"} : std::vector<std::string>{"--cache", cache::root()};
   }
   const auto r = batch::submit_slurm(spec, a.positional[0], so);
   std::cout << r.message;
@@ -482,7 +483,8 @@ int cmd_sweep(const cli::Args& a) {
   // The runs (child processes) find the cache through the environment, by an absolute path.
   const harness::WorldCacheOptions co = app::cache_options(a);
   o.world_cache = o.share_worlds && !co.dir.empty();
-  ::setenv("OMNILOC_CACHE", co.dir.empty() ? "off" : co.dir.c_str(), 1);
+  const std::string root = cache::root();
+  ::setenv("OMNILOC_CACHE", root.empty() ? "off" : root.c_str(), 1);
   o.stop_after = static_cast<std::size_t>(a.integer("--stop-after", 0, 0, 1000000000));
   o.debug_view = a.has("--debug-view");
   o.out_dir = a.value("-o");
@@ -523,6 +525,8 @@ int cmd_calibrate(const cli::Args& a) {
   const bool image_centre = a.has("--image-centre");
   auto r = harness::calibrate_camera(cfg, seed, &report, image_centre ? harness::CentreSource::kImageCentre : harness::CentreSource::kRim);
   // An image-centre map is a comparison, not what runs should pick up from the cache.
+  // Runs compute the seed-1 map when the cache has none; another seed's map goes only where -o says.
+  if (!a.has("-o") && seed != 1 && !image_centre) throw UsageError("calibrate --seed " + std::to_string(seed) + " needs -o MAP.json: the cache holds the seed-1 map every run computes");
   const std::string out = a.value("-o", image_centre ? std::string() : harness::calibration_cache_file(cfg));
   if (!out.empty()) r.map.save(out);
   std::printf("directions used %d, rejected %d\n", r.directions_used, r.directions_rejected);
@@ -551,7 +555,9 @@ int cmd_colour_calibrate(const cli::Args& a) {
   const auto s = harness::load_scenario(a.positional[0]);
   const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
   const ColourTable t = harness::colour_calibrate(cfg, s.field, seed);
-  const std::string out = a.value("-o", "results/cache/colour_" + harness::camera_tag(cfg) + "_" + s.field.fingerprint() + ".lut");
+  if (!a.has("-o") && seed != 1) throw UsageError("colour-calibrate --seed " + std::to_string(seed) + " needs -o TABLE.lut: the cache holds the seed-1 table every run computes");
+  const std::string out = a.value("-o", harness::colour_table_cache_file(cfg, s.field));
+  if (out.empty()) throw UsageError("colour-calibrate needs -o TABLE.lut when the cache is off");
   t.save(out);
   std::cout << "wrote " << out << "\n";
   return 0;

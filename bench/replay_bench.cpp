@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "harness/cache_dirs.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/recording.hpp"
 #include "harness/runner.hpp"
@@ -83,7 +84,7 @@ static void BM_MatchingAloneOnTrackingFrames(benchmark::State& state) {
   }
   harness::LocalizerContext ctx;
   ctx.field = &sc.field;
-  ctx.cache_dir = "results/cache";
+  ctx.cache_dir = harness::build_cache_dir("fieldmaps");
   double n = 0;
   for (auto _ : state) {
     auto loc = harness::make_localizer(sc.localizer, "/localizer", ctx, nullptr);

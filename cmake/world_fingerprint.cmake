@@ -1,11 +1,13 @@
 # Run at every build: the fingerprint of everything in this source tree that determines a world's
 # frames (the world cache's key, harness/world_cache.cpp; docs/recording.md "World cache"): the
-# simulation, rendering, vision and recording code and the data they read. Written to OUT only when
+# simulation, rendering, vision and recording code and the data they read; and the distance table's
+# code, whose cached tables are kept per fingerprint too (harness/cache_dirs.hpp). Written to OUT only when
 # it changed, so an unchanged tree recompiles nothing. A change to any of these files gives every
 # world a new key: the cache misses rather than serve frames an older build drew.
 file(GLOB_RECURSE files RELATIVE "${SRC}"
      "${SRC}/core/*.cpp" "${SRC}/core/*.hpp" "${SRC}/sim/*.cpp" "${SRC}/sim/*.hpp"
      "${SRC}/localization/vision/*.cpp" "${SRC}/localization/vision/*.hpp" "${SRC}/localization/localizer.hpp"
+     "${SRC}/localization/field_map.cpp" "${SRC}/localization/field_map.hpp"
      "${SRC}/external/*.cpp" "${SRC}/external/*.hpp" "${SRC}/harness/*.cpp" "${SRC}/harness/*.hpp"
      "${SRC}/data/*.json" "${SRC}/data/*.yml" "${SRC}/data/*.yaml" "${SRC}/data/*.xml" "${SRC}/data/*.txt"
      "${SRC}/cmake/Dependencies.cmake" "${SRC}/CMakeLists.txt")

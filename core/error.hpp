@@ -23,4 +23,19 @@ class RuntimeFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The operating system refused an operation on a file or folder. what() names the action, the path
+/// and the cause in the system's words: "cannot write results/x.tmp: No space left on device".
+/// Callers that can go on without the file (the caches) tell it apart by type and path.
+class IoError : public RuntimeFailure {
+ public:
+  /// `err`: the errno value the system call left.
+  IoError(const std::string& action, std::string path, int err);
+  /// `why`: the cause in words, when it is not an errno value (std::error_code::message()).
+  IoError(const std::string& action, std::string path, const std::string& why);
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 }  // namespace omniloc

@@ -12,6 +12,7 @@
 #include "core/angles.hpp"
 #include "core/rng.hpp"
 #include "experiments/report_format.hpp"
+#include "harness/cache_dirs.hpp"
 #include "harness/camera_perception.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/vision_setup.hpp"
@@ -138,7 +139,7 @@ struct RenderedScene {
   const Cooperative001Config& c;
   const CoopRenderedConfig& g;
   const Eigen::Vector2d half;  ///< paper frame -> field frame: p - half
-  // Off-line set-up as a team does it (cached in results/cache): mirror calibration and colour table
+  // Off-line set-up as a team does it (cached in the cache root, core/cache_root.hpp): mirror calibration and colour table
   // for this camera and this field, then the robot-side detectors.
   CameraPerception rig;
   const Clock::time_point setup_done;
@@ -161,7 +162,7 @@ struct RenderedScene {
       LocalizerContext ctx;
       ctx.field = &g.field;
       ctx.seed = derive_seed(seed, "rendered/localizer");
-      ctx.cache_dir = "results/cache";
+      ctx.cache_dir = harness::build_cache_dir("fieldmaps");
       loc = make_localizer(g.localizer, "/rendered/self_localisation/localizer", ctx);
     }
   }

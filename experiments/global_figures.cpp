@@ -8,6 +8,7 @@
 
 #include "core/angles.hpp"
 #include "experiments/report_format.hpp"
+#include "harness/cache_dirs.hpp"
 #include "harness/camera_perception.hpp"
 #include "harness/field_picture.hpp"
 #include "harness/plot.hpp"
@@ -52,7 +53,7 @@ namespace {
 /// MCL convergence from a uniform cloud, the robot standing still (zero odometry) where the scene puts it.
 void mcl_convergence(const GlobalFiguresConfig& cfg, const Scenario& sc, const sim::WorldState& ws, int robot, double t, CameraPerception& perception,
                      Rng& mti, GlobalFiguresResult& r) {
-  McLLocalizer mcl(sc.field, McLParams{}, derive_seed(cfg.seed, "mcl"), "results/cache");
+  McLLocalizer mcl(sc.field, McLParams{}, derive_seed(cfg.seed, "mcl"), harness::build_cache_dir("fieldmaps"));
   mcl.reset(std::nullopt);
   Odometry still;
   std::size_t shot = 0;
@@ -84,7 +85,7 @@ GlobalFiguresResult compute_global_figures(const GlobalFiguresConfig& cfg) {
   r.field = sc.field;
   r.truth = ws.robot(robot)->pose;
   CameraPerception perception(sc, cfg.seed);
-  const FieldMap map(sc.field, 0.05, "results/cache");
+  const FieldMap map(sc.field, 0.05, harness::build_cache_dir("fieldmaps"));
 
   // Figure 7 / 9: the MTi heading is the true heading plus the robot profile's 1 degree of noise.
   Rng mti = Rng::stream(cfg.seed, "mti");

@@ -242,7 +242,11 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
   result.seed = opt.seed.value_or(sc.seed);
   RunDirectory dir(opt.out_dir.empty() ? "results/recordings/" + sc.name + "/" + std::to_string(result.seed) : opt.out_dir);
   LiveSource source(sc, result.seed, true);
-  if (opt.images) fs::create_directories(fs::path(dir.staging()) / "images");
+  if (opt.images) {
+    std::error_code ec;
+    fs::create_directories(fs::path(dir.staging()) / "images", ec);
+    if (ec) throw IoError("cannot create folder", (fs::path(dir.staging()) / "images").string(), ec.message());
+  }
   std::string frames;
   std::string timing = "k,robot,render_ms,vision_ms\n";  // wall time: the one file that differs between recordings of a run
   while (auto f = source.next()) {
@@ -257,7 +261,9 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
         if (r.obs.image) {
           const std::string path = (fs::path(dir.staging()) / image_name(r.id, f->k)).string();
           write_png(*r.obs.image, path);
-          result.image_bytes += fs::file_size(path);
+          std::error_code ec;
+          const auto bytes = fs::file_size(path, ec);
+          if (!ec) result.image_bytes += bytes;
         }
     ++result.frames;
     if (opt.log && f->k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && f->k > 0) *opt.log << "  t = " << f->t << " s\n";

@@ -68,7 +68,7 @@ RunDirectory::RunDirectory(std::string final_dir) : final_(std::move(final_dir))
   // Watched before it exists: an interruption between the two leaves nothing behind.
   watch_slot_ = interrupt::watch_folder(staging_.c_str());
   fs::create_directories(staging_, ec);
-  if (ec) throw RuntimeFailure("cannot create " + staging_ + ": " + ec.message());
+  if (ec) throw IoError("cannot create folder", staging_, ec.message());
 }
 
 RunDirectory::~RunDirectory() {
@@ -94,12 +94,12 @@ void RunDirectory::commit() {
   watch_slot_ = -1;
   const std::string old = staging_ + ".old";
   fs::remove_all(old, ec);
-  if (fs::exists(final_)) {
+  if (fs::exists(final_, ec)) {
     fs::rename(final_, old, ec);
-    if (ec) throw RuntimeFailure("cannot move old results " + final_ + " aside: " + ec.message());
+    if (ec) throw IoError("cannot move aside the old results", final_, ec.message());
   }
   fs::rename(staging_, final_, ec);
-  if (ec) throw RuntimeFailure("cannot rename " + staging_ + " to " + final_ + ": " + ec.message());
+  if (ec) throw IoError("cannot rename " + staging_ + " to", final_, ec.message());
   committed_ = true;
   const fs::path f(final_);
   fsync_dir(f.has_parent_path() ? f.parent_path().string() : std::string("."));

@@ -8,8 +8,10 @@
 #include <memory>
 #include <ostream>
 
+#include "core/atomic_file.hpp"
 #include "core/version.hpp"
 #include "external/external_localizer.hpp"
+#include "harness/cache_dirs.hpp"
 #include "harness/external_session.hpp"
 #include "harness/frame_source.hpp"
 #include "harness/localizer_registry.hpp"
@@ -47,7 +49,7 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
     LocalizerContext ctx;
     ctx.field = &sc.field;
     ctx.seed = derive_seed(seed, "localizer/" + std::to_string(id));
-    ctx.cache_dir = "results/cache";
+    ctx.cache_dir = build_cache_dir("fieldmaps");
     external::Session session;
     if (info.type == "external") {
       session = make_session(sc, id, source.client_camera(id), source.detects_blobs(), ctx.seed, log_dir);
@@ -229,8 +231,8 @@ RunResult run_frames_after_hello(const Scenario& sc, std::uint64_t seed, const F
                       "frames with images: this recording was made without them (omniloc record --images)");
   const bool strip = opt.replay && !info.needs_vision;
   // Streamed into the staging folder: 60 s with 200 particles a frame is about 38 MB.
-  std::unique_ptr<std::ofstream> view;
-  if (opt.debug_view) view = std::make_unique<std::ofstream>(std::filesystem::path(dir.staging()) / "view.jsonl", std::ios::binary);
+  std::unique_ptr<StreamFile> view;
+  if (opt.debug_view) view = std::make_unique<StreamFile>((std::filesystem::path(dir.staging()) / "view.jsonl").string());
 
   // perceive (the source) -> localize -> record, at every camera frame (the first at t = 0 before any motion).
   while (auto frame = source.next()) {
@@ -241,16 +243,13 @@ RunResult run_frames_after_hello(const Scenario& sc, std::uint64_t seed, const F
     for (std::size_t i = 0; i < tracked.size(); ++i) {
       if (strip) without_vision(frame->robots[i]);
       const Estimate est = robot_frame(tracked[i], frame->robots[i], frame->k, opt, log);
-      if (view) *view << view_line(tracked[i], frame->robots[i], frame->k, est, opt.debug_particles);
+      if (view) view->write(view_line(tracked[i], frame->robots[i], frame->k, est, opt.debug_particles));
     }
     if (opt.log && frame->k % static_cast<long long>(std::max(1.0, 10 * sc.camera_rate)) == 0 && frame->k > 0)
       *opt.log << "  t = " << frame->t << " s\n";
   }
   for (auto& tr : tracked) tr.localizer->finish();  // an external client must end cleanly, or the run fails
-  if (view) {
-    view->close();
-    if (!*view) throw RuntimeFailure("cannot write view.jsonl into " + dir.staging());
-  }
+  if (view) view->close();
   const std::string name = tracked.empty() ? info.type : tracked.front().localizer->name();
   const Json external = tracked.empty() ? Json(nullptr) : tracked.front().localizer->provenance();
   const bool start_pose_given = !tracked.empty() && tracked.front().start_pose_given;

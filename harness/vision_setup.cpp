@@ -7,9 +7,11 @@
 #include <sstream>
 
 #include "core/angles.hpp"
+#include "core/cache_root.hpp"
 #include "core/calibration_patch.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
+#include "harness/cache_dirs.hpp"
 #include "harness/metrics.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
@@ -26,7 +28,24 @@ std::string fnv_hex(const std::string& s) {
   os << std::hex << h;
   return os.str();
 }
-const char* kCache = "results/cache";
+ 
+// A map or table computed because none was cached is kept for the next run; a cache that cannot be
+// written only costs the computation next time (said once per process).
+template <typename T>
+void keep(const T& value, const std::string& file) {
+  if (file.empty() || cache::unwritable()) return;
+  try {
+    value.save(file);
+  } catch (const IoError& e) {
+    cache::report_unwritable(e.what());
+  }
+}
+
+// A cached file is used when it is a regular file that loads; anything else is computed again.
+bool cached(const std::string& file) {
+  std::error_code ec;
+  return !file.empty() && std::filesystem::is_regular_file(file, ec);
+}
 }  // namespace
 
 std::string camera_tag(const sim::CameraConfig& cfg) {
@@ -204,7 +223,14 @@ CalibrationMap exact_calibration(const sim::CameraConfig& cfg) {
 std::string calibration_cache_file(const sim::CameraConfig& cfg) {
   // v2: the mirror axis is estimated from the rim (docs/camera.md "The mirror centre"); "calibration_<tag>" files took the
   // image centre and are not reused.
-  return std::string(kCache) + "/calibration_v2_" + camera_tag(cfg) + ".json";
+  const std::string dir = build_cache_dir("vision");
+  return dir.empty() ? dir : dir + "/calibration_v2_" + camera_tag(cfg) + ".json";
+}
+
+std::string colour_table_cache_file(const sim::CameraConfig& cfg, const Field& field) {
+  // v2: learned over a range of exposures (colour_calibrate).
+  const std::string dir = build_cache_dir("vision");
+  return dir.empty() ? dir : dir + "/colour_v2_" + camera_tag(cfg) + "_" + field.fingerprint() + ".lut";
 }
 
 CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed) {
@@ -212,7 +238,7 @@ CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& 
   if (path == "exact") return exact_calibration(cfg);
   if (path != "auto") return CalibrationMap::load(path, tag, cfg.width, cfg.height);
   const std::string file = calibration_cache_file(cfg);
-  if (std::filesystem::exists(file)) {
+  if (cached(file)) {
     try {
       return CalibrationMap::load(file, tag, cfg.width, cfg.height);
     } catch (const ConfigError&) {
@@ -222,15 +248,14 @@ CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& 
   // The cached map must not depend on which run made it first: a fixed seed, not the run's.
   (void)seed;
   CalibrationResult r = calibrate_camera(cfg, 1);
-  r.map.save(file);
+  keep(r.map, file);
   return r.map;
 }
 
 ColourTable colour_table_for(const sim::CameraConfig& cfg, const Field& field, const std::string& path, std::uint64_t seed) {
   if (path != "auto") return ColourTable::load(path, field.fingerprint());
-  // v2: learned over a range of exposures (colour_calibrate).
-  const std::string file = std::string(kCache) + "/colour_v2_" + camera_tag(cfg) + "_" + field.fingerprint() + ".lut";
-  if (std::filesystem::exists(file)) {
+  const std::string file = colour_table_cache_file(cfg, field);
+  if (cached(file)) {
     try {
       return ColourTable::load(file, field.fingerprint());
     } catch (const ConfigError&) {
@@ -238,7 +263,7 @@ ColourTable colour_table_for(const sim::CameraConfig& cfg, const Field& field, c
   }
   (void)seed;
   ColourTable t = colour_calibrate(cfg, field, 1);
-  t.save(file);
+  keep(t, file);
   return t;
 }
 

@@ -2,7 +2,8 @@
 // Off-line vision set-up, as a team does it before a match: the model-free mirror calibration
 // (`omniloc calibrate`) and the colour table (`omniloc colour-calibrate`), both produced by rendering
 // with the simulated camera and processing the images with the robot-side code. Results are cached in
-// results/cache/ under a hash of the camera configuration (and field), so runs share them.
+// the cache root's vision/ folder (core/cache_root.hpp) under a hash of the camera configuration (and
+// field), so runs share them.
 #include <cstdint>
 #include <string>
 
@@ -32,13 +33,17 @@ ColourTable colour_calibrate(const sim::CameraConfig& cfg, const Field& field, s
 /// Tag identifying a camera configuration (what a calibration map was made for).
 std::string camera_tag(const sim::CameraConfig& cfg);
 
-/// The cache file of `cfg`'s calibration map (results/cache/calibration_v2_<tag>.json).
+/// The cache file of `cfg`'s calibration map (<cache root>/vision/calibration_v2_<tag>.json); "" when
+/// caching is off.
 std::string calibration_cache_file(const sim::CameraConfig& cfg);
+/// The cache file of the colour table for `cfg` on `field` (<cache root>/vision/colour_v2_<tag>_<field>.lut);
+/// "" when caching is off.
+std::string colour_table_cache_file(const sim::CameraConfig& cfg, const Field& field);
 /// The map for `cfg`: from `path` when given ("auto" = cached, calibrating when missing).
 /// A perfect calibration: the simulator's true mirror profile and centre in the map's format (no
 /// tilt). A measurement-model baseline for the error budget ("calibration": "exact"), never a default.
 CalibrationMap exact_calibration(const sim::CameraConfig& cfg);
-/// "auto": the model-free calibration (cached under results/cache), "exact": exact_calibration, else a map file.
+/// "auto": the model-free calibration (cached in the cache root), "exact": exact_calibration, else a map file.
 CalibrationMap calibration_for(const sim::CameraConfig& cfg, const std::string& path, std::uint64_t seed);
 /// The colour table for `cfg` and `field`: from `path` when given ("auto" = cached or learned).
 ColourTable colour_table_for(const sim::CameraConfig& cfg, const Field& field, const std::string& path, std::uint64_t seed);

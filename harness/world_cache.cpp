@@ -17,6 +17,7 @@
 #include <opencv2/core/version.hpp>
 
 #include "core/atomic_file.hpp"
+#include "core/cache_root.hpp"
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "external/sha256.hpp"
@@ -140,9 +141,7 @@ std::string format_bytes(std::uint64_t b) {
 
 WorldCacheOptions world_cache_from_env() {
   WorldCacheOptions o;
-  const char* dir = std::getenv("OMNILOC_CACHE");
-  const std::string d = dir ? dir : "results/cache/worlds";
-  if (d != "off" && d != "0" && !d.empty()) o.dir = fs::absolute(d).lexically_normal().string();
+  o.dir = cache::dir("worlds");
   const char* max = std::getenv("OMNILOC_CACHE_MAX_SIZE");
   o.max_bytes = max ? parse_byte_size(max, "OMNILOC_CACHE_MAX_SIZE") : kDefaultMaxBytes;
   return o;
@@ -167,8 +166,9 @@ std::string world_key(const Scenario& sc, std::uint64_t seed, bool images) {
       const std::string v = world["vision"].value(k, std::string("auto"));
       if (v == "auto" || v == "exact") continue;
       fs::path p = v;
-      if (p.is_relative() && !fs::exists(p) && !sc.source.empty()) p = fs::path(sc.source).parent_path() / v;
-      files[k] = fs::exists(p) ? external::sha256_file(p.string()) : std::string("missing");
+      std::error_code ec;
+      if (p.is_relative() && !fs::exists(p, ec) && !sc.source.empty()) p = fs::path(sc.source).parent_path() / v;
+      files[k] = fs::is_regular_file(p, ec) ? external::sha256_file(p.string()) : std::string("missing");
     }
   const Json key = {{"cache", kManifestFormat},   {"world", world},
                     {"seed", seed},               {"noise_profile", sc.noise.name},
@@ -187,11 +187,21 @@ WorldCache::WorldCache(WorldCacheOptions o) : o_(std::move(o)) {}
 std::string WorldCache::entry_dir(const std::string& key) const { return (fs::path(o_.dir) / key).string(); }
 
 int WorldCache::lock(const std::string& key) const {
+  try {
+    return open_lock(key);
+  } catch (const IoError& e) {
+    throw WorldCacheUnwritable(e);
+  }
+}
+
+int WorldCache::open_lock(const std::string& key) const {
   const fs::path locks = fs::path(o_.dir) / ".locks";
-  fs::create_directories(locks);
+  std::error_code ec;
+  fs::create_directories(locks, ec);
+  if (ec) throw IoError("cannot create folder", locks.string(), ec.message());
   const std::string path = (locks / (key + ".lock")).string();
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) throw RuntimeFailure("world cache: cannot create lock " + path + ": " + std::strerror(errno));
+  if (fd < 0) throw IoError("cannot create lock", path, errno);
   return fd;
 }
 
@@ -267,9 +277,13 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
         }
         // Always said, even by a quiet run: the cache was not what it claimed to be.
         std::cerr << "omniloc: world cache entry " << dir.string() << " is damaged (" << why << "): removed, drawing it again\n";
-        fs::remove_all(dir);
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+        if (ec) throw IoError("cannot remove the damaged entry", dir.string(), ec.message());
       }
-      fs::create_directories(o_.dir);
+      std::error_code ec;
+      fs::create_directories(o_.dir, ec);
+      if (ec) throw IoError("cannot create folder", o_.dir, ec.message());
       remove_stale_partials(o_.dir);
       Scenario world = sc;
       world.input.erase("localizer");  // the recording keeps no localizer; every run replays it with its own
@@ -297,6 +311,14 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
       }
       return WorldLease(dir.string(), key, true, fd);
     }
+  } catch (const IoError& e) {
+    ::close(fd);
+    // Only a failure to write the cache itself is the cache's; it leaves no partial entry (the
+    // recording's staging folder is gone already: RunDirectory removes it when not committed).
+    if (e.path().rfind(o_.dir + "/", 0) != 0 && e.path() != o_.dir) throw;
+    std::error_code ec;
+    if (!fs::exists(dir / kManifest, ec)) fs::remove_all(dir, ec);
+    throw WorldCacheUnwritable(e);
   } catch (...) {
     ::close(fd);
     throw;
@@ -351,18 +373,9 @@ PruneResult WorldCache::prune(std::optional<double> older_than_s, std::optional<
       ++r.kept;
       continue;
     }
-    // An entry in use (a run replaying it holds its lock shared) or being drawn is kept.
-    const int fd = lock(e.key);
-    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-      ::close(fd);
-      ++r.busy;
-      ++r.kept;
-      continue;
-    }
-    std::error_code ec;
-    fs::remove_all(entry_dir(e.key), ec);
-    ::close(fd);
-    if (ec) {
+    const Removal how = remove(e.key);
+    if (how != Removal::kRemoved) {
+      r.busy += how == Removal::kBusy ? 1 : 0;
       ++r.kept;
       continue;
     }
@@ -374,8 +387,22 @@ PruneResult WorldCache::prune(std::optional<double> older_than_s, std::optional<
   return r;
 }
 
+WorldCache::Removal WorldCache::remove(const std::string& key) {
+  // An entry in use (a run replaying it holds its lock shared) or being drawn is kept.
+  const int fd = lock(key);
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd);
+    return Removal::kBusy;
+  }
+  std::error_code ec;
+  fs::remove_all(entry_dir(key), ec);
+  ::close(fd);
+  return ec ? Removal::kFailed : Removal::kRemoved;
+}
+
 RunResult run_with_world_cache(const Scenario& sc, const RunOptions& opt, WorldCache& cache) {
-  const std::string why = world_cache_ineligible(sc, opt);
+  std::string why = world_cache_ineligible(sc, opt);
+  if (why.empty() && cache::unwritable()) why = "it cannot be written";
   if (cache.options().dir.empty() || !why.empty()) {
     if (opt.log && !cache.options().dir.empty()) *opt.log << "  world cache: not used (" << why << ")\n";
     return run_scenario(sc, opt);
@@ -385,11 +412,20 @@ RunResult run_with_world_cache(const Scenario& sc, const RunOptions& opt, WorldC
   o.replay = true;
   std::optional<WorldLease> lease;
   std::unique_ptr<RecordingSource> source;
+  std::unique_ptr<LiveSource> live;  // the world drawn as the run goes, when the cache cannot be written
   const auto open = [&](bool images, Json& provenance) -> FrameSource& {
-    if (!lease || lease->key() != world_key(sc, seed, images)) {
-      source.reset();
-      lease.reset();
-      lease.emplace(cache.get(sc, seed, images));
+    try {
+      if (!lease || lease->key() != world_key(sc, seed, images)) {
+        source.reset();
+        lease.reset();
+        lease.emplace(cache.get(sc, seed, images));
+      }
+    } catch (const WorldCacheUnwritable& e) {
+      // The cache never costs a run: the same frames come from the live world (what --no-cache runs).
+      cache::report_unwritable(e.what());
+      live = std::make_unique<LiveSource>(sc, seed, true);
+      if (const auto dev = live->perception().render_device()) provenance["render"] = dev->to_json();
+      return *live;
     }
     source = std::make_unique<RecordingSource>(RecordingHeader::read(lease->dir()));
     if (!source->header().render.is_null()) provenance["render"] = source->header().render;
@@ -405,8 +441,11 @@ RunResult run_with_world_cache(const Scenario& sc, const RunOptions& opt, WorldC
   // wants images. They come from an entry already there, else from the live world set up for them.
   std::unique_ptr<FrameSource> hello;
   for (const bool images : {false, true})
-    if (!lease)
-      if (auto l = cache.find(world_key(sc, seed, images))) lease.emplace(std::move(*l));
+    if (!lease) try {
+        if (auto l = cache.find(world_key(sc, seed, images))) lease.emplace(std::move(*l));
+      } catch (const WorldCacheUnwritable&) {
+        // No lock can be taken: nothing to find; get() says why when the frames are wanted.
+      }
   if (lease) {
     if (opt.log) *opt.log << "  world cache: " << sc.name << ", seed " << seed << " from " << lease->dir() << "\n";
     hello = std::make_unique<RecordingSource>(RecordingHeader::read(lease->dir()));

@@ -3,7 +3,7 @@
 // a world (a scenario without its localizer, a seed) is drawn once, whichever sweep folder, `omniloc
 // run`, shard or Slurm task needs it, and every later run with a localizer replays it.
 //
-// An entry is a recording folder under <cache>/worlds/<key>/ with a manifest (entry.json: the size
+// An entry is a recording folder under <cache root>/worlds/<key>/ (core/cache_root.hpp) with a manifest (entry.json: the size
 // and SHA-256 of every file) and a `last_used` stamp. The key is the SHA-256 of everything that
 // determines the frames: the scenario's effective configuration without the localizer, name,
 // description and scoring; the seed; the noise profile; the field's geometry; the content of every
@@ -14,7 +14,8 @@
 // Concurrency: one lock file per key. A run holds it shared while it replays the entry; drawing an
 // entry, removing a damaged one and eviction hold it exclusively (eviction skips entries in use).
 // A damaged entry (a file cut, changed, missing; no manifest) is reported on one line, removed and
-// drawn again: never used.
+// drawn again: never used. A cache that cannot be written (a full disk, a read-only folder, no
+// permission) never costs a run: run_with_world_cache runs it live instead, with one warning.
 #include <cstdint>
 #include <ctime>
 #include <optional>
@@ -22,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 
@@ -33,9 +35,8 @@ struct WorldCacheOptions {
   std::ostream* log = nullptr;    ///< one line per hit, draw, damaged entry and eviction
 };
 
-/// The default: results/cache/worlds under the working directory, 20 GiB at most. The environment
-/// overrides it: OMNILOC_CACHE (a folder, or "off" / "0" for none) and OMNILOC_CACHE_MAX_SIZE (bytes,
-/// or with K, M, G, T: "500M").
+/// The cache root's worlds/ folder (core/cache_root.hpp: OMNILOC_CACHE, else the XDG cache folder),
+/// 20 GiB at most, or OMNILOC_CACHE_MAX_SIZE (bytes, or with K, M, G, T: "500M").
 WorldCacheOptions world_cache_from_env();
 /// "20G", "500M", "1048576": bytes. Throws ConfigError naming `what` otherwise.
 std::uint64_t parse_byte_size(const std::string& text, const std::string& what);
@@ -70,6 +71,13 @@ class WorldLease {
   int fd_ = -1;
 };
 
+/// The world cache could not be written (a full disk, a read-only folder, no permission, a quota):
+/// what() has the file and the system's words. The partial entry is removed before it is thrown.
+class WorldCacheUnwritable : public IoError {
+ public:
+  explicit WorldCacheUnwritable(const IoError& e) : IoError(e) {}
+};
+
 struct WorldEntryInfo {
   std::string key;
   std::string scenario;
@@ -93,17 +101,22 @@ class WorldCache {
   /// The entry of `key` if it is there and whole (checked against its manifest), held shared.
   std::optional<WorldLease> find(const std::string& key);
   /// The entry of (`sc`, `seed`, `images`): found, or drawn now (record_scenario) while other
-  /// processes wanting it wait; a damaged one is removed and drawn again.
+  /// processes wanting it wait; a damaged one is removed and drawn again. Throws WorldCacheUnwritable
+  /// when the entry cannot be written, leaving no partial entry.
   WorldLease get(const Scenario& sc, std::uint64_t seed, bool images);
   std::vector<WorldEntryInfo> list() const;
   std::uint64_t size() const;
   /// Removes entries unused for more than `older_than_s` seconds, then the least recently used ones
   /// until the cache holds at most `max_bytes`; entries in use are kept.
   PruneResult prune(std::optional<double> older_than_s, std::optional<std::uint64_t> max_bytes);
+  enum class Removal { kRemoved, kBusy, kFailed };
+  /// Removes the entry of `key` unless a run replays it or draws it now (kBusy).
+  Removal remove(const std::string& key);
 
  private:
   std::string entry_dir(const std::string& key) const;
-  int lock(const std::string& key) const;
+  int lock(const std::string& key) const;       ///< the key's lock file, open; WorldCacheUnwritable when it cannot be
+  int open_lock(const std::string& key) const;  ///< lock()'s work, throwing IoError
   std::string damage(const std::string& key) const;  ///< why the entry is not whole ("" when it is)
   WorldCacheOptions o_;
 };
@@ -112,7 +125,8 @@ class WorldCache {
 /// miss) when world_cache_ineligible() is empty, else run live. The run folder is byte-identical to
 /// the live run's but for summary.json's provenance block ("world_cache": the key) and timing.csv's
 /// wall-clock times. External clients are started first: the entry is drawn with images when the
-/// client's `ready` asks for them.
+/// client's `ready` asks for them. When the cache cannot be written the run goes on live (uncached),
+/// after one warning line on stderr naming the cause.
 RunResult run_with_world_cache(const Scenario& sc, const RunOptions& opt, WorldCache& cache);
 
 }  // namespace omniloc::harness

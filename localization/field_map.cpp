@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/atomic_file.hpp"
+#include "core/cache_root.hpp"
 
 namespace omniloc {
 
@@ -27,7 +28,8 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   // table holds the same float values.
   std::ostringstream header;
   header << "omniloc-fieldmap 1 " << fingerprint_ << " " << cell << " " << nx << " " << ny << "\n";
-  if (!file.empty() && std::filesystem::exists(file)) {
+  std::error_code ec;
+  if (!file.empty() && std::filesystem::is_regular_file(file, ec)) {
     std::ifstream in(file, std::ios::binary);
     std::string line;
     std::getline(in, line);
@@ -43,14 +45,15 @@ FieldMap::FieldMap(const Field& field, double cell, const std::string& cache_dir
   }
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) grid_[static_cast<std::size_t>(j) * nx + i] = static_cast<float>(field.distance_to_marking({x0 + i * cell, y0 + j * cell}));
-  if (!file.empty()) {
+  if (!file.empty() && !cache::unwritable()) {
     std::string out = header.str();
     const std::vector<float> stored(grid_.begin(), grid_.end());
     out.append(reinterpret_cast<const char*>(stored.data()), stored.size() * sizeof(float));
     try {
       write_file_atomic(file, out);
-    } catch (const std::exception&) {
-      // A read-only cache folder only costs the rebuild next time.
+    } catch (const std::exception& e) {
+      // A full or read-only cache only costs the rebuild next time; said once.
+      cache::report_unwritable(e.what());
     }
   }
 }
