@@ -45,7 +45,9 @@ else
   build/icount --list | awk '{print $1}' >"$work/names"
 fi
 # Calibration maps, colour tables and distance maps are cached on disk first, natively, so that no
-# workload's count (or time) depends on whether a cache was warm.
+# workload's count (or time) depends on whether a cache was warm. In a cache root of the build's own
+# (docs/recording.md section 9), never the user's.
+export OMNILOC_CACHE="$PWD/build/icount_cache"
 build/icount --prepare
 # Mesa's on-disk shader cache (~/.cache/mesa_shader_cache): llvmpipe compiles a shader it has not
 # cached with LLVM, inside the counted region, so a cold or partly warm cache put 10-16 % on

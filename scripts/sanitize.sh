@@ -27,10 +27,12 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # signal 11", google/sanitizers#1353) in processes with many threads, which fails a run that passed;
 # the images are byte-identical with any thread count (docs/performance.md).
 export LP_NUM_THREADS=0
-# The worlds these tests draw go to a cache of their own, emptied first (scripts/test.sh does the same
-# for the normal build), never into the clone's results/cache.
+# Every cache these tests fill goes to a root of their own, emptied first, and their temporary folders
+# into the build tree (scripts/test.sh does the same for the normal build), never the user's.
 export OMNILOC_CACHE="$PWD/build-asan/test_world_cache"
 rm -rf "$OMNILOC_CACHE"
+export TMPDIR="$PWD/build-asan/test_tmp"
+rm -rf "$TMPDIR" && mkdir -p "$TMPDIR"
 cd build-asan
 # Test programs of the scenario label are not built here: ctest would report them as missing.
 # -E _NOT_BUILT: gtest_discover_tests adds a failing placeholder for each test program not built here.

@@ -64,7 +64,7 @@ class Recording(unittest.TestCase):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
     def omniloc(self, *args, check=True, cache="cache"):
-        # A world cache of this test's own (docs/recording.md section 9), never the source tree's.
+        # A cache root of this test's own (docs/recording.md section 9), never the user's.
         env = dict(os.environ, OMNILOC_CACHE=str(self.tmp / cache))
         r = subprocess.run([BIN, *args], cwd=ROOT, capture_output=True, text=True, timeout=600, env=env)
         if check and r.returncode != 0:
@@ -142,7 +142,7 @@ class Recording(unittest.TestCase):
                     self.assertEqual(live, wire[mode].read_bytes(), f"{mode}: messages differ")
                     self.assertTrue(json.loads((self.tmp / f"{mode}_ext_{tag}" / "summary.json").read_text())["omniloc"]["world_cache"])
                     self.assert_same_run(self.tmp / f"live_ext_{tag}", self.tmp / f"{mode}_ext_{tag}", command_differs=True)
-                cached = [p for p in (self.tmp / f"ext_cache_{tag}").iterdir() if not p.name.startswith(".")]
+                cached = [p for p in (self.tmp / f"ext_cache_{tag}" / "worlds").iterdir() if not p.name.startswith(".")]
                 self.assertEqual(len(cached), 1)
                 self.assertEqual(json.loads((cached[0] / "entry.json").read_text())["images"], images)
                 self.assertGreater(live.count(b'"type":"frame"'), 80)
@@ -183,7 +183,7 @@ class Recording(unittest.TestCase):
         self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(folder), "--no-cache", cache="sweep_cache")
         # The world cache: one world per seed, drawn once and replayed into matching, hybrid and the
         # client (which wants no images); odometry_only runs live. Nothing in the sweep folder.
-        entries = sorted(p.name for p in (self.tmp / "sweep_cache").iterdir() if not p.name.startswith("."))
+        entries = sorted(p.name for p in (self.tmp / "sweep_cache" / "worlds").iterdir() if not p.name.startswith("."))
         self.assertEqual(len(entries), 2)
         self.assertFalse((shared / "recordings").exists())
         # Without the cache: one recording per seed in the sweep folder, shared by matching and hybrid.
@@ -202,12 +202,12 @@ class Recording(unittest.TestCase):
         replayed = [r for r in runs if "replay" in json.loads((folder / "runs" / r / "summary.json").read_text())["omniloc"]]
         self.assertEqual(sorted(replayed), sorted(r for r in runs if "__matching__" in r or "__hybrid__" in r))
         # A second sweep of the same worlds with other localizers, into another folder: nothing drawn.
-        stamps = {e: (self.tmp / "sweep_cache" / e / "last_used").stat().st_mtime_ns for e in entries}
+        stamps = {e: (self.tmp / "sweep_cache" / "worlds" / e / "last_used").stat().st_mtime_ns for e in entries}
         again = self.tmp / "sweep_again"
         r = self.omniloc("sweep", str(sweep), "-j", "2", "-o", str(again), "--localizer", '{"type": "mcl", "particles": 200}', cache="sweep_cache")
-        self.assertEqual(sorted(p.name for p in (self.tmp / "sweep_cache").iterdir() if not p.name.startswith(".")), entries)
+        self.assertEqual(sorted(p.name for p in (self.tmp / "sweep_cache" / "worlds").iterdir() if not p.name.startswith(".")), entries)
         for e in entries:
-            self.assertGreaterEqual((self.tmp / "sweep_cache" / e / "last_used").stat().st_mtime_ns, stamps[e])
+            self.assertGreaterEqual((self.tmp / "sweep_cache" / "worlds" / e / "last_used").stat().st_mtime_ns, stamps[e])
         for run in (again / "runs").iterdir():
             self.assertIn(json.loads((run / "summary.json").read_text())["omniloc"].get("world_cache"), entries, run.name)
 
