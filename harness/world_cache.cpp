@@ -56,6 +56,13 @@ const std::string& osmesa_identity() {
   return id;
 }
 
+// Whether a path of the cache exists; a path the system cannot look at (a name too long, a loop of
+// links) is not there, and writing it then says why (IoError), which never costs a run.
+bool there(const fs::path& p) {
+  std::error_code ec;
+  return fs::exists(p, ec);
+}
+
 std::uint64_t folder_bytes(const fs::path& dir) {
   std::uint64_t n = 0;
   std::error_code ec;
@@ -208,7 +215,7 @@ int WorldCache::open_lock(const std::string& key) const {
 std::string WorldCache::damage(const std::string& key) const {
   const fs::path dir = entry_dir(key);
   const fs::path manifest = dir / kManifest;
-  if (!fs::exists(manifest)) return "no " + std::string(kManifest) + ": its drawing was interrupted";
+  if (!there(manifest)) return "no " + std::string(kManifest) + ": its drawing was interrupted";
   Json m;
   try {
     m = read_json_strict(manifest.string(), manifest.string());
@@ -235,10 +242,10 @@ std::string WorldCache::damage(const std::string& key) const {
 }
 
 std::optional<WorldLease> WorldCache::find(const std::string& key) {
-  if (o_.dir.empty() || !fs::exists(entry_dir(key))) return std::nullopt;
+  if (o_.dir.empty() || !there(entry_dir(key))) return std::nullopt;
   const int fd = lock(key);
   flock_retry(fd, LOCK_SH);
-  if (fs::exists(entry_dir(key)) && damage(key).empty()) {
+  if (there(entry_dir(key)) && damage(key).empty()) {
     touch(fs::path(entry_dir(key)) / kLastUsed);
     return WorldLease(entry_dir(key), key, false, fd);
   }
@@ -254,12 +261,12 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
   // another process may take the key and remove the entry. Then the entry is looked up again.
   auto still_there_shared = [&] {
     flock_retry(fd, LOCK_SH);
-    return fs::exists(dir / kManifest);
+    return there(dir / kManifest);
   };
   try {
     for (;;) {
       flock_retry(fd, LOCK_SH);
-      if (fs::exists(dir) && damage(key).empty()) {
+      if (there(dir) && damage(key).empty()) {
         touch(dir / kLastUsed);
         if (o_.log) *o_.log << "  world cache: " << sc.name << ", seed " << seed << " from " << dir.string() << "\n";
         return WorldLease(dir.string(), key, false, fd);
@@ -267,7 +274,7 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
       // Drawing needs the key alone; whoever holds it may be drawing the same world right now.
       flock_retry(fd, LOCK_UN);
       flock_retry(fd, LOCK_EX);
-      if (fs::exists(dir)) {
+      if (there(dir)) {
         const std::string why = damage(key);
         if (why.empty()) {
           touch(dir / kLastUsed);

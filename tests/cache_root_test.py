@@ -167,21 +167,22 @@ class CacheRoot(unittest.TestCase):
             self.assert_same_as_reference(out / name)
 
     def test_a_root_that_cannot_be_created_costs_no_run(self):
-        # A component of the root is a file: the system says "Not a directory" (also as root).
+        # A component of the root is a file ("Not a directory"), a name over NAME_MAX ("File name too
+        # long"): the system refuses both, also to root.
         cwd, out = self.fresh("cwd_nodir"), self.fresh("out_nodir")
         (cwd / "afile").write_text("not a folder\n")
-        env = clean_env(HOME=str(self.tmp / "home_nodir"), OMNILOC_CACHE=str(cwd / "afile" / "cache"))
-        r = self.omniloc("run", str(self.scenario), "-o", str(out / "run"), "--quiet", env=env, cwd=cwd)
-        warnings = [line for line in r.stderr.splitlines() if line.startswith(WARNING)]
-        self.assertEqual(len(warnings), 1, r.stderr)
-        self.assertIn("Not a directory", warnings[0])
-        self.assertIn("going on without it", warnings[0])
-        self.assert_same_as_reference(out / "run")
-        self.assertEqual(files_under(cwd), ["afile"])
-        r = self.omniloc("replay", str(self.reference), "--localizer", '{"type": "matching"}', "-o", str(out / "rep"), "--quiet",
-                         env=env, cwd=cwd, expect=None)
-        # A run folder is no recording: exit 2 naming what is missing, before any cache is touched.
-        self.assertEqual(r.returncode, 2, r.stderr)
+        for name, root, cause in (("nodir", cwd / "afile" / "cache", "Not a directory"), ("long", cwd / ("x" * 300) / "cache", "File name too long")):
+            with self.subTest(root=name):
+                env = clean_env(HOME=str(self.tmp / "home_nodir"), OMNILOC_CACHE=str(root))
+                r = self.omniloc("run", str(self.scenario), "-o", str(out / name), "--quiet", env=env, cwd=cwd)
+                warnings = [line for line in r.stderr.splitlines() if line.startswith(WARNING)]
+                self.assertEqual(len(warnings), 1, r.stderr)
+                self.assertIn(cause, warnings[0])
+                self.assertIn("going on without it", warnings[0])
+                self.assert_same_as_reference(out / name)
+                self.assertEqual(files_under(cwd), ["afile"])
+                r = self.omniloc("cache", "list", env=env, cwd=cwd)
+                self.assertTrue(r.stdout.splitlines()[-1].startswith("0 entries, "), r.stdout)
 
 
 @unittest.skipUnless(namespaces_work(), "unshare --user --mount is refused here: no small file system can be mounted without root")
