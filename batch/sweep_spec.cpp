@@ -132,7 +132,9 @@ ScenarioEntry read_recording_entry(const Json& entry, const std::string& sp, con
   er.finish();
   fs::path p = rel;
   if (p.is_relative()) p = base / p;
-  sc.recording = fs::absolute(p).lexically_normal().string();
+  std::error_code ec;
+  sc.recording = fs::absolute(p, ec).lexically_normal().string();
+  if (ec) throw ConfigError(json_child(sp, "recording"), path_value(p.string(), ec.message()), "a recording folder (relative to the sweep file)");
   try {
     sc.header = harness::RecordingHeader::read(sc.recording);
   } catch (const ConfigError& e) {
@@ -162,7 +164,7 @@ ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, cons
     throw ConfigError(fp, json_brief(*file), "a scenario file path (relative to the sweep file), or {\"file\": path, \"parameters\": ..., \"localizers\": ...}");
   fs::path p = file->get<std::string>();
   if (p.is_relative()) p = base / p;
-  if (!fs::exists(p)) throw ConfigError(fp, json_brief(*file), "an existing scenario file (looked for " + p.string() + ")");
+  require_readable_file(p.string(), fp, "a readable scenario file (relative to the sweep file)");
   sc.json = read_json_file(p.string(), fp);
   if (!sc.json.is_object()) throw ConfigError(fp, json_brief(*file), "a scenario file holding a JSON object (" + p.string() + " holds " + json_brief(sc.json) + ")");
   sc.name = sc.json.is_object() && sc.json.contains("name") && sc.json["name"].is_string() ? sc.json["name"].get<std::string>() : p.stem().string();
