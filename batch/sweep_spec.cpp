@@ -34,6 +34,14 @@ std::string sanitize(const std::string& s) {
 
 Json read_json_file(const std::string& path, const std::string& what_path) { return read_json_strict(path, what_path); }
 
+// A run's id names its files and folders (runs/<id>/, and ".<id>.partial-HOST-PID.old" beside it
+// while it is written, which must stay under NAME_MAX): past 150 characters (long parameter values)
+// its tail is replaced by a hash of the whole id, so long ids stay distinct and every name writable.
+std::string bounded_id(const std::string& id) {
+  if (id.size() <= 150) return id;
+  return id.substr(0, 132) + "_h" + external::sha256_hex(id).substr(0, 16);
+}
+
 
 }  // namespace
 
@@ -266,7 +274,7 @@ void add_recording_run(const std::string& path, const ScenarioEntry& sc, const s
   run.seed = h.seed;
   run.scenario = parsed.input;
   run.recording = sc.recording;
-  run.id = sanitize(sc.name) + "__" + label + "__recording__s" + std::to_string(h.seed);
+  run.id = bounded_id(sanitize(sc.name) + "__" + label + "__recording__s" + std::to_string(h.seed));
   if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two entries give the same run id; add \"label\"s)");
   spec.runs.push_back(std::move(run));
 }
@@ -335,7 +343,7 @@ void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenari
           run.scenario = patched;
           run.scenario["seed"] = seed;
           run.scenario["name"] = sc.name;
-          run.id = sanitize(sc.name) + "__" + loc_label + "__" + sanitize(run.params_label) + "__s" + std::to_string(seed);
+          run.id = bounded_id(sanitize(sc.name) + "__" + loc_label + "__" + sanitize(run.params_label) + "__s" + std::to_string(seed));
           if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two combinations give the same run id; add \"label\"s)");
           spec.runs.push_back(std::move(run));
         }
@@ -350,8 +358,14 @@ SweepSpec load_sweep(const std::string& path, const Json& localizers) {
   const Json j = read_json_file(path, "sweep file");
   JsonReader r(j, "");
   r.allow("comment");
-  spec.name = r.string("name", fs::path(path).stem().string());
-  spec.name = sanitize(spec.name);
+  // The name is a folder (results/sweeps/<name>): as bounded as a scenario's name, and never "." or
+  // "..", which would write the sweep's runs/ and specs/ into results/sweeps or results/ itself.
+  const bool named = j.is_object() && j.contains("name");
+  spec.name = sanitize(r.string("name", fs::path(path).stem().string()));
+  if (named && (spec.name.size() > 100 || spec.name == "." || spec.name == ".."))
+    throw ConfigError("/name", json_brief(j["name"]), "a sweep name of 1-100 characters, not \".\" or \"..\" (it names results/sweeps/<name>)");
+  if (spec.name.size() > 100) spec.name.resize(100);
+  if (spec.name == "." || spec.name == "..") spec.name = "sweep";
 
   // Sweep-wide localizers and parameters apply to every scenario entry; an entry written as
   // {"file": ..., "parameters": {...}, "localizers": [...]} adds its own parameters to the sweep's and
