@@ -76,6 +76,12 @@ std::string why_not_writable(const std::string& path, bool folder, bool replace)
     const bool replaceable = replace && (S_ISDIR(st.st_mode) || S_ISREG(st.st_mode));
     if (folder && !S_ISDIR(st.st_mode) && !replaceable) return std::string(kind_words(st.st_mode)) + ", not a folder";
     if (!folder && !S_ISREG(st.st_mode) && !replaceable) return std::string(kind_words(st.st_mode)) + ", not a regular file";
+    // An existing folder that is kept is written into; one that is replaced, like a file, is
+    // replaced by a new entry beside it in its parent.
+    if (folder && S_ISDIR(st.st_mode) && !replace) {
+      if (::access(p.c_str(), W_OK | X_OK) != 0) return std::string(std::strerror(errno)) + " (cannot write into " + p.string() + ")";
+      return {};
+    }
   } else if (errno != ENOENT) {
     return std::strerror(errno);  // a component that is a file, a loop of links, a folder without search permission
   }
