@@ -1,11 +1,13 @@
 #include "apps/cache_command.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <iostream>
 
 #include "core/error.hpp"
+#include "core/path_check.hpp"
 
 namespace omniloc::app {
 
@@ -27,12 +29,16 @@ harness::WorldCacheOptions cache_options(const cli::Args& a) {
   if (a.has("--cache")) {
     const std::string d = a.value("--cache");
     if (d.empty()) throw cli::UsageError("--cache needs a folder");
+    require_writable(d, "--cache", true);
     o.dir = std::filesystem::absolute(d).lexically_normal().string();
   }
   if (a.has("--no-cache")) {
     if (a.has("--cache")) throw cli::UsageError("--cache and --no-cache contradict each other");
     o.dir.clear();
   }
+  // A folder the user named in the environment is checked like --cache (the default is ours).
+  const char* env = std::getenv("OMNILOC_CACHE");
+  if (!a.has("--cache") && !o.dir.empty() && env && *env) require_writable(o.dir, "OMNILOC_CACHE", true);
   return o;
 }
 
