@@ -417,10 +417,14 @@ int cmd_replay(const cli::Args& a) {
   return 0;
 }
 
+// Where a sweep's folder is without -o, named for messages about it.
+const char* kDefaultSweepFolder = "the sweep folder (results/sweeps/<name>; -o DIR chooses another)";
+
 // Slurm submission and status (batch/slurm.hpp); every option is checked before anything is written.
 int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
   if (a.has("--slurm") && a.has("--status")) throw UsageError("--status and --slurm are separate commands");
   if (!a.value("-o").empty()) require_writable(a.value("-o"), "-o", true);
+  else require_writable("results/sweeps/" + spec.name, kDefaultSweepFolder, true);
   const int tasks = static_cast<int>(a.integer("--tasks", 0, 1, 100000));
   if (a.has("--status")) {
     const auto st = batch::sweep_status(spec, a.value("-o"), tasks);
@@ -494,6 +498,7 @@ int cmd_sweep(const cli::Args& a) {
   o.out_dir = a.value("-o");
   if (!o.out_dir.empty()) require_writable(o.out_dir, "-o", true);
   const auto spec = batch::load_sweep(a.positional[0], sweep_localizers(a));
+  if (o.out_dir.empty()) require_writable("results/sweeps/" + spec.name, kDefaultSweepFolder, true);
   o.progress = &std::cerr;
   std::cerr << "sweep " << spec.name << ": " << spec.runs.size() << " runs, " << o.jobs << " worker(s)"
             << (o.shard_count > 1 ? ", shard " + shard : std::string())
