@@ -11,6 +11,8 @@
 
 #include "core/cache_root.hpp"
 #include "core/error.hpp"
+#include "core/path_check.hpp"
+#include "core/path_check.hpp"
 
 namespace omniloc::app {
 
@@ -37,6 +39,10 @@ harness::WorldCacheOptions cache_options(const cli::Args& a) {
   if (a.has("--cache")) {
     const std::string d = a.value("--cache");
     if (d.empty()) throw cli::UsageError("--cache needs a folder");
+    // A folder named on the command line is checked like every output path (exit 2 with the
+    // reason); the environment's and the default root are not: a root that cannot be written only
+    // costs the caching (one warning, core/cache_root.hpp).
+    require_writable(d, "--cache", true);
     std::error_code ec;
     const fs::path p = fs::absolute(d, ec);
     ::setenv("OMNILOC_CACHE", (ec ? fs::path(d) : p).lexically_normal().c_str(), 1);

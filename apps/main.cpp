@@ -21,6 +21,7 @@
 #include "core/cli_args.hpp"
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
+#include "core/path_check.hpp"
 #include "core/field.hpp"
 #include "core/install_paths.hpp"
 #include "core/version.hpp"
@@ -219,10 +220,13 @@ const cli::Command kExperiment{"experiment", "NAME", 1, 1, "Run a named experime
                                 {"--config", "FILE", "description file instead of scenarios/experiments/NAME.json"}}};
 
 // -o must not silently destroy what the user did not ask to replace: an existing file, or a folder
-// with anything in it, is only replaced with --overwrite. Checked before any work.
-void check_output_target(const cli::Args& a) {
+// with anything in it, is only replaced with --overwrite. Checked before any work, as is whether
+// the result (a `folder` or a file) can be written there at all.
+void check_output_target(const cli::Args& a, bool folder) {
   const std::string out = a.value("-o");
-  if (out.empty() || a.has("--overwrite")) return;
+  if (out.empty()) return;
+  require_writable(out, "-o", folder, true);
+  if (a.has("--overwrite")) return;
   std::error_code ec;
   const auto st = std::filesystem::symlink_status(out, ec);
   if (ec || !std::filesystem::exists(st)) return;
@@ -333,8 +337,9 @@ int cmd_run(const cli::Args& a) {
   harness::RunOptions o;
   if (a.has("--seed")) o.seed = a.unsigned_integer("--seed", 0, kMaxSeed);
   o.out_dir = a.value("-o");
-  check_output_target(a);
+  check_output_target(a, true);
   o.frames_dir = a.value("--frames");
+  if (!o.frames_dir.empty()) require_writable(o.frames_dir, "--frames", true);
   o.frames_every = static_cast<int>(a.integer("--frames-every", o.frames_every, 1, 1000000));
   o.debug_view = a.has("--debug-view");
   if (!a.has("--quiet")) o.log = &std::cerr;
@@ -354,7 +359,7 @@ int cmd_record(const cli::Args& a) {
   harness::RecordOptions o;
   if (a.has("--seed")) o.seed = a.unsigned_integer("--seed", 0, kMaxSeed);
   o.out_dir = a.value("-o");
-  check_output_target(a);
+  check_output_target(a, true);
   o.images = a.has("--images");
   if (!a.has("--quiet")) o.log = &std::cerr;
   const auto r = harness::record_scenario(s, o);
@@ -390,7 +395,7 @@ Json localizer_argument(const std::string& v) { return localizer_values(v, "repl
 
 int cmd_replay(const cli::Args& a) {
   const Json localizer = localizer_argument(a.value("--localizer"));
-  check_output_target(a);
+  check_output_target(a, true);
   harness::RecordingHeader header = harness::RecordingHeader::read(a.positional[0]);
   const harness::Scenario s = harness::replay_scenario(header, localizer);
   harness::RecordingSource source(std::move(header));  // reads and checks every frame before any work
@@ -413,9 +418,14 @@ int cmd_replay(const cli::Args& a) {
   return 0;
 }
 
+// Where a sweep's folder is without -o, named for messages about it.
+const char* kDefaultSweepFolder = "the sweep folder (results/sweeps/<name>; -o DIR chooses another)";
+
 // Slurm submission and status (batch/slurm.hpp); every option is checked before anything is written.
 int cmd_sweep_slurm(const cli::Args& a, const batch::SweepSpec& spec) {
   if (a.has("--slurm") && a.has("--status")) throw UsageError("--status and --slurm are separate commands");
+  if (!a.value("-o").empty()) require_writable(a.value("-o"), "-o", true);
+  else require_writable("results/sweeps/" + spec.name, kDefaultSweepFolder, true);
   const int tasks = static_cast<int>(a.integer("--tasks", 0, 1, 100000));
   if (a.has("--status")) {
     const auto st = batch::sweep_status(spec, a.value("-o"), tasks);
@@ -488,7 +498,9 @@ int cmd_sweep(const cli::Args& a) {
   o.stop_after = static_cast<std::size_t>(a.integer("--stop-after", 0, 0, 1000000000));
   o.debug_view = a.has("--debug-view");
   o.out_dir = a.value("-o");
+  if (!o.out_dir.empty()) require_writable(o.out_dir, "-o", true);
   const auto spec = batch::load_sweep(a.positional[0], sweep_localizers(a));
+  if (o.out_dir.empty()) require_writable("results/sweeps/" + spec.name, kDefaultSweepFolder, true);
   o.progress = &std::cerr;
   std::cerr << "sweep " << spec.name << ": " << spec.runs.size() << " runs, " << o.jobs << " worker(s)"
             << (o.shard_count > 1 ? ", shard " + shard : std::string())
@@ -505,7 +517,7 @@ int cmd_sweep(const cli::Args& a) {
 int cmd_render(const cli::Args& a) {
   const std::string out = a.value("-o");
   if (out.empty()) throw UsageError("render needs -o frame.png");
-  check_output_target(a);
+  check_output_target(a, false);
   const auto s = harness::load_scenario(a.positional[0]);
   const double t = a.number("--t", 0.0, 0.0, s.duration);
   const int robot = static_cast<int>(a.integer("--robot", s.localized_robots().front(), 0, 99));
@@ -517,7 +529,7 @@ int cmd_render(const cli::Args& a) {
 }
 
 int cmd_calibrate(const cli::Args& a) {
-  check_output_target(a);  // an explicit -o; the default is the shared cache, which calibrating refreshes
+  check_output_target(a, false);  // an explicit -o; the default is the shared cache, which calibrating refreshes
   const std::uint64_t seed = a.unsigned_integer("--seed", 1, kMaxSeed);
   const auto s = harness::load_scenario(a.positional[0]);
   const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
@@ -550,7 +562,7 @@ int cmd_calibrate(const cli::Args& a) {
 }
 
 int cmd_colour_calibrate(const cli::Args& a) {
-  check_output_target(a);  // an explicit -o; the default is the shared cache
+  check_output_target(a, false);  // an explicit -o; the default is the shared cache
   const std::uint64_t seed = a.unsigned_integer("--seed", 1, kMaxSeed);
   const auto s = harness::load_scenario(a.positional[0]);
   const auto cfg = sim::CameraConfig::from_json(s.camera, "/camera");
@@ -569,6 +581,7 @@ int cmd_schema(const cli::Args& a) {
                            : a.has("--sweep")  ? batch::sweep_schema().dump(2) + "\n"
                                                : harness::scenario_schema().dump(2) + "\n";
   const std::string out = a.value("-o");
+  if (!out.empty()) require_writable(out, "-o", false);
   if (out.empty()) {
     std::cout << text;
   } else {
@@ -634,7 +647,7 @@ std::string shipped_or_given(const std::string& file) {
 }
 
 int cmd_experiment(const cli::Args& a) {
-  check_output_target(a);
+  check_output_target(a, true);
   for (const auto& e : experiments::all()) {
     if (e.name != a.positional[0]) continue;
     experiments::ExperimentArgs ea;
@@ -642,6 +655,7 @@ int cmd_experiment(const cli::Args& a) {
     ea.out_dir = a.value("-o", "results/experiments/" + e.name);
     ea.quick = a.has("--quick");
     ea.config = a.value("--config");
+    if (!ea.config.empty()) require_readable_file(ea.config, "--config", "an experiment description file (JSON)");
     return e.run(ea, std::cout);
   }
   throw UsageError("unknown experiment \"" + a.positional[0] + "\" (see omniloc list)");

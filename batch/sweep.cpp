@@ -122,6 +122,14 @@ std::string failure_line(int status, const std::string& log) {
 
 namespace {
 
+// The sweep folder's parts: a full disk or a lost permission is a runtime failure in words, not a
+// raw filesystem_error (the folder itself was checked before any work, apps/main.cpp).
+void make_folder(const fs::path& p) {
+  std::error_code ec;
+  fs::create_directories(p, ec);
+  if (ec) throw RuntimeFailure("cannot create folder " + p.string() + ": " + ec.message());
+}
+
 struct SweepFolder {
   fs::path dir;
   std::string exe;  ///< the binary spawned for runs
@@ -129,12 +137,12 @@ struct SweepFolder {
 
 SweepFolder open_sweep_folder(const std::string& out_dir, const SweepOptions& o) {
   SweepFolder f{out_dir, ""};
-  fs::create_directories(f.dir / "runs");
-  fs::create_directories(f.dir / "specs");
-  fs::create_directories(f.dir / "logs");
-  fs::create_directories(f.dir / "failed");
+  make_folder(f.dir / "runs");
+  make_folder(f.dir / "specs");
+  make_folder(f.dir / "logs");
+  make_folder(f.dir / "failed");
   f.exe = o.omniloc_exe.empty() ? fs::read_symlink("/proc/self/exe").string() : o.omniloc_exe;
-  fs::create_directories(f.dir / "locks");
+  make_folder(f.dir / "locks");
   // Staging folders of runs killed mid-write are hidden (".<id>.partial-<host>-<pid>"); clear those
   // whose process is gone, never those of runs still going (another shard or Slurm array task
   // sharing the folder), nor another host's, which cannot be judged from here.
@@ -288,7 +296,7 @@ class SweepWorkers {
       ~Unlock() { ::close(fd); }
     } unlock{fd};
     if (fs::exists(dir / "recording.json")) return dir.string();
-    fs::create_directories(dir.parent_path());
+    make_folder(dir.parent_path());
     remove_stale_partials(dir.parent_path().string());
     Json world = r.scenario;
     world.erase("localizer");  // perception runs whatever the localizer; the recording keeps no localizer
@@ -349,7 +357,7 @@ void write_shard_progress(const SweepSpec& spec, const SweepOptions& o, const fs
   out.missing = runs - done - failed;
   // Named as on the command line (--shard I/N, I from 0).
   const std::string name = "shard-" + std::to_string(o.shard_index) + "-of-" + std::to_string(o.shard_count) + ".json";
-  fs::create_directories(dir / "progress");
+  make_folder(dir / "progress");
   write_file_atomic((dir / "progress" / name).string(),
                     Json{{"shard", o.shard_index}, {"shards", o.shard_count}, {"runs", runs}, {"done", done}, {"failed", failed},
                          {"missing", out.missing}, {"omniloc", build_info_json()}}

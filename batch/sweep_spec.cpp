@@ -34,6 +34,14 @@ std::string sanitize(const std::string& s) {
 
 Json read_json_file(const std::string& path, const std::string& what_path) { return read_json_strict(path, what_path); }
 
+// A run's id names its files and folders (runs/<id>/, and ".<id>.partial-HOST-PID.old" beside it
+// while it is written, which must stay under NAME_MAX): past 150 characters (long parameter values)
+// its tail is replaced by a hash of the whole id, so long ids stay distinct and every name writable.
+std::string bounded_id(const std::string& id) {
+  if (id.size() <= 150) return id;
+  return id.substr(0, 132) + "_h" + external::sha256_hex(id).substr(0, 16);
+}
+
 
 }  // namespace
 
@@ -132,7 +140,9 @@ ScenarioEntry read_recording_entry(const Json& entry, const std::string& sp, con
   er.finish();
   fs::path p = rel;
   if (p.is_relative()) p = base / p;
-  sc.recording = fs::absolute(p).lexically_normal().string();
+  std::error_code ec;
+  sc.recording = fs::absolute(p, ec).lexically_normal().string();
+  if (ec) throw ConfigError(json_child(sp, "recording"), path_value(p.string(), ec.message()), "a recording folder (relative to the sweep file)");
   try {
     sc.header = harness::RecordingHeader::read(sc.recording);
   } catch (const ConfigError& e) {
@@ -162,7 +172,7 @@ ScenarioEntry read_scenario_entry(const Json& entry, const std::string& sp, cons
     throw ConfigError(fp, json_brief(*file), "a scenario file path (relative to the sweep file), or {\"file\": path, \"parameters\": ..., \"localizers\": ...}");
   fs::path p = file->get<std::string>();
   if (p.is_relative()) p = base / p;
-  if (!fs::exists(p)) throw ConfigError(fp, json_brief(*file), "an existing scenario file (looked for " + p.string() + ")");
+  require_readable_file(p.string(), fp, "a readable scenario file (relative to the sweep file)");
   sc.json = read_json_file(p.string(), fp);
   if (!sc.json.is_object()) throw ConfigError(fp, json_brief(*file), "a scenario file holding a JSON object (" + p.string() + " holds " + json_brief(sc.json) + ")");
   sc.name = sc.json.is_object() && sc.json.contains("name") && sc.json["name"].is_string() ? sc.json["name"].get<std::string>() : p.stem().string();
@@ -264,7 +274,7 @@ void add_recording_run(const std::string& path, const ScenarioEntry& sc, const s
   run.seed = h.seed;
   run.scenario = parsed.input;
   run.recording = sc.recording;
-  run.id = sanitize(sc.name) + "__" + label + "__recording__s" + std::to_string(h.seed);
+  run.id = bounded_id(sanitize(sc.name) + "__" + label + "__recording__s" + std::to_string(h.seed));
   if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two entries give the same run id; add \"label\"s)");
   spec.runs.push_back(std::move(run));
 }
@@ -333,7 +343,7 @@ void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenari
           run.scenario = patched;
           run.scenario["seed"] = seed;
           run.scenario["name"] = sc.name;
-          run.id = sanitize(sc.name) + "__" + loc_label + "__" + sanitize(run.params_label) + "__s" + std::to_string(seed);
+          run.id = bounded_id(sanitize(sc.name) + "__" + loc_label + "__" + sanitize(run.params_label) + "__s" + std::to_string(seed));
           if (!ids.insert(run.id).second) throw ConfigError("/", run.id, "distinct runs (two combinations give the same run id; add \"label\"s)");
           spec.runs.push_back(std::move(run));
         }
@@ -348,8 +358,14 @@ SweepSpec load_sweep(const std::string& path, const Json& localizers) {
   const Json j = read_json_file(path, "sweep file");
   JsonReader r(j, "");
   r.allow("comment");
-  spec.name = r.string("name", fs::path(path).stem().string());
-  spec.name = sanitize(spec.name);
+  // The name is a folder (results/sweeps/<name>): as bounded as a scenario's name, and never "." or
+  // "..", which would write the sweep's runs/ and specs/ into results/sweeps or results/ itself.
+  const bool named = j.is_object() && j.contains("name");
+  spec.name = sanitize(r.string("name", fs::path(path).stem().string()));
+  if (named && (spec.name.size() > 100 || spec.name == "." || spec.name == ".."))
+    throw ConfigError("/name", json_brief(j["name"]), "a sweep name of 1-100 characters, not \".\" or \"..\" (it names results/sweeps/<name>)");
+  if (spec.name.size() > 100) spec.name.resize(100);
+  if (spec.name == "." || spec.name == "..") spec.name = "sweep";
 
   // Sweep-wide localizers and parameters apply to every scenario entry; an entry written as
   // {"file": ..., "parameters": {...}, "localizers": [...]} adds its own parameters to the sweep's and

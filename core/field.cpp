@@ -222,21 +222,23 @@ std::string data_dir() {
 std::vector<std::string> Field::preset_names() {
   std::vector<std::string> names;
   const auto dir = std::filesystem::path(data_dir()) / "fields";
-  if (std::filesystem::is_directory(dir))
-    for (const auto& e : std::filesystem::directory_iterator(dir))
-      if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  // OMNILOC_DATA_DIR may name anything: an unreadable folder lists no presets rather than throwing.
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().extension() == ".json") names.push_back(it->path().stem().string());
   std::sort(names.begin(), names.end());
   return names;
 }
 
 Field Field::preset(const std::string& name, const std::string& path) {
   const auto file = std::filesystem::path(data_dir()) / "fields" / (name + ".json");
-  std::ifstream in(file);
-  // A name with a folder part would read any JSON file on the machine as a field.
-  if (!in || name.empty() || name.find('/') != std::string::npos || name[0] == '.') {
+  // A name with a folder part would read any JSON file on the machine as a field (and a FIFO there
+  // would block the open): the name is judged before anything is opened.
+  const bool plain = !name.empty() && name.find('/') == std::string::npos && name.find('\0') == std::string::npos && name[0] != '.';
+  if (!plain || !why_not_readable_file(file.string()).empty()) {
     std::string known;
     for (const auto& n : preset_names()) known += (known.empty() ? "" : ", ") + n;
-    throw ConfigError(path, "\"" + name + "\"", "a field preset name (" + known + ")");
+    throw ConfigError(path, "\"" + path_shown(name) + "\"", "a field preset name (" + known + ")");
   }
   const Json j = read_json_strict(file.string(), path);
   Field f = from_json(j, file.string());

@@ -135,23 +135,14 @@ Json parse_json_strict(std::string_view text, const std::string& source) {
   return std::move(b.result);
 }
 
-void require_readable_file(const std::string& path, const std::string& where, const std::string& what) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0)
-    throw ConfigError(where, "\"" + path + "\" (" + std::strerror(errno) + ")", what);
-  if (S_ISDIR(st.st_mode)) throw ConfigError(where, "\"" + path + "\" (a directory)", what);
-  if (!S_ISREG(st.st_mode)) throw ConfigError(where, "\"" + path + "\" (not a regular file)", what);
-  if (::access(path.c_str(), R_OK) != 0) throw ConfigError(where, "\"" + path + "\" (" + std::strerror(errno) + ")", what);
-}
-
 Json read_json_strict(const std::string& path, const std::string& where) {
   require_readable_file(path, where, "a readable JSON file");
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && static_cast<std::size_t>(st.st_size) > kJsonMaxBytes)
-    throw ConfigError(where, "\"" + path + "\" (" + std::to_string(st.st_size) + " bytes)",
+    throw ConfigError(where, path_value(path, std::to_string(st.st_size) + " bytes"),
                       "a JSON file of at most " + std::to_string(kJsonMaxBytes) + " bytes");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(where, "\"" + path + "\" (cannot open)", "a readable JSON file");
+  if (!in) throw ConfigError(where, path_value(path, std::strerror(errno)), "a readable JSON file");
   // Read in chunks up to one byte past the limit, so a file growing meanwhile cannot exhaust
   // memory (and a small file does not pay for a 16 MiB buffer).
   std::string text;
@@ -160,7 +151,7 @@ Json read_json_strict(const std::string& path, const std::string& where) {
     in.read(buf, sizeof buf);
     text.append(buf, static_cast<std::size_t>(in.gcount()));
   }
-  if (in.bad()) throw ConfigError(where, "\"" + path + "\" (read error)", "a readable JSON file");
+  if (in.bad()) throw ConfigError(where, path_value(path, std::string("read error: ") + std::strerror(errno)), "a readable JSON file");
   return parse_json_strict(text, path);
 }
 

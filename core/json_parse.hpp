@@ -14,6 +14,7 @@
 #include <string_view>
 
 #include "core/json_reader.hpp"
+#include "core/path_check.hpp"  // require_readable_file: data files named in a scenario
 
 namespace omniloc {
 
@@ -28,9 +29,5 @@ Json parse_json_strict(std::string_view text, const std::string& source);
 /// Reads and parses a JSON file. `where` is the JSON pointer or option that named the file (used in
 /// the message when it cannot be read: missing, a directory, too large). Throws ConfigError.
 Json read_json_strict(const std::string& path, const std::string& where);
-
-/// Throws ConfigError(where, ...) unless `path` is a regular file this process can read (a data file
-/// named in a scenario, such as /vision/calibration), so `validate` catches it before any work.
-void require_readable_file(const std::string& path, const std::string& where, const std::string& what);
 
 }  // namespace omniloc

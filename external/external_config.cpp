@@ -4,6 +4,7 @@
 #include <fstream>
 #include <regex>
 
+#include "core/path_check.hpp"
 #include "external/client_process.hpp"
 #include "external/sha256.hpp"
 
@@ -45,8 +46,7 @@ ExternalConfig ExternalConfig::from_json(JsonReader& r) {
     if (c.command[i].empty() || c.command[i].find('\0') != std::string::npos)
       throw ConfigError(json_child(cmd_path, i), "\"\"", "a non-empty string");
   c.cwd = absolute_from(r.string("cwd", fs::current_path().string()), fs::current_path().string());
-  std::error_code ec;
-  if (!fs::is_directory(c.cwd, ec)) throw ConfigError(r.child_path("cwd"), "\"" + c.cwd + "\"", "an existing folder (the client's working directory)");
+  require_readable_folder(c.cwd, r.child_path("cwd"), "an existing folder (the client's working directory)");
   if (const Json* p = r.raw("params")) {
     if (!p->is_object()) throw ConfigError(r.child_path("params"), json_brief(*p), "an object (passed to the client in hello.params)");
     c.params = *p;
@@ -73,25 +73,26 @@ ExternalConfig ExternalConfig::from_json(JsonReader& r) {
   const std::vector<std::string> hash = r.strings("hash", std::vector<std::string>{});
   if (hash.size() > 256) throw ConfigError(r.child_path("hash"), std::to_string(hash.size()) + " files", "at most 256 files");
   for (std::size_t i = 0; i < hash.size(); ++i) {
-    const std::string p = hash[i].empty() || hash[i].find('\0') != std::string::npos ? std::string() : absolute_from(hash[i], c.cwd);
-    if (p.empty() || !fs::is_regular_file(p, ec))
-      throw ConfigError(json_child(r.child_path("hash"), i), json_brief(Json(hash[i])),
-                        "an existing file to record in provenance (relative paths are taken against " + c.cwd + ")");
+    const std::string p = hash[i].empty() || hash[i].find('\0') != std::string::npos ? hash[i] : absolute_from(hash[i], c.cwd);
+    require_readable_file(p, json_child(r.child_path("hash"), i),
+                          "an existing file to record in provenance (relative paths are taken against " + c.cwd + ")");
     c.hash.push_back(p);
   }
 
   const auto program = resolve_program(c.command[0], c.cwd);
-  if (!program)
-    throw ConfigError(json_child(cmd_path, std::size_t{0}), "\"" + c.command[0] + "\"",
-                      c.command[0].find('/') != std::string::npos
-                          ? "an executable file (relative paths are taken against " + c.cwd + ")"
-                          : "an executable program on PATH");
+  if (!program) {
+    const bool has_slash = c.command[0].find('/') != std::string::npos;
+    // A path names one file: say what is wrong with it. A bare name was looked for on PATH.
+    std::string why = has_slash ? why_not_readable_file(absolute_from(c.command[0], c.cwd)) : "not on PATH";
+    if (why.empty()) why = "not executable";
+    throw ConfigError(json_child(cmd_path, std::size_t{0}), path_value(c.command[0], why),
+                      has_slash ? "an executable file (relative paths are taken against " + c.cwd + ")" : "an executable program on PATH");
+  }
   c.program = *program;
   if (const std::size_t i = script_index(c.command); i > 0) {
     const std::string script = absolute_from(c.command[i], c.cwd);
-    if (!fs::is_regular_file(script, ec))
-      throw ConfigError(json_child(cmd_path, i), "\"" + c.command[i] + "\"",
-                        "an existing script file for " + fs::path(c.command[0]).filename().string() + " (relative paths are taken against " + c.cwd + ")");
+    require_readable_file(script, json_child(cmd_path, i),
+                          "an existing script file for " + fs::path(c.command[0]).filename().string() + " (relative paths are taken against " + c.cwd + ")");
   }
   return c;
 }

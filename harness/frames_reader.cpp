@@ -1,5 +1,6 @@
 #include "harness/frames_reader.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -186,12 +187,12 @@ class GzipBytes : public Bytes {
 class PlainBytes : public Bytes {
  public:
   explicit PlainBytes(const std::string& path) : f_(std::fopen(path.c_str(), "rb")) {
-    if (!f_) throw std::runtime_error("cannot open " + path);
+    if (!f_) throw std::runtime_error(std::string("cannot open: ") + std::strerror(errno));
   }
   ~PlainBytes() override { std::fclose(f_); }
   std::size_t read(char* out, std::size_t n) override {
     const std::size_t got = std::fread(out, 1, n, f_);
-    if (got == 0 && std::ferror(f_)) throw std::runtime_error("unreadable");
+    if (got == 0 && std::ferror(f_)) throw std::runtime_error(std::string("read error: ") + std::strerror(errno));
     return got;
   }
 
@@ -278,15 +279,17 @@ FramesReader::FramesReader(const RecordingHeader& h) : s_(std::make_unique<State
   s.robots = h.robots;
   s.truth = h.ground_truth;
   s.gz = h.frames_file.size() > 3 && h.frames_file.compare(h.frames_file.size() - 3, 3, ".gz") == 0;
+  if (const std::string why = why_not_readable_file(s.file); !why.empty())
+    throw ConfigError(s.file, why, "a readable file of the recording (docs/recording.md)");
   std::error_code ec;
   const auto size = fs::file_size(s.file, ec);
-  if (ec) throw ConfigError(s.file, "missing", "a readable file of the recording (docs/recording.md)");
+  if (ec) throw ConfigError(s.file, ec.message(), "a readable file of the recording (docs/recording.md)");
   if (size > kMaxFramesBytes) throw ConfigError(s.file, std::to_string(size) + " bytes", "at most " + std::to_string(kMaxFramesBytes) + " bytes");
   try {
     if (s.gz) s.bytes = std::make_unique<GzipBytes>(s.file);
     else s.bytes = std::make_unique<PlainBytes>(s.file);
-  } catch (const std::exception&) {
-    throw ConfigError(s.file, "unreadable", "a readable file");
+  } catch (const std::exception& e) {
+    throw ConfigError(s.file, e.what(), "a readable file");
   }
 }
 

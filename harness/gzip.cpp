@@ -1,6 +1,8 @@
 #include "harness/gzip.hpp"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -69,7 +71,7 @@ struct GzipFileReader::State {
 
 GzipFileReader::GzipFileReader(const std::string& path) : s_(std::make_unique<State>()) {
   s_->f = std::fopen(path.c_str(), "rb");
-  if (!s_->f) throw std::runtime_error("cannot open " + path);
+  if (!s_->f) throw std::runtime_error(std::string("cannot open: ") + std::strerror(errno));
   if (inflateInit2(&s_->z, 15 + 16) != Z_OK) throw std::runtime_error("zlib: inflateInit2 failed");
 }
 

@@ -191,7 +191,8 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
 
 std::shared_ptr<const Image> read_png(const std::string& path) {
   const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
-  if (bgr.empty()) throw RuntimeFailure("cannot read image " + path);
+  // The file was found readable before (why_not_readable_file): what fails here is its content.
+  if (bgr.empty()) throw ConfigError(path, "no image OpenCV can read", "a PNG image (recording.json says \"images\": true)");
   cv::Mat rgb;
   cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
   auto img = std::make_shared<Image>();
@@ -306,10 +307,9 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
 RecordingHeader RecordingHeader::read(const std::string& dir) {
   RecordingHeader h;
   h.dir = dir;
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw ConfigError(dir, "not a folder", "a recording folder (recording.json, frames.jsonl; docs/recording.md)");
+  if (const std::string why = why_not_readable_folder(dir); !why.empty())
+    throw ConfigError(path_shown(dir), why, "a recording folder (recording.json, frames.jsonl; docs/recording.md)");
   const std::string file = (fs::path(dir) / "recording.json").string();
-  if (!fs::exists(file, ec)) throw ConfigError(dir, "no recording.json", "a recording folder (docs/recording.md)");
   const Json j = read_json_strict(file, file);
   if (!j.is_object()) throw ConfigError(file, json_brief(j), "a recording header object (docs/recording.md)");
   // The format first: a later version's other keys must not be judged by this version's rules.
@@ -365,6 +365,11 @@ RecordingHeader RecordingHeader::read(const std::string& dir) {
   if (const Json* rd = r.raw("render")) h.render = *rd;
   h.frames_sha256 = r.string("frames_sha256", std::string());
   h.frames_file = r.string("frames_file", std::string("frames.jsonl"), {"frames.jsonl", "frames.jsonl.gz"});
+  // Checked with the header, so a sweep's validation (which reads only headers) refuses a recording
+  // whose frames cannot be read (a FIFO would block the reader) before any run.
+  const std::string frames = (fs::path(dir) / h.frames_file).string();
+  if (const std::string why = why_not_readable_file(frames); !why.empty())
+    throw ConfigError(frames, why, "a readable file of the recording (docs/recording.md)");
   // No finish(): keys a later omniloc adds to version 1 are ignored, as docs/recording.md promises.
   return h;
 }
@@ -384,7 +389,10 @@ RecordingSource::~RecordingSource() = default;
 // timing.csv (optional): the render and vision times the recording's frames cost, for the run's
 // timing.csv. A line that does not parse is ignored: these are wall-clock figures, never results.
 void RecordingSource::read_timing() {
-  std::ifstream in(fs::path(header_.dir) / "timing.csv");
+  // Optional: anything but a readable file (a FIFO would block the read) is as if it were absent.
+  const std::string file = (fs::path(header_.dir) / "timing.csv").string();
+  if (!why_not_readable_file(file).empty()) return;
+  std::ifstream in(file);
   std::string line;
   if (!std::getline(in, line)) return;
   while (std::getline(in, line)) {
@@ -401,10 +409,10 @@ std::optional<FrameData> RecordingSource::next() {
   for (auto& r : f->robots)
     if (const auto it = timing_.find({f->k, r.id}); it != timing_.end()) std::tie(r.render_ms, r.vision_ms) = it->second;
   if (header_.images) {
-    std::error_code ec;
     for (auto& r : f->robots) {
       const fs::path p = fs::path(header_.dir) / image_name(r.id, f->k);
-      if (!fs::is_regular_file(p, ec)) throw ConfigError(p.string(), "missing", "an image for every frame (recording.json says \"images\": true)");
+      if (const std::string why = why_not_readable_file(p.string()); !why.empty())
+        throw ConfigError(p.string(), why, "an image for every frame (recording.json says \"images\": true)");
       r.obs.image = read_png(p.string());
     }
   }

@@ -2,7 +2,9 @@
 """Mutation test of `omniloc validate` (robust input: every input class exits 0 or 2): deterministic
 mutants of the shipped scenario, experiment and sweep files (sweeps since a sweep localizer's
 "label" of the wrong type was found to exit 1), each run through `omniloc validate`, which must
-exit 0 or 2 - never a signal, never another code, never hang.
+exit 0 or 2 - never a signal, never another code, never hang. Besides the random mutants, every
+shipped sweep is validated with its first scenario entry set to each hostile path of path_cases()
+(tests/path_cases.py checks the words of every command's path errors).
 
 Usage: mutation_validate.py OMNILOC [--count N] [--seed S] [--jobs J] [--keep DIR]
 Exit 1 (listing the first bad inputs, saved under --keep) when any mutant misbehaves.
@@ -33,6 +35,31 @@ EXTREME_JSON = [1e39, -1e39, 1e308, -1e308, 0, -1, 1, 2**63, 2**64, 0.5, 1e6, -1
                 {"colour_table": "/"}, {"sectors": [[0, 10]] * 50}, list(range(200))]
 
 
+def path_cases(work):
+    """Hostile paths (the sweep's scenario entry of 5000 characters once ended in a raw "filesystem
+    error: File name too long", exit 1): over NAME_MAX, over PATH_MAX, through a file, through a
+    folder without permission, a link loop, a FIFO (whose reader would block), a device. Absolute,
+    under `work` (see `prepare`), and relative to a mutant sweep (work/scenarios/sweeps/)."""
+    return ["x" * 5000, "n" * 300, str(work / "/".join(["p" * 200] * 25)), str(work / "plain.txt" / "child.json"),
+            "../../plain.txt/child.json", str(work / "locked" / "inside.json"), str(work / "loop"), str(work / "fifo"),
+            str(work / "dev"), "/dev/zero", "../../fifo", ""]
+
+
+def path_mutants(work, seeds):
+    """Deterministic mutants: every shipped sweep with its first scenario entry (as a string and as
+    {"file": ...}) and its first recording entry set to each hostile path."""
+    out = []
+    for name, text in seeds:
+        if not is_sweep(name):
+            continue
+        for p in path_cases(work):
+            for entry in (p, {"file": p}, {"recording": p}):
+                m = json.loads(text)
+                m["scenarios"][0] = entry
+                out.append((name, json.dumps(m).encode()))
+    return out
+
+
 def corpus():
     """Every shipped input file: scenarios, experiments and sweeps. A sweep names its scenario files
     relative to itself and its external clients relative to the working directory, so its mutants are
@@ -51,6 +78,12 @@ def prepare(work, omniloc):
     shutil.copytree(ROOT / "scenarios", work / "scenarios")
     for name in ("clients", "tests", "data"):
         (work / name).symlink_to(ROOT / name)
+    # What path_cases() points at.
+    (work / "plain.txt").write_text("{}\n")
+    os.mkfifo(work / "fifo")
+    (work / "dev").symlink_to("/dev/zero")
+    (work / "loop").symlink_to("loop")
+    (work / "locked").mkdir(mode=0)
     (work / "build").symlink_to(pathlib.Path(omniloc).resolve().parent if os.sep in omniloc else ROOT / "build")
 
 
@@ -166,10 +199,14 @@ def main():
     prepare(work, a.omniloc)
     # Inputs are generated up front from one seeded generator, so a run is reproducible whatever the
     # scheduling of the workers.
+    # Hostile paths are also values a random mutation may put anywhere (a scenario's data files, a
+    # client's cwd).
+    EXTREME_JSON.extend(path_cases(work))
     inputs = []
     for k in range(a.count):
         name, text = seeds[rng.randrange(len(seeds))]
         inputs.append((k, name, mutate(rng, text)))
+    fixed = [(a.count + i, name, text) for i, (name, text) in enumerate(path_mutants(work, seeds))]
     codes = {}
     bad = []
     t0 = time.monotonic()
@@ -179,7 +216,7 @@ def main():
     # exactly that input, without paying the program's start-up (~0.2 s) per mutant.
     batch = 100
 
-    def one(chunk):
+    def one(chunk, timeout=None):
         files = []
         for k, name, text in chunk:
             f = place(work, k, name)
@@ -188,7 +225,7 @@ def main():
         verdict = {}
         try:
             r = subprocess.run([a.omniloc, "validate"] + [str(f) for _, _, f in files], stdout=subprocess.PIPE,
-                               stderr=subprocess.DEVNULL, timeout=a.timeout * len(files), cwd=str(work))
+                               stderr=subprocess.DEVNULL, timeout=timeout or a.timeout * len(files), cwd=str(work))
             for line in r.stdout.decode(errors="replace").splitlines():
                 if line.startswith("[exit ") or line.startswith("[signal "):
                     kind, _, rest = line[1:].partition("] ")
@@ -204,9 +241,12 @@ def main():
             out.append((k, name, rc, "", f))
         return out
 
-    chunks = [inputs[i:i + batch] for i in range(0, len(inputs), batch)]
+    # The path mutants in small batches with one time limit each: a reader blocked on the FIFO
+    # must not hold a whole batch for a.timeout per file.
+    chunks = [(inputs[i:i + batch], None) for i in range(0, len(inputs), batch)]
+    chunks += [(fixed[i:i + 20], a.timeout) for i in range(0, len(fixed), 20)]
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as ex:
-        for results in ex.map(one, chunks):
+        for results in ex.map(lambda c: one(*c), chunks):
             for k, name, rc, err, f in results:
                 codes[rc] = codes.get(rc, 0) + 1
                 if rc not in (0, 2):
@@ -217,7 +257,7 @@ def main():
     sweeps = sum(1 for _, name, _ in inputs if is_sweep(name))
     print(f"mutation_validate: {a.count} mutants (seed {a.seed}; {sweeps} of them of the {sum(1 for n, _ in seeds if is_sweep(n))} "
           f"shipped sweeps, the rest of {sum(1 for n, _ in seeds if not is_sweep(n))} scenario and experiment files) "
-          f"in {secs:.1f} s with {a.jobs} jobs: {summary}")
+          f"and {len(fixed)} sweeps with a hostile path in {secs:.1f} s with {a.jobs} jobs: {summary}")
     if bad:
         keep = pathlib.Path(a.keep) if a.keep else work
         keep.mkdir(parents=True, exist_ok=True)
@@ -228,6 +268,7 @@ def main():
             print(f"  BAD mutant {k} of {name}: {rc}; input kept as {dst}\n    {err.strip()}")
         print(f"mutation_validate: {len(bad)} mutants neither exited 0 nor 2")
         return 1
+    os.chmod(work / "locked", 0o755)
     shutil.rmtree(work, ignore_errors=True)
     return 0
 

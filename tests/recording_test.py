@@ -309,7 +309,7 @@ class Recording(unittest.TestCase):
 
         rec = self.copy("tracking", "no_image")
         (rec / "images" / "r0_000042.png").unlink()
-        self.bad_replay(rec, expect=["r0_000042.png", "missing"])
+        self.bad_replay(rec, expect=["r0_000042.png", "No such file or directory"])
 
         # A client that wants the image, on a recording made without images.
         self.bad_replay(self.recordings["kidnap"], {"type": "external", "command": [PY, str(EXAMPLES / "own_vision.py")]},

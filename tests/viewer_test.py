@@ -381,7 +381,7 @@ class Viewer(unittest.TestCase):
         out_dir = self.tmp / "bad_out"
         out_dir.mkdir(exist_ok=True)
         out = out_dir / "page.html"
-        self.assert_bad([self.tmp / "no_such_run"], ["no_such_run", "missing", "run folder"], out)
+        self.assert_bad([self.tmp / "no_such_run"], ["no_such_run", "No such file or directory", "run folder"], out)
         d = self.copy_run("no_est")
         (d / "est.tum").unlink()
         self.assert_bad([d], ["est.tum", "missing", "TUM"], out)

@@ -38,6 +38,7 @@ import xml.etree.ElementTree as ET
 
 from omniloc import compare as CMP
 from omniloc.core import metrics as M
+from omniloc.core import pathcheck as PC
 from omniloc.core import rundir as RD
 from omniloc.core import stats as ST
 from omniloc.core.rundir import Run
@@ -69,6 +70,9 @@ def _number(rule: Any, key: Any, where: Any) -> Any:
 
 def load_rules(path: Any, have_baseline: Any) -> Any:
     """The rules of `path`, checked key by key; BadInput names the JSON path, the value and what was expected."""
+    why = PC.why_not_readable_file(path)
+    if why:  # before open(): a FIFO would block it for ever
+        raise BadInput(f"{PC.shown(path)}: cannot be read ({why})")
     try:
         doc = json.loads(pathlib.Path(path).read_text())
     except OSError as e:
@@ -203,8 +207,9 @@ def statistic(values: Sequence[Any], stat: Any) -> Any:
 
 def load_runs(folder: Any, what: Any) -> Any:
     """The runs under `folder`; BadInput when it is missing, holds no run or an incomplete sweep."""
-    if not pathlib.Path(folder).is_dir():
-        raise BadInput(f"{what} {folder}: not a folder")
+    why = PC.why_not_readable_folder(folder)
+    if why:
+        raise BadInput(f"{what} {PC.shown(folder)}: {why}, expected a folder of results")
     try:
         runs, _, _ = RD.discover([folder])
     except SystemExit as e:

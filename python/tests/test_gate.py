@@ -181,7 +181,7 @@ class Gate(unittest.TestCase):
 
     def test_bad_input(self):
         good_rules = self.rules([{"metric": "position_m/rmse", "max": 1}], "ok.json")
-        self.assert_bad([self.tmp / "missing", "--rules", good_rules], "not a folder")
+        self.assert_bad([self.tmp / "missing", "--rules", good_rules], "missing: No such file or directory")
         self.assert_bad([self.good, "--rules", self.tmp / "none.json"], "cannot be read")
         self.assert_bad([self.good, "--rules", self.rules("{nope", "broken.json")], "not JSON")
         self.assert_bad([self.good, "--rules", self.rules([])], "/rules: got [], expected a non-empty array")

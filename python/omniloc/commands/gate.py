@@ -9,6 +9,7 @@ from typing import Optional, Sequence
 
 from omniloc import compare as CMP
 from omniloc import gate as G
+from omniloc.core import pathcheck as PC
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -27,6 +28,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     try:
         if not 0 < a.alpha < 1:
             raise G.BadInput(f"--alpha: got {a.alpha:g}, expected a number in (0, 1)")
+        for option, out in (("--junit", a.junit), ("--benchmark-json", a.benchmark_json)):
+            why = PC.why_not_writable(out, False) if out is not None else None
+            if why:
+                raise G.BadInput(f"{option} {PC.shown(out)}: {why}")
         rules = G.load_rules(a.rules, a.baseline is not None)
         runs = G.load_runs(a.results, "results")
         base = G.load_runs(a.baseline, "baseline") if a.baseline else None

@@ -6,19 +6,33 @@ import argparse
 import json
 import os
 import pathlib
+import sys
 from typing import Optional, Sequence
 
 from omniloc import global_start as G
+from omniloc.core import pathcheck as PC
 
 
-def main(argv: Optional[Sequence[str]] = None) -> None:
+def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(prog=os.environ.get("OMNILOC_GLOBAL_START_PROG", "python3 -m omniloc.commands.global_start"),
                                  description=(G.__doc__ or "").splitlines()[0])
     ap.add_argument("folders", nargs="+")
     ap.add_argument("--json", help="write the table (and the per-run figures) as JSON here")
     ap.add_argument("--markdown", action="store_true", help="print a Markdown table (default: JSON)")
     a = ap.parse_args(argv)
-    by = G.collect(a.folders)
+    prog = ap.prog
+    try:
+        if a.json is not None:
+            PC.require_writable(a.json, "--json", False)
+        by = G.collect(a.folders)
+    except PC.PathError as e:
+        print(f"{prog}: error: {e}", file=sys.stderr)
+        return 2
+    except SystemExit as e:  # discover(): a folder that is not one, an incomplete sweep
+        if isinstance(e.code, str):
+            print(f"{prog}: error: {e.code}", file=sys.stderr)
+            return 2
+        raise
     order = [loc for loc in ("mcl", "hybrid", "grid_global") if loc in by] + sorted(set(by) - {"mcl", "hybrid", "grid_global"})
     table = {loc: G.summarise([r for _, r in by[loc]]) for loc in order}
     per_run = {loc: [{"seed": seed, "recall": r.get("recall"), "valid_fraction": r.get("valid_fraction"), "first_within_s": r.get("first_within_s"),
@@ -34,8 +48,9 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
             print(f"\n{loc}: seeds not ending right: {bad if bad else 'none'}")
     else:
         print(json.dumps({"summary": table, "runs": per_run}, indent=1))
+    return 0
 
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -37,7 +37,6 @@ from typing import Optional, Sequence
 
 from omniloc.core import pairing as PR
 from omniloc.core import rundir as RD
-from omniloc.paper import text_tables as TT
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -50,7 +49,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (said in the output)")
     a = ap.parse_args(argv)
     papers = PR.load_papers()
-    tables = TT.error_tables(papers)
     published = [k for k in papers if k not in ("comment", "claims")]
     if a.paper == "list":
         print("\n".join(published))
@@ -63,6 +61,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     except SystemExit as e:
         print(f"error: cannot read results: {e}", file=sys.stderr)
         return 2
+    from omniloc.paper import text_tables as TT  # after the results are found: its imports take a second
+    tables = TT.error_tables(papers)
     profile, how = TT.choose_profile(runs, a.profile)
     if profile is None:
         print(f"error: {how}", file=sys.stderr)

@@ -53,12 +53,13 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from typing import Optional, Sequence
 
-from omniloc.report.assemble import build
+from omniloc.core import pathcheck as PC
 
 
-def main(argv: Optional[Sequence[str]] = None) -> None:
+def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(prog=os.environ.get("OMNILOC_REPORT_PROG", "python3 -m omniloc.commands.report"), description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("results", nargs="+")
@@ -68,8 +69,31 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
     ap.add_argument("--baseline", nargs="+", help="result folders to compare with (e.g. another commit's), per metric with Welch's t")
     ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (the report says so)")
     ap.add_argument("--history", help="folder with icount.jsonl / bench.jsonl (default results/history if it exists; 'none' to leave out)")
-    build(ap.parse_args(argv))
+    a = ap.parse_args(argv)
+    prog = ap.prog
+    # Every folder named is checked before the (long) reading and drawing: a bad one is exit 2 with
+    # the option and the reason.
+    try:
+        for r in a.results:
+            PC.require_folder(r, "RESULTS", "a folder of results")
+        for r in a.baseline or []:
+            PC.require_folder(r, "--baseline", "a folder of results")
+        if a.history and a.history != "none":
+            PC.require_folder(a.history, "--history", "a folder with icount.jsonl / bench.jsonl")
+        PC.require_writable(a.out, "-o", True)
+    except PC.PathError as e:
+        print(f"{prog}: error: {e}", file=sys.stderr)
+        return 2
+    from omniloc.report.assemble import build  # after the checks: its imports take a second
+    try:
+        build(a)
+    except SystemExit as e:  # discover(): an incomplete sweep, a summary.json that cannot be read; no results
+        if isinstance(e.code, str):
+            print(e.code if e.code.startswith(prog) else f"{prog}: error: {e.code}", file=sys.stderr)
+            return 2
+        raise
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -14,6 +14,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable, List, NoReturn, Optional
 
+from omniloc.core import pathcheck as PC
 from omniloc.view.load import ViewInputError, load_run
 from omniloc.view.page import render
 
@@ -113,6 +114,18 @@ def main(argv: Optional[List[str]] = None) -> int:
     run_dir = Path(args.run_dir)
     out = Path(args.output) if args.output else run_dir / "view.html"
     try:
+        # Every path given, before anything is read: pathlib's is_dir() raises on a name over
+        # NAME_MAX and reading a FIFO blocks, so each is asked about in words first.
+        checks = [(run_dir, "RUN_DIR", "a run folder (omniloc run / replay -o DIR)"),
+                  (args.recording, "--recording", "a recording folder (omniloc record)"),
+                  (args.frames, "--frames", "the folder omniloc run --frames DIR wrote")]
+        for path, where, what in checks:
+            why = PC.why_not_readable_folder(path) if path is not None else None
+            if why:
+                raise ViewInputError(PC.shown(path), f"{why}: {where} expects {what}")
+        why = PC.why_not_writable(out, False)
+        if why:
+            raise ViewInputError(PC.shown(out), f"{why}: {'-o' if args.output else 'the page RUN_DIR/view.html'} is written there")
         if out.is_dir():
             raise ViewInputError(out, "a folder: expected the name of the HTML file to write")
         if not out.parent.is_dir() and run_dir.is_dir():

@@ -14,6 +14,8 @@ import os
 import pathlib
 from typing import Any, Iterable, Sequence
 
+from omniloc.core import pathcheck as PC
+
 # The events of events.jsonl that the report marks on a run, with their colours.
 EVENT_COLOURS = {"kidnap": "red", "cover": "black", "teleport": "red", "occlude": "grey", "lights": "orange", "camera": "purple"}
 
@@ -51,9 +53,10 @@ def discover(paths: Sequence[Any], accept_incomplete: bool = False) -> Any:
     runs, sweeps, experiments = [], [], []
     stale: set[Any] = set()
     for p in paths:
+        why = PC.why_not_readable_folder(p)
+        if why:
+            raise SystemExit(f"{PC.shown(p)}: {why}, expected a folder of results")
         p = pathlib.Path(p)
-        if not p.is_dir():
-            raise SystemExit(f"{p}: not a folder")
         for d, subdirs, files in os.walk(p):
             d = pathlib.Path(d)
             if _skip_dir(d):
@@ -90,6 +93,9 @@ class Run:
 
     def __init__(self, folder: Any) -> None:
         self.folder = pathlib.Path(folder)
+        why = PC.why_not_readable_file(self.folder / "summary.json")
+        if why:  # a FIFO named summary.json would block read_text() for ever
+            raise SystemExit(f"{PC.shown(self.folder / 'summary.json')}: {why}, expected a run's summary")
         self.summary = json.loads((self.folder / "summary.json").read_text())
         self._config = None
 

@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from omniloc.view.model import (T_TOLERANCE, ViewInputError, Blob, Debug, _finite, _read_text)
+from omniloc.view.model import (T_TOLERANCE, ViewInputError, Blob, Debug, _check_file, _finite, _read_text)
 
 # ----------------------------------------------------------------------------------- debug inputs
 
@@ -127,8 +127,7 @@ def read_recording(folder: Path, ids: Sequence[int], times: Dict[int, List[float
         raise ViewInputError(head_path, f"`frames` {head.get('frames')}: the run has {frames} frames (frames.csv)")
     name = head.get("frames_file", "frames.jsonl")
     fpath = folder / str(name)
-    if not fpath.is_file():
-        raise ViewInputError(fpath, "missing: expected the recording's frames (docs/recording.md section 4)")
+    _check_file(fpath, "the recording's frames (docs/recording.md section 4)")
     try:
         raw = gzip.open(fpath).read() if str(name).endswith(".gz") else fpath.read_bytes()
         lines = raw.decode("utf-8").splitlines()
@@ -173,6 +172,7 @@ def read_images(folder: Path, ids: Sequence[int], frames: int, every: int) -> Di
     for rid in ids:
         for k in range(0, frames, every):
             p = folder / "images" / f"r{rid}_{k:06d}.png"
+            _check_file(p, "the frame's image (the recording says it holds every image)")
             try:
                 data = p.read_bytes()
             except OSError:
@@ -196,6 +196,7 @@ def read_frame_images(folder: Path, ids: Sequence[int], frames: int, every: int)
             if k - last < every or name not in names:
                 continue
             p = folder / name
+            _check_file(p, "the frame's PNG")
             try:
                 out[rid][k] = _png_base64(p, p.read_bytes())
             except OSError as err:

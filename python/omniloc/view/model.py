@@ -2,9 +2,13 @@
 readers every input file shares (docs/viewer.md)."""
 from __future__ import annotations
 
+import errno
 import math
+import os
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Tuple, TypedDict, TypeGuard
+
+from omniloc.core import pathcheck as PC
 
 # frames.csv's own columns (docs/results.md); the others are the localizer's and are shown as given.
 FRAMES_COLUMNS = ["t", "robot", "gt_x", "gt_y", "gt_theta", "est_x", "est_y", "est_theta", "err_x", "err_y", "err_theta",
@@ -96,11 +100,18 @@ def _finite(v: Any) -> TypeGuard[float]:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-def _read_text(path: Path, what: str) -> str:
-    if not path.exists():
+def _check_file(path: Path, what: str) -> None:
+    """ViewInputError unless `path` is a readable regular file: asked before reading, as reading a
+    FIFO blocks for ever. "missing" is kept for a file that is not there (the common case)."""
+    why = PC.why_not_readable_file(path)
+    if why == os.strerror(errno.ENOENT):
         raise ViewInputError(path, f"missing: expected {what}")
-    if not path.is_file():
-        raise ViewInputError(path, f"not a file: expected {what}")
+    if why:
+        raise ViewInputError(path, f"{why}: expected {what}")
+
+
+def _read_text(path: Path, what: str) -> str:
+    _check_file(path, what)
     try:
         return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as e:
