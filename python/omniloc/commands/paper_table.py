@@ -37,7 +37,7 @@ from typing import Optional, Sequence
 
 from omniloc.core import pairing as PR
 from omniloc.core import rundir as RD
-from omniloc.paper import text_tables as TT
+from omniloc.report import text_tables as TT
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
