@@ -14,7 +14,8 @@ import tempfile
 from pathlib import Path
 from typing import Callable, List, NoReturn, Optional
 
-from omniloc.view.load import ViewInputError, load_run
+from omniloc.core.files import InputFileError
+from omniloc.view.load import load_run
 from omniloc.view.page import render
 
 DESCRIPTION = """\
@@ -114,14 +115,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     out = Path(args.output) if args.output else run_dir / "view.html"
     try:
         if out.is_dir():
-            raise ViewInputError(out, "a folder: expected the name of the HTML file to write")
+            raise InputFileError(out, "a folder: expected the name of the HTML file to write")
         if not out.parent.is_dir() and run_dir.is_dir():
-            raise ViewInputError(out.parent, "missing: expected an existing folder to write the page into")
+            raise InputFileError(out.parent, "missing: expected an existing folder to write the page into")
         run = load_run(run_dir, Path(args.recording) if args.recording else None, image_every=args.image_every,
                        images=not args.no_images, frames_dir=Path(args.frames) if args.frames else None)
         page = render(run, max_particles=args.particles, particles_every=args.particles_every)
         _write_atomically(out, page)
-    except ViewInputError as e:
+    except InputFileError as e:
         print(f"{prog}: {e}", file=sys.stderr)
         return 2
     except OSError as e:
