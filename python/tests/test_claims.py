@@ -8,9 +8,9 @@ import unittest
 from helpers import ROOT, robot, write_occlusion_sweep, write_run
 from omniloc.core import pairing as PR
 from omniloc.core import rundir as RD
+from omniloc.core import verdicts
 from omniloc.paper import causes as K
 from omniloc.paper import claims as C
-from omniloc.paper import data as D
 from omniloc.paper import quantity as Q
 from omniloc.paper import tables as T
 from omniloc.report import headline as RHL
@@ -126,18 +126,18 @@ class Causes(unittest.TestCase):
         cause = lambda expect: [{"text": "because y", "doc": "docs/x.md", "evidence": [{"label": "y", "ours": y, "unit": "cm", "expect": expect}]}]
         verdict, ex = self.verdict_and_cause(1.5, cause([1.5, 2.5]))
         self.assertEqual(verdict, "partly")
-        self.assertEqual([(e["id"], e["status"]) for e in ex], [("c1", D.EXPLAINED)])
+        self.assertEqual([(e["id"], e["status"]) for e in ex], [("c1", verdicts.EXPLAINED)])
         self.assertAlmostEqual(ex[0]["evidence"][0]["value"], 2.0)
         _, ex = self.verdict_and_cause(1.5, cause([0, 1]))
-        self.assertEqual(ex[0]["status"], D.CONTRADICTED)
+        self.assertEqual(ex[0]["status"], verdicts.CONTRADICTED)
         self.assertIn("CONTRADICTS", K.evidence_text(ex[0]["evidence"][0]))
         _, ex = self.verdict_and_cause(1.5, [{"text": "t", "evidence": [{"label": "z", "ours": {"row": ["T", "r"], "metric": "nothing/here"}}]}])
-        self.assertEqual(ex[0]["status"], D.NOT_MEASURED)
+        self.assertEqual(ex[0]["status"], verdicts.NOT_MEASURED)
         _, ex = self.verdict_and_cause(1.5, [])
-        self.assertEqual(ex[0]["status"], D.UNEXPLAINED)
+        self.assertEqual(ex[0]["status"], verdicts.UNEXPLAINED)
         # A cause written for "does not" only does not explain a "partly"; a holding claim needs none.
         _, ex = self.verdict_and_cause(1.5, [dict(cause([1.5, 2.5])[0], verdicts=["does not"])])
-        self.assertEqual(ex[0]["status"], D.UNEXPLAINED)
+        self.assertEqual(ex[0]["status"], verdicts.UNEXPLAINED)
         verdict, ex = self.verdict_and_cause(0.5, [], y_mean=0.5)
         self.assertEqual((verdict, ex), ("holds", []))
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from omniloc.paper.data import CONTRADICTED, EXPLAINED, NOT_MEASURED, UNEXPLAINED
+from omniloc.core.verdicts import CONTRADICTED, EXPLAINED, NOT_MEASURED, UNEXPLAINED
 from omniloc.paper.labels import cause_summary
 from omniloc.paper.quantity import quantity
 from omniloc.paper.tables import Context

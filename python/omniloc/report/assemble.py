@@ -12,7 +12,6 @@ from omniloc import compare as CMP
 from omniloc.core import pairing as PR
 from omniloc.core import paths as PATHS
 from omniloc.core import rundir as RD
-from omniloc.paper import data as D
 from omniloc.paper import tables as T
 from omniloc.report import real_robots as RR
 from omniloc.report.cdf import cdf_and_timing
@@ -26,6 +25,7 @@ from omniloc.report.scorecard import judge_claims, scorecard
 from omniloc.report.sweeps import global_start_section, report_sweep
 from omniloc.report import viewers as V
 from omniloc.report.viewers import ViewerReport
+from omniloc.tools.citations import BIBLIOGRAPHY
 from omniloc.tools.markup import Report
 from omniloc.tools.markup import Writer
 
@@ -34,8 +34,8 @@ def bibliography(rep: Writer) -> None:
     """The five papers, numbered as the report cites them ('Lu et al. 2013 [3]')."""
     rep.heading("References", 2, "references")
     items = []
-    for k, b in enumerate(D.BIBLIOGRAPHY):
-        items.append(f"[{k + 1}] {b['authors']}. {b['title']}. {b['venue']}, {b['year']}. {b['note']}")
+    for k, b in enumerate(BIBLIOGRAPHY):
+        items.append(f"[{k + 1}] {b.authors}. {b.title}. {b.venue}, {b.year}. {b.note}")
     rep.raw_html("<ol id='bibliography'>" + "".join(f"<li id='ref-{k + 1}'>{html.escape(t.split('] ', 1)[1])}</li>" for k, t in enumerate(items))
                  + "</ol>", "\n".join(f"{t}  " for t in items))
 

@@ -8,8 +8,8 @@ from typing import Any
 from omniloc.core import metrics as M
 from omniloc.core import pairing as PR
 from omniloc.core.stats import fnum
+from omniloc.core.verdicts import EXPLAINED
 from omniloc.paper import causes as K
-from omniloc.paper import data as D
 from omniloc.paper import labels as L
 from omniloc.paper import tables as T
 from omniloc.report.scorecard import field_robot_runs, ratio_text
@@ -112,7 +112,7 @@ def headline(rep: Writer, ctx: Context, claims: Any, field_claims: Any, causes: 
         if k and k["summary"]:
             measured = next((e for e in k["evidence"] if e["value"] is not None), None)
             s += "Cause: " + k["summary"].rstrip(".") + "." + (f" Measured here: {K.evidence_text(measured)}." if measured else "")
-            if k["status"] != D.EXPLAINED:
+            if k["status"] != EXPLAINED:
                 s += f" (Cause status: {k['status']}.)"
         else:
             s += "no cause is recorded for it yet."

@@ -10,6 +10,7 @@ from typing import Any, Sequence
 from omniloc.core import pairing as PR
 from omniloc.core.pairing import profile_of
 from omniloc.core.stats import fnum
+from omniloc.core.verdicts import CONTRADICTED, EXPLAINED, NOT_MEASURED, UNEXPLAINED
 from omniloc.paper import causes as K
 from omniloc.paper import claims as C
 from omniloc.paper import data as D
@@ -109,7 +110,7 @@ def causes_totals(causes: Any) -> Any:
     counts: dict[Any, Any] = {}
     for c in causes:
         counts[c["status"]] = counts.get(c["status"], 0) + 1
-    order = [D.EXPLAINED, D.NOT_MEASURED, D.CONTRADICTED, D.UNEXPLAINED]
+    order = [EXPLAINED, NOT_MEASURED, CONTRADICTED, UNEXPLAINED]
     return f"{len(causes)} verdicts other than holds: " + ", ".join(f"{counts[k]} {k}" for k in order if counts.get(k))
 
 
@@ -168,7 +169,7 @@ def causes_section(rep: Writer, claims: Any, field_claims: Any, causes: Any) -> 
         cause = per_profile({p: k["summary"] or "no cause recorded" for p, k in ks.items()})
         status = per_profile({p: k["status"] for p, k in ks.items()})
         rows.append([L.claim_label(c["id"]), L.cite_field(c["paper"])] + verdicts + [ratio, cause, status])
-        classes.append("" if all(k["status"] == D.EXPLAINED for k in ks.values()) else "outlier")
+        classes.append("" if all(k["status"] == EXPLAINED for k in ks.values()) else "outlier")
     rep.table(header, rows, "Claims whose verdict is not 'holds': one row per claim, its verdict under each noise profile.", classes)
     rep.details("The argument behind each cause and the measurements it rests on")
     for c in claims:

@@ -4,7 +4,7 @@
 Sections are functions that call heading / para / table / figure / image / markdown; a heading of
 level 2 becomes an entry of the table of contents. Cells are numbers (right-aligned) only when the
 whole cell is one (NUMERIC_CELL). No absolute path reaches the report (Report.clean); abbreviations
-are spelled out at their first use (Report.expand) and papers cited (omniloc.paper.labels).
+are spelled out at their first use (Report.expand) and papers cited (omniloc.tools.citations).
 Figures come from omniloc.tools.plot (the only module that imports matplotlib): Report.figure saves
 and closes them through it.
 """
@@ -19,13 +19,13 @@ import tempfile
 from typing import Any, Optional, Union
 
 from omniloc.core import paths as PATHS
-from omniloc.paper import data as D
-from omniloc.paper import labels as L
+from omniloc.core.verdicts import CONTRADICTED, DOES_NOT, EXPLAINED, HOLDS, NOT_APPLICABLE, NOT_MEASURED, NOT_RUN, PARTLY, UNEXPLAINED
+from omniloc.tools.citations import ABBREVIATIONS, cite_text
 from omniloc.tools.images import compress_png
 
 
-VERDICT_CLASS = {"holds": "ok", "partly": "partly", "does not": "no", "not run": "notrun", "n/a": "notrun",
-                 D.EXPLAINED: "ok", D.NOT_MEASURED: "notrun", D.CONTRADICTED: "no", D.UNEXPLAINED: "no"}
+VERDICT_CLASS = {HOLDS: "ok", PARTLY: "partly", DOES_NOT: "no", NOT_RUN: "notrun", NOT_APPLICABLE: "notrun",
+                 EXPLAINED: "ok", NOT_MEASURED: "notrun", CONTRADICTED: "no", UNEXPLAINED: "no"}
 
 
 # A cell is a number (right-aligned) only when the WHOLE cell is one: a number with an optional
@@ -119,7 +119,7 @@ class Report:
 
     def clean(self, text: str) -> Any:
         """text with every absolute path under a known root made relative (see __init__)."""
-        text = L.cite_text(text)  # 'paper 002' -> 'Lu et al. 2013 [3]' (the bibliography at the end)
+        text = cite_text(text)  # 'paper 002' -> 'Lu et al. 2013 [3]' (the bibliography at the end)
         if "/" not in text:
             return text
         cwd = pathlib.Path.cwd()
@@ -139,10 +139,10 @@ class Report:
         return COMMAND.sub(r"`\1`", REPO_PATH.sub("", text))
 
     def expand(self, text: str) -> Any:
-        """The text with each abbreviation of D.ABBREVIATIONS spelled out at its first use in the
+        """The text with each abbreviation of ABBREVIATIONS spelled out at its first use in the
         report (outside `code`): 'MCL (Monte Carlo localization)'. Headings are left as they are."""
         text = str(text)
-        for abbr, full in D.ABBREVIATIONS.items():
+        for abbr, full in ABBREVIATIONS.items():
             if abbr in self.expanded or abbr not in text:
                 continue
             for m in re.finditer(r"(?<![\w/.-])" + re.escape(abbr) + r"(?![\w-])", text):
