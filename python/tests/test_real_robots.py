@@ -92,7 +92,7 @@ class RealRobots(unittest.TestCase):
             # The real figures equal those the recordings' headers carry (the converter's).
             for robot in ("robot1", "robot2", "robot4", "robot5"):
                 head = json.loads((REAL / robot / "recording.json").read_text())
-                got = RR.real_noise(REAL / robot, head)
+                got = RR.real_noise(RR.read_header(REAL / robot))
                 for g, want in zip(got, head["reference"]["line_point_noise"]["bands"]):
                     self.assertEqual((g["range_m"], g["points"]), (want["range_m"], want["points"]))
                     for k in ("median_cm", "p90_cm"):

@@ -8,14 +8,13 @@ pointer and tell a null (a statistic over no frame: (True, None)) from an absent
 """
 from __future__ import annotations
 
-import csv
 import json
 import os
 import pathlib
 from typing import Any, Iterable, Sequence
 
-# The events of events.jsonl that the report marks on a run, with their colours.
-EVENT_COLOURS = {"kidnap": "red", "cover": "black", "teleport": "red", "occlude": "grey", "lights": "orange", "camera": "purple"}
+from omniloc.core.aggregate import read_aggregate, read_run_ids
+from omniloc.core.files import read_csv
 
 def _skip_dir(d: Any) -> Any:
     return d.name.startswith(".") or ".staging" in d.name or d.name.endswith(".tmp") or ".partial" in d.name
@@ -32,11 +31,11 @@ def incomplete_reason(d: Any, files: Any) -> Any:
     specs/ but no aggregate.json is a sweep whose shards or merge have not finished."""
     if "aggregate.json" in files:
         try:
-            agg = json.loads((d / "aggregate.json").read_text())
+            agg = read_aggregate(d)
         except (OSError, ValueError):
             return "its aggregate.json cannot be read"
-        if agg.get("complete") is False:
-            return f"its aggregate covers {agg.get('done')} of {agg.get('expected')} runs"
+        if agg.complete is False:
+            return f"its aggregate covers {agg.done} of {agg.expected} runs"
         return None
     if (d / "runs").is_dir() and (d / "specs").is_dir():
         return "it has no final aggregate yet (shards still running, or the merge `omniloc sweep SPEC --aggregate-only` not run)"
@@ -70,7 +69,7 @@ def discover(paths: Sequence[Any], accept_incomplete: bool = False) -> Any:
             if "aggregate.json" in files:
                 sweeps.append(d)
                 # Only the runs this sweep lists: a folder reused with another spec keeps old runs.
-                listed = {row["id"] for row in read_csv(d / "runs.csv")}
+                listed = read_run_ids(d)
                 if listed and (d / "runs").is_dir():
                     stale.update(str(x) for x in (d / "runs").iterdir() if x.name not in listed)
             if str(d) in stale:
@@ -167,14 +166,6 @@ class Run:
 
     def timing(self) -> Any:
         return read_csv(self.folder / "timing.csv")
-
-
-def read_csv(path: Any) -> Any:
-    path = pathlib.Path(path)
-    if not path.exists():
-        return []
-    with path.open(newline="") as fh:
-        return list(csv.DictReader(fh))
 
 
 def dig(obj: Any, path: Any) -> Any:

@@ -10,6 +10,7 @@ from typing import Any
 from omniloc.core import metrics as M
 from omniloc.core import rundir as RD
 from omniloc.core import stats as ST
+from omniloc.core.files import read_csv
 from omniloc.core.stats import fnum
 from omniloc.paper import claims as C
 from omniloc.paper import labels as L
@@ -196,7 +197,7 @@ def identical_maps(exp: Any) -> Any:
     """{solver: [solvers whose error map is the same cell for cell]} from an experiment's
     maps_004.csv (landmark_maps: the exact solvers are one estimator, so their heat maps are one
     picture under different titles). Empty without the file."""
-    rows = RD.read_csv(exp / "maps_004.csv") if (exp / "maps_004.csv").exists() else []
+    rows = read_csv(exp / "maps_004.csv") if (exp / "maps_004.csv").exists() else []
     cols = [k[:-len("_mean_err_cm")] for k in (rows[0] if rows else {}) if k.endswith("_mean_err_cm")]
     groups: dict[Any, Any] = {}
     for s in cols:

@@ -2,11 +2,11 @@
 """
 from __future__ import annotations
 
-import json
 import pathlib
 from typing import Any
 
 from omniloc.core import paths as PATHS
+from omniloc.core.files import read_json_lines
 from omniloc.core.stats import fnum
 from omniloc.tools import plot
 from omniloc.core.rundir import Run
@@ -14,15 +14,9 @@ from omniloc.tools.markup import Writer
 
 
 def load_jsonl(path: Any) -> Any:
-    out = []
-    if path.exists():
-        for line in path.read_text().splitlines():
-            if line.strip():
-                try:
-                    out.append(json.loads(line))
-                except json.JSONDecodeError:
-                    pass  # a line cut by an interrupted append: the others still count
-    return out
+    """The records of a history file (icount.jsonl, bench.jsonl): every line that is a JSON object; a
+    line cut by an interrupted append does not hide the others."""
+    return [r for r in read_json_lines(path) if isinstance(r, dict)]
 
 
 def history_plot(rep: Writer, records: Any, field: str, key: Any, ylabel: Any, caption: str, fmt: Any) -> None:

@@ -27,18 +27,20 @@ results/sweeps/paper_suite_field_robot).
 """
 from __future__ import annotations
 
-import gzip
-import json
 import math
 import pathlib
 import re
 import statistics
-from typing import Any, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
 from omniloc.core import metrics as M
 from omniloc.core import paths as PATHS
+from omniloc.core import recording
+from omniloc.core.framedata import pairs
+from omniloc.core.jsonvalue import JSON, number, numbers
+from omniloc.core.recording import RecordingHeader
 from omniloc.data import nubot as P
 from omniloc.core.rundir import Run
 from omniloc.report import viewers as V
@@ -69,23 +71,19 @@ PROFILES = ("robot", "field_robot")
 ORDER = ("mcl", "hybrid", "grid_global")
 
 
-_headers = {}
+# recording.json of the recordings this report has read, by folder (None: not a readable one).
+HEADERS: dict[pathlib.Path, Optional[RecordingHeader]] = {}
 
 
-def read_header(folder: Any) -> Any:
-    """recording.json of a recording folder (cached), or None."""
-    folder = pathlib.Path(folder)
-    if folder not in _headers:
-        try:
-            _headers[folder] = json.loads((folder / "recording.json").read_text())
-        except (OSError, ValueError):
-            _headers[folder] = None
-    return _headers[folder]
+def read_header(folder: pathlib.Path) -> Optional[RecordingHeader]:
+    """recording.json of a recording folder (read once per report), or None."""
+    if folder not in HEADERS:
+        HEADERS[folder] = recording.read_header(folder)
+    return HEADERS[folder]
 
 
-def has_reference(header: Any) -> Any:
-    ref = (header or {}).get("reference")
-    return isinstance(ref, dict) and isinstance(ref.get("reference"), list) and isinstance(ref.get("twin"), list)
+def has_reference(header: Optional[RecordingHeader]) -> bool:
+    return header is not None and header.reference is not None
 
 
 def recording_of(run: Run) -> Any:
@@ -97,7 +95,7 @@ def recording_of(run: Run) -> Any:
         return None
     for folder in (pathlib.Path(path), REAL_DATA / pathlib.Path(path).name):
         h = read_header(folder)
-        if has_reference(h):
+        if h is not None and has_reference(h):
             return folder, h
     return None
 
@@ -175,33 +173,31 @@ def real_runs(runs: list[Run]) -> Any:
         rec = recording_of(run)
         if rec is None:
             continue
-        j = judge(run, rec[1]["reference"]["reference"])
+        ref = rec[1].reference
+        j = judge(run, ref.reference if ref else None)
         if j is not None:
             out.append({"run": run, "folder": rec[0], "header": rec[1], "label": label_of(run), "judged": j})
     return out
 
 
-def markings_of(header: Any) -> Any:
+def markings_of(header: RecordingHeader) -> Any:
     """The field markings of a recording: its own field_markings, else drawn from its field."""
-    fm = header.get("field_markings")
-    return P.field_markings(fm if isinstance(fm, dict) and "segments" in fm else header.get("field", "msl2012"))
+    fm = header.field_markings
+    return P.field_markings(fm if fm is not None and "segments" in fm else header.raw.get("field", "msl2012"))
 
 
-def frames_of(folder: Any, header: Any, limit: Any = None) -> Any:
+def frames_of(header: RecordingHeader, limit: Optional[int] = None) -> Any:
     """The frames of a recording (robot 0): [(truth, line points (N, 2))], frames without a usable
     image, without truth or without points left out; at most `limit` of them."""
-    name = header.get("frames_file", "frames.jsonl")
-    path = pathlib.Path(folder) / name
     out: list[Any] = []
-    with (gzip.open(path) if name.endswith(".gz") else path.open("rb")) as fh:
-        for line in fh:
-            if limit is not None and len(out) >= limit:
-                break
-            if not line.strip():
-                continue
-            r = json.loads(line)["robots"][0]
-            if r.get("camera_ok", True) and r.get("truth") and r.get("line_points"):
-                out.append((r["truth"], np.asarray(r["line_points"], dtype=float).reshape(-1, 2)))
+    for frame in recording.read_frames(header):
+        if limit is not None and len(out) >= limit:
+            break
+        r = frame.robot(0)
+        truth = numbers(r.get("truth"))
+        if r.get("camera_ok", True) and r.get("truth") and r.get("line_points") and truth is not None:
+            points = pairs(r["line_points"], header.frames_path, frame.line, "line_points")
+            out.append((truth, np.asarray(points, dtype=float).reshape(-1, 2)))
     return out
 
 
@@ -229,10 +225,10 @@ def bands(d: Any, r: Any) -> Any:
     return out
 
 
-def real_noise(folder: Any, header: Any) -> Any:
+def real_noise(header: RecordingHeader) -> Any:
     """The real frame's bands: its first frame's points (every frame holds the same) at the reference pose."""
-    frames = frames_of(folder, header, limit=1)
-    pose = header["reference"]["reference"]
+    frames = frames_of(header, limit=1)
+    pose = header.reference.reference if header.reference else []
     return bands(*distances(markings_of(header), [(pose, pts) for _, pts in frames]))
 
 
@@ -243,28 +239,37 @@ def sim_recordings(sweeps: list[Any]) -> Any:
     for sw in sweeps:
         for rec in sorted(pathlib.Path(sw).glob("recordings/*/recording.json")):
             h = read_header(rec.parent)
-            sc = (h or {}).get("scenario")
-            if not isinstance(sc, dict) or h.get("name") != "tracking" or not h.get("ground_truth", True):
+            sc = h.scenario if h is not None else None
+            if h is None or sc is None or h.name != "tracking" or not h.ground_truth:
                 continue
             occ = sc.get("occlusion")
-            if isinstance(occ, dict) and occ.get("fraction", 0) > 0:
+            if isinstance(occ, dict) and (number(occ.get("fraction", 0)) or 0) > 0:
                 continue
-            out.setdefault(sc.get("noise_profile", "robot"), []).append(rec.parent)
+            out.setdefault(str(sc.get("noise_profile", "robot")), []).append(rec.parent)
     return out
 
 
 def sim_noise(recordings: Any) -> Any:
     """(bands, frames, seeds) over every frame of the given simulated recordings, pooled."""
-    d, r, nframes, seeds = [], [], 0, set()
+    d, r, nframes = [], [], 0
+    seeds: list[JSON] = []
     for folder in recordings:
         h = read_header(folder)
-        frames = frames_of(folder, h)
+        if h is None:
+            continue
+        frames = frames_of(h)
         nframes += len(frames)
-        seeds.add(h.get("seed"))
+        if h.seed not in seeds:
+            seeds.append(h.seed)
         di, ri = distances(markings_of(h), frames)
         d.append(di)
         r.append(ri)
-    return bands(np.concatenate(d), np.concatenate(r)), nframes, sorted(s for s in seeds if s is not None)
+    return bands(np.concatenate(d), np.concatenate(r)), nframes, sorted((s for s in seeds if s is not None), key=seed_order)
+
+
+def seed_order(seed: JSON) -> float:
+    """A recording's seed as a sort key (its number)."""
+    return float(seed) if isinstance(seed, (int, float)) else math.inf
 
 
 def cm_or_m(m: Any) -> Any:
@@ -376,9 +381,9 @@ def noise_table(rep: Writer, real: Any, sweeps: list[Any]) -> None:
     if not folders:  # no runs: the shipped frames still give the real figures (nothing to run for them)
         for f in sorted(REAL_DATA.glob("robot*")):
             h = read_header(f)
-            if has_reference(h):
+            if h is not None and has_reference(h):
                 folders[str(f)] = (f, h)
-    real_cols = [(f"real: {pathlib.Path(f).name}", real_noise(f, h)) for f, h in sorted(folders.values(), key=lambda v: str(v[0]))]
+    real_cols = [(f"real: {pathlib.Path(f).name}", real_noise(h)) for f, h in sorted(folders.values(), key=lambda v: str(v[0]))]
     sims = sim_recordings(sweeps)
     sim_cols, missing = [], []
     for prof in PROFILES:

@@ -2,7 +2,6 @@
 """
 from __future__ import annotations
 
-import json
 import math
 from typing import Any, Optional
 
@@ -10,6 +9,8 @@ from omniloc.core import metrics as M
 from omniloc.core import pairing as PR
 from omniloc.core import rundir as RD
 from omniloc.core import stats as ST
+from omniloc.core.events import read_events
+from omniloc.core.files import InputFileError
 from omniloc.tools import plot
 from omniloc.core.pairing import profile_of
 from omniloc.core.stats import fnum
@@ -31,9 +32,8 @@ def plot_run(rep: Writer, run: Run, title: str, link: bool = True) -> None:
         return
     rep.plotted.add(run.folder)
     try:
-        events = [json.loads(l) for l in (run.folder / "events.jsonl").read_text().splitlines() if l.strip()] if (run.folder / "events.jsonl").exists() else []
-        fig = plot.run_figure(run, frames, events)
-    except (ValueError, KeyError, TypeError, IndexError, OSError) as e:  # a malformed field.json or events.jsonl: the report goes on
+        fig = plot.run_figure(run, frames, read_events(run.folder / "events.jsonl"))
+    except (ValueError, KeyError, TypeError, IndexError, OSError, InputFileError) as e:  # a malformed field.json or events.jsonl: the report goes on
         rep.para(f"No plot for this run: {e.__class__.__name__}: {str(e)[:200]}")
     else:
         rep.figure(fig, "run", f"{title}: trajectory over the field, position and heading error over time"

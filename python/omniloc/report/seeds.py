@@ -3,7 +3,6 @@ their cause read from frames.csv and events.jsonl, and the strip plot of the see
 """
 from __future__ import annotations
 
-import json
 import math
 import statistics
 from typing import Any, Sequence
@@ -11,7 +10,7 @@ from typing import Any, Sequence
 from omniloc.core import metrics as M
 from omniloc.core import stats as ST
 from omniloc.tools import plot
-from omniloc.core.rundir import EVENT_COLOURS
+from omniloc.core.events import read_events
 from omniloc.core.stats import fnum
 from omniloc.core.rundir import Run
 from omniloc.report import viewers as V
@@ -58,16 +57,7 @@ def outlier_cause(run: Run, wrong_m: Any = 0.5) -> Any:
     frames = [f for f in run.frames() if f.get("robot", "0") == "0" and f.get("err_pos") not in (None, "")]  # scored frames (with truth)
     if not frames:
         return "no frames.csv to read the cause from"
-    events = []
-    ev = run.folder / "events.jsonl"
-    if ev.exists():
-        for line in ev.read_text().splitlines():
-            try:
-                e = json.loads(line)
-            except json.JSONDecodeError:
-                continue
-            if e.get("type") in EVENT_COLOURS:
-                events.append(e)
+    events = [e for e in read_events(run.folder / "events.jsonl", skip_bad=True) if e.marked]
     err = [(float(f["t"]), float(f["err_pos"]) if f.get("valid") == "1" else math.nan, f.get("mode", "")) for f in frames]
     bad = lambda e: not (e <= wrong_m)  # a frame without an estimate counts as wrong
     e_end = err[-1][1]
@@ -79,8 +69,8 @@ def outlier_cause(run: Run, wrong_m: Any = 0.5) -> Any:
         t0 = stretch[0][0]
         valid = sorted(e for _, e, _ in stretch if not math.isnan(e))
         typical = f"{fnum(ST.percentile(valid, 0.5), 2)} m from the truth (median)" if valid else "no estimate"
-        before = [e for e in events if e["t"] <= t0 + 0.5]
-        after_event = f", after the {before[-1]['type']} at t = {before[-1]['t']:.1f} s" if before else ""
+        before = [e for e in events if e.t <= t0 + 0.5]
+        after_event = f", after the {before[-1].type} at t = {before[-1].t:.1f} s" if before else ""
         since = "from the start" if k == 0 else f"from t = {t0:.1f} s{after_event}"
         # The localizer claimed a pose (a mode other than searching / lost) that was wrong: the
         # worst failure, as it does not know it is lost.
@@ -112,11 +102,11 @@ def outlier_cause(run: Run, wrong_m: Any = 0.5) -> Any:
     stretches.append(cur)
     longest = max(stretches, key=lambda st: sum(dur(k) for k in st))
     a, b = times[longest[0]], times[longest[-1]] + dur(longest[-1])
-    before = [e for e in events if e["t"] <= a + 0.5]
+    before = [e for e in events if e.t <= a + 0.5]
     off = statistics.median(err[k][1] for k in longest)
     return (f"on a wrong pose (> {wrong_m} m off) for {sum(dur(k) for k in wrong):.1f} s of {total:.1f} s"
             + (", longest" if len(stretches) > 1 else ",") + f" from t = {a:.1f} to {b:.1f} s"
-            + (f" (after the {before[-1]['type']} at t = {before[-1]['t']:.1f} s)" if before else "")
+            + (f" (after the {before[-1].type} at t = {before[-1].t:.1f} s)" if before else "")
             + f", {fnum(off, 2)} m off (median); within {wrong_m} m at the end")
 
 

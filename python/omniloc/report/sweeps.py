@@ -4,11 +4,12 @@ sweeps judged per run (omniloc.global_start).
 from __future__ import annotations
 
 import json
-from typing import Any
+from typing import Any, Optional
 
 from omniloc import global_start as G
 from omniloc.core import metrics as M
 from omniloc.core import rundir as RD
+from omniloc.core.aggregate import Aggregate, AggregateMetric, read_aggregate, read_runs_csv
 from omniloc.core.stats import fnum
 from omniloc.report import viewers as V
 from omniloc.report.runs import params_text, report_run, run_title
@@ -22,11 +23,9 @@ def sweep_runs(sweep: Any, all_runs: list[Run]) -> Any:
     params and the localizer name of their row: runs.csv's, the name the aggregate gives the row
     (docs/protocol.md "Which name"; a run missing from runs.csv: the name in its summary.json)."""
     by_folder = {r.folder: r for r in all_runs}
-    order = {}
-    for row in RD.read_csv(sweep / "runs.csv"):
-        order[row["id"]] = (int(row["index"]), row["params"], row.get("localizer"))
-    agg = json.loads((sweep / "aggregate.json").read_text())
-    group_rank = {(g.get("scenario"), g.get("localizer"), g.get("params")): k for k, g in enumerate(agg["groups"])}
+    order = {row.id: (row.index, row.params, row.localizer) for row in read_runs_csv(sweep)}
+    agg = read_aggregate(sweep)
+    group_rank = {(g.scenario, g.localizer, g.params): k for k, g in enumerate(agg.groups)}
     out = []
     for folder, run in by_folder.items():
         if folder.parent != sweep / "runs":
@@ -38,51 +37,58 @@ def sweep_runs(sweep: Any, all_runs: list[Run]) -> Any:
     return [(r, p, n) for _, _, r, p, n in sorted(out, key=lambda x: (x[0], x[1]))]
 
 
-def aggregate_cell(metric: Any, digits: int) -> Any:
-    """One metric of an aggregate.json group ({"n", "mean", "no_value", ...}): its mean; "no
-    estimate" where no run had a value; "-" where the group lacks the metric."""
+def aggregate_cell(metric: Optional[AggregateMetric], digits: int) -> str:
+    """One metric of an aggregate.json group: its mean; "no estimate" where no run had a value; "-"
+    where the group lacks the metric."""
     if not metric:
         return "-"
-    if metric.get("mean") is None:
-        return M.NO_ESTIMATE if metric.get("no_value") else "-"
-    return fnum(metric["mean"], digits)
+    if metric.mean is None:
+        return M.NO_ESTIMATE if metric.no_value else "-"
+    return fnum(metric.mean, digits)
 
 
-def middle_recall_key(agg: Any) -> Any:
+def middle_recall_key(agg: Aggregate) -> Optional[str]:
     """The middle recall threshold an aggregate names (its runs' headline where they do not say)."""
-    keys = sorted({k.split("/")[-1] for g in agg.get("groups", []) for k in g.get("metrics", {}) if k.startswith("r0/recall/")}, key=M.recall_order)
+    keys = sorted({k.split("/")[-1] for g in agg.groups for k in g.metrics if k.startswith("r0/recall/")}, key=M.recall_order)
     return keys[len(keys) // 2] if keys else None
 
 
 def report_sweep(rep: Writer, sweep: Any, all_runs: list[Run], max_runs: Any) -> Any:
-    agg = json.loads((sweep / "aggregate.json").read_text())
-    name = agg.get("sweep", agg.get("name", sweep.name))
+    agg = read_aggregate(sweep)
+    name = agg.name
     rep.heading(f"Sweep {name}", 2)
-    o = agg.get("omniloc") or {}
-    rep.para(f"{sweep}: {agg.get('runs')} runs; aggregated by omniloc {o.get('version', 'unrecorded')}; runs made by "
-             + ", ".join(f"{v} ({n})" for v, n in (agg.get("run_versions") or {}).items()) + ".")
+    rep.para(f"{sweep}: {agg.runs} runs; aggregated by omniloc {agg.version}; runs made by "
+             + ", ".join(f"{v} ({n})" for v, n in agg.run_versions.items()) + ".")
     rows = []
     # Groups given the start pose say so where the sweep also has groups that were not (a sweep
     # from before start_pose_given has neither).
-    kinds = {g.get("start_pose_given") for g in agg["groups"]}
+    kinds = {g.start_pose_given for g in agg.groups}
     mark = True in kinds and (False in kinds or "mixed" in kinds)
     runs = sweep_runs(sweep, all_runs)
     key = M.headline_key([r for r, _, _ in runs]) or middle_recall_key(agg)
-    answered = any("r0/valid_fraction" in g["metrics"] for g in agg["groups"])
-    for g in agg["groups"]:
-        m = g["metrics"]
+    answered = any("r0/valid_fraction" in g.metrics for g in agg.groups)
+    for g in agg.groups:
+        m = g.metrics
         phase = "r0/tracking_phase/x_cm/mean" in m
-        name = lambda path: f"r0/tracking_phase/{path}" if phase else f"r0/{path}"
-        cell = lambda path, digits: aggregate_cell(m.get(name(path)), digits)
-        x = m.get("r0/x_cm/mean", {})
-        n, without = x.get("n", 0), x.get("no_value", 0)
-        given = g.get("start_pose_given")
+
+        def metric(path: str) -> Optional[AggregateMetric]:
+            return m.get(f"r0/tracking_phase/{path}" if phase else f"r0/{path}")
+
+        def cell(path: str, digits: int) -> str:
+            return aggregate_cell(metric(path), digits)
+
+        def mean_of(path: str) -> Optional[float]:
+            found = metric(path)
+            return found.mean if found else None
+        x = m.get("r0/x_cm/mean")
+        n, without = (x.n, x.no_value) if x else (0, 0)
+        given = g.start_pose_given
         task = " (given the start pose)" if mark and given is True else " (start pose: mixed)" if given == "mixed" else ""
-        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')}{task} / {params_text(g.get('params', ''))}" + (" (tracking phase)" if phase else "")] +
-                    ([M.percent((m.get(name(f"recall/{key}")) or {}).get("mean"))] if key else []) +
-                    ([M.percent((m.get(name("valid_fraction")) or {}).get("mean"))] if answered else []) +
+        rows.append([f"{g.scenario or ''} / {g.localizer or ''}{task} / {params_text(g.params or '')}" + (" (tracking phase)" if phase else "")] +
+                    ([M.percent(mean_of(f"recall/{key}"))] if key else []) +
+                    ([M.percent(mean_of("valid_fraction"))] if answered else []) +
                     [cell(f"{a}/{s}", 3) for a, s in M.TABLE_KEYS] + [cell("position_m/mean", 3), cell("position_m/rmse", 3)] +
-                    [f"{g.get('finished', '-')}/{g.get('failed', 0)}", f"{n}; {M.no_estimate_text(without, n + without)}" if without else n])
+                    [f"{g.finished}/{g.failed}", f"{n}; {M.no_estimate_text(without, n + without)}" if without else n])
     rep.table(["group"] + ([f"within {M.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + M.TABLE_COLS +
               ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
               "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'."
@@ -90,8 +96,8 @@ def report_sweep(rep: Writer, sweep: Any, all_runs: list[Run], max_runs: Any) ->
                  "'answered': the share of frames with an estimate; the errors are over the answered frames, 'no estimate' where no run of the "
                  "group answered any, and n counts the runs with a value (aggregate.csv also counts those without one)." if key or answered else ""))
     groups: dict[Any, Any] = {}
-    for run, params, name in runs:
-        groups.setdefault((run.scenario, name, params), []).append(run)
+    for run, params, row_name in runs:
+        groups.setdefault((run.scenario, row_name, params), []).append(run)
     rows_runs = [(f"{k[0]} / {k[1]} / {params_text(k[2])}", sorted(v, key=lambda r: r.seed)) for k, v in groups.items()]
     # Groups whose every seed a published table above already showed are not shown again.
     seeded = rep.__dict__.get("seeded", set())
@@ -104,13 +110,16 @@ def report_sweep(rep: Writer, sweep: Any, all_runs: list[Run], max_runs: Any) ->
     flagged = shown_flagged + seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json and aggregate.csv hold the same intervals by the same rule (column interval: t95 or range).")
     # Per run: its tables always; plots for the first seed of each group (every condition shown
     # once, at most max_runs) and for every outlying seed, collapsed: a reader opens what they need.
-    rep.details(f"Runs of sweep {name}: {len(runs)} runs, tables and plots")
+    # The title names the localizer row of the sweep's last run, not the sweep (as it always has: the
+    # same report byte for byte; naming the sweep is a change of its own).
+    last = runs[-1][2] if runs else name
+    rep.details(f"Runs of sweep {last}: {len(runs)} runs, tables and plots")
     plotted, seen = 0, set()
-    for run, params, name in runs:
-        first = (run.scenario, name, params) not in seen
-        seen.add((run.scenario, name, params))
+    for run, params, row_name in runs:
+        first = (run.scenario, row_name, params) not in seen
+        seen.add((run.scenario, row_name, params))
         report_run(rep, run, plots=(first and plotted < max_runs) or run in flagged, params=params,
-                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None, name=name)
+                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None, name=row_name)
         plotted += first
     rep.end_details()
     return [r for r, _, _ in runs]

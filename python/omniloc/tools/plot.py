@@ -19,8 +19,8 @@ from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormat
 
 from omniloc.core import metrics as M  # noqa: E402
 from omniloc.core import stats as ST  # noqa: E402
-from omniloc.core.rundir import EVENT_COLOURS, Run  # noqa: E402
-from omniloc.core.rundir import Run
+from omniloc.core.events import EVENT_COLOURS, Event  # noqa: E402
+from omniloc.core.rundir import Run  # noqa: E402
 
 
 def save(fig: Figure, path: Any, dpi: int) -> None:
@@ -105,7 +105,7 @@ def field_lines(ax: Any, run: Run) -> None:
     ax.set_ylim(-hy, hy)
 
 
-def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, Any]]) -> Figure:
+def run_figure(run: Run, frames: list[dict[str, str]], events: list[Event]) -> Figure:
     """A run's trajectory over the field, and its position and heading error over time with its events."""
     by_robot: dict[str, list[dict[str, str]]] = {}
     for f in frames:
@@ -131,7 +131,7 @@ def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, An
     ax.set_ylabel("y (m)")
     ax.set_title("trajectory on the field", fontsize=10)
     ax.legend(fontsize=7, loc="upper right")
-    kinds = sorted({e["type"] for e in events if e.get("type") in EVENT_COLOURS})
+    kinds = sorted({e.type for e in events if e.type is not None and e.marked})
     for k, (col, label, unit, scale) in enumerate([("err_pos", "position error", "cm", 100.0), ("err_theta", "heading error", "deg", 180.0 / math.pi)]):
         ax = axes[1 + k]
         for rid, fr in sorted(by_robot.items()):
@@ -140,10 +140,10 @@ def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, An
         # Events: a triangle above the plotting area and a faint dashed line BEHIND the data, so a
         # mark never hides the error it explains.
         for e in events:
-            c = EVENT_COLOURS.get(e.get("type") or "")
+            c = EVENT_COLOURS.get(e.type or "")
             if c:
-                ax.axvline(e["t"], color=c, lw=0.6, ls=(0, (3, 3)), alpha=0.45, zorder=1)
-                ax.plot([e["t"]], [1.0], marker="v", color=c, ms=6, transform=ax.get_xaxis_transform(), clip_on=False, zorder=4)
+                ax.axvline(e.t, color=c, lw=0.6, ls=(0, (3, 3)), alpha=0.45, zorder=1)
+                ax.plot([e.t], [1.0], marker="v", color=c, ms=6, transform=ax.get_xaxis_transform(), clip_on=False, zorder=4)
         t_end = max(float(f["t"]) for f in frames)
         for r in run.summary.get("robots", []):  # left out of the tracking phase: shaded
             for a, b in (r.get("tracking_phase") or {}).get("excluded", []):
