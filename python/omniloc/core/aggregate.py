@@ -9,7 +9,8 @@ from dataclasses import dataclass
 from typing import Optional, Union
 
 from omniloc.core.files import read_csv
-from omniloc.core.jsonvalue import JSON, integer, load_file, lst, number, obj, text
+from omniloc.core.jsonvalue import JSON, JSONObject, integer, load_file, lst, number, obj, text
+from omniloc.core.stats import NO_INTERVAL
 
 
 @dataclass(frozen=True)
@@ -22,6 +23,15 @@ class AggregateMetric:
     ci95: tuple[Optional[float], Optional[float]]
     interval: Optional[str]
     no_value: int
+
+    def bounds(self) -> tuple[Optional[float], Optional[float], str]:
+        """(lo, hi, kind) of the metric's interval. Aggregates written before the rule have no
+        "interval" and hold an unclipped Student t interval for every n >= 2: the kind is then
+        "t95 (old aggregate)" for n >= 2, so a reader never takes it for the current rule's."""
+        kind = self.interval
+        if kind is None:
+            kind = NO_INTERVAL if self.n < 2 else "t95 (old aggregate)"
+        return self.ci95[0], self.ci95[1], kind
 
     @staticmethod
     def from_json(raw: JSON) -> AggregateMetric:
@@ -102,3 +112,26 @@ def read_run_ids(sweep: pathlib.Path) -> set[str]:
     """The run ids runs.csv lists (an empty set without the file)."""
     return {row["id"] for row in read_csv(sweep / "runs.csv")}
 
+
+def summary_metrics(summary: JSONObject) -> dict[str, Optional[float]]:
+    """Every number of a summary.json under its aggregate.csv name (batch/aggregate.cpp run_metrics):
+    "r<robot>/<path>" for the robots' blocks, "<path>" for the sweep-level "metrics" block. A null
+    (a statistic over no answered frame) is kept as None: the metric exists and has no value."""
+    out: dict[str, Optional[float]] = {}
+
+    def flat(value: JSON, prefix: str) -> None:
+        if isinstance(value, bool):
+            return
+        if value is None:
+            out[prefix] = None
+        elif isinstance(value, (int, float)):
+            out[prefix] = float(value)
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                flat(v, f"{prefix}/{k}" if prefix else k)
+
+    for robot in lst(summary.get("robots")):
+        r = obj(robot)
+        flat({k: v for k, v in r.items() if k != "robot"}, f"r{r.get('robot', 0)}")
+    flat(summary.get("metrics") or {}, "")
+    return out

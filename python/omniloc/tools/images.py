@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import io
-from typing import Any
+import pathlib
 
 
-def compress_png(path: Any) -> Any:
+def compress_png(path: pathlib.Path) -> pathlib.Path:
     """Re-encodes a picture so that report.html, which embeds every one, stays under 3 MB without
     leaving one out: plots (few colours) as an optimised 256-colour palette PNG; camera frames and
     other photographic pictures, which stay large as a palette PNG, as JPEG (quality 85). Keeps the
@@ -16,7 +16,6 @@ def compress_png(path: Any) -> Any:
         from PIL import Image
     except ImportError:
         return path
-    import io
     with Image.open(path) as im:
         im.load()
     has_alpha = im.mode in ("RGBA", "LA") or (im.mode == "P" and "transparency" in im.info)
