@@ -60,7 +60,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [os.path.join(REPO, "python"), os.path.join(REPO, "clients", "python")]
 import omniloc_recording  # noqa: E402
 from omniloc.data import nubot as refpose  # noqa: E402
-from omniloc.data.nubot_frames import (SOURCE_COMMIT, SOURCE_REPOSITORY, _reproducible_gzip, mirror_law, noise_by_band,  # noqa: E402
+from omniloc.data.nubot_frames import (SOURCE_COMMIT, SOURCE_REPOSITORY, reproducible_gzip, mirror_law, noise_by_band,  # noqa: E402
                                        pixels_to_robot, read_whites, read_xml_numbers, sha256_file)
 
 
@@ -133,7 +133,7 @@ def convert(calib_dir, out, robot_label, field="msl2012", frames=300, rate=30.0,
         for k in range(frames):
             w.frame(k / rate, [{"robot": 0, "odometry": (0.0, 0.0, 0.0), "heading": None,
                                 "line_points": line_points, "truth": truth}])
-    _reproducible_gzip(os.path.join(out, "frames.jsonl.gz"))
+    reproducible_gzip(os.path.join(out, "frames.jsonl.gz"))
     if not quiet:
         print(json.dumps({"out": out, "line_points": len(pts), "reference": res["reference"], "twin": res["twin"],
                           "residual_m": res["residual_m"], "inliers": res["inliers"], "next_best": res["next_best"],

@@ -29,12 +29,29 @@ from __future__ import annotations
 
 import json
 import textwrap
-from typing import Any
+from typing import Callable, Iterator, NamedTuple, Optional, Sequence, Union
 
-from omniloc.core import metrics as M
-from omniloc.core import pairing as PR
-from omniloc.core import stats as ST
+from omniloc.core import metrics, pairing, stats
+from omniloc.core.jsonvalue import JSON
 from omniloc.core.rundir import Run
+from omniloc.core.stats import SeedStats, Welch
+
+# A cell of compare_rows' table: text, or a count of runs.
+Cell = Union[str, int]
+
+
+class GroupKey(NamedTuple):
+    """A condition: scenario, localizer, configuration (config.json without the seed and the run's
+    name, as sorted JSON text) and whether the runs were given the start pose (True, False, or None
+    for runs from before omniloc recorded it). Runs of one condition are its seeds."""
+    scenario: Optional[str]
+    localizer: Optional[str]
+    config: str
+    start_pose_given: Optional[bool]
+
+
+# The pairs of compare_pairs: (A's key, B's key, what differs between them).
+Pair = tuple[GroupKey, GroupKey, list[str]]
 
 
 # After the coverage metrics (recall at the headline threshold, valid_fraction: metrics_for), in this order.
@@ -55,102 +72,106 @@ EXPLANATION = ("Runs pair by scenario, localizer and effective configuration (no
                "'exceeds spread': Welch's t-test over seeds, p < alpha; n < 2: no spread to compare with.")
 
 
-def metrics_for(runs: list[Run], metrics: Any = None) -> Any:
+def metrics_for(runs: list[Run], wanted: Optional[Sequence[str]] = None) -> list[str]:
     """The metrics of a pair of conditions, coverage first: recall at the runs' headline threshold,
     the share answered (valid_fraction), then `metrics` (default METRICS: the errors over answered
     frames, position RMSE first), then the other recall thresholds and the time to the first
     estimate within the headline threshold. Runs from before recall was scored: `metrics` alone."""
-    metrics = list(METRICS if metrics is None else metrics)
-    head = M.headline_key(runs)
+    names = list(METRICS if wanted is None else wanted)
+    head = metrics.headline_key(runs)
     if head is None:
-        return [COVERAGE] + metrics if any(r.lookup(COVERAGE)[0] for r in runs) and COVERAGE not in metrics else metrics
-    others = [f"recall/{k}" for k in M.recall_keys(runs) if k != head]
-    return [f"recall/{head}", COVERAGE] + [m for m in metrics if m != COVERAGE] + others + ["first_within_s"]
+        return [COVERAGE] + names if any(r.lookup(COVERAGE)[0] for r in runs) and COVERAGE not in names else names
+    others = [f"recall/{k}" for k in metrics.recall_keys(runs) if k != head]
+    return [f"recall/{head}", COVERAGE] + [m for m in names if m != COVERAGE] + others + ["first_within_s"]
 
 
-def group_key(run: Run) -> Any:
-    """(scenario, localizer, configuration, start_pose_given): the start pose is part of the
-    condition (True, False, or None for runs from before omniloc recorded it)."""
+def group_key(run: Run) -> GroupKey:
+    """The run's condition: the start pose is part of it (True, False, or None for runs from before
+    omniloc recorded it)."""
     cfg = dict(run.config)
     cfg.pop("seed", None)
     cfg.pop("name", None)
-    return (run.scenario, run.localizer, json.dumps(cfg, sort_keys=True), run.start_pose_given)
+    return GroupKey(run.scenario, run.localizer, json.dumps(cfg, sort_keys=True), run.start_pose_given)
 
 
-def same_task(x: Any, y: Any) -> Any:
-    """Whether two conditions ran the same start-pose task (PR.start_pose_compatible)."""
-    return PR.start_pose_compatible(x[3], y[3])
+def same_task(x: GroupKey, y: GroupKey) -> bool:
+    """Whether two conditions ran the same start-pose task (pairing.start_pose_compatible)."""
+    return pairing.start_pose_compatible(x.start_pose_given, y.start_pose_given)
 
 
-def flatten(obj: Any, prefix: Any = "") -> Any:
-    out = {}
-    if isinstance(obj, dict):
-        for k, v in obj.items():
+def flatten(value: JSON, prefix: str = "") -> dict[str, str]:
+    """{JSON pointer: the value's compact JSON text} of every leaf (arrays of objects indexed)."""
+    out: dict[str, str] = {}
+    if isinstance(value, dict):
+        for k, v in value.items():
             out.update(flatten(v, f"{prefix}/{k}"))
-    elif isinstance(obj, list) and obj and all(isinstance(v, dict) for v in obj):
-        for i, v in enumerate(obj):
+    elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        for i, v in enumerate(value):
             out.update(flatten(v, f"{prefix}/{i}"))
     else:
-        out[prefix] = json.dumps(obj, separators=(",", ":"))
+        out[prefix] = json.dumps(value, separators=(",", ":"))
     return out
 
 
-def flat_config(key: Any) -> Any:
-    return flatten(json.loads(key[2]))
+def flat_config(key: GroupKey) -> dict[str, str]:
+    parsed: JSON = json.loads(key.config)
+    return flatten(parsed)
 
 
-def differing(fa: Any, fb: Any, skip_localizer: Any = False) -> Any:
+def differing(fa: dict[str, str], fb: dict[str, str], skip_localizer: bool = False) -> list[str]:
     """The JSON pointers whose values differ between two flattened configurations, all of them."""
     ptrs = sorted(p for p in set(fa) | set(fb) if fa.get(p) != fb.get(p))
     return [p for p in ptrs if not (skip_localizer and p.startswith("/localizer"))]
 
 
-def labels(keys: Any) -> Any:
+def labels(keys: set[GroupKey]) -> dict[GroupKey, str]:
     """'scenario / localizer', plus EVERY configuration value that tells apart conditions sharing both
     (no '...': two variants must never look identical)."""
-    by: dict[Any, Any] = {}
+    by: dict[tuple[Optional[str], Optional[str]], list[GroupKey]] = {}
     for k in keys:
-        by.setdefault(k[:2], []).append(k)
+        by.setdefault((k.scenario, k.localizer), []).append(k)
     out = {}
     for sl, ks in by.items():
         flat = {k: flat_config(k) for k in ks}
         ptrs = sorted({p for f in flat.values() for p in f if len({f.get(p) for f in flat.values()}) > 1})
         # Where one side holds a condition both with and without the start pose, the given one says so.
-        both = {k[3] for k in ks} >= {True, False}
+        both = {k.start_pose_given for k in ks} >= {True, False}
         for k in ks:
             extra = ", ".join(f"{p}={flat[k].get(p, 'absent')}" for p in ptrs)
-            out[k] = f"{sl[0]} / {sl[1]}" + (f" / {extra}" if extra else "") + (" (given the start pose)" if both and k[3] is True else "")
+            out[k] = f"{sl[0]} / {sl[1]}" + (f" / {extra}" if extra else "") + (" (given the start pose)" if both and k.start_pose_given is True else "")
     return out
 
 
-def groups(runs: list[Run]) -> Any:
-    g: dict[Any, Any] = {}
+def groups(runs: list[Run]) -> dict[GroupKey, list[Run]]:
+    """The runs by condition (their seeds), in the order of the runs."""
+    g: dict[GroupKey, list[Run]] = {}
     for r in runs:
         g.setdefault(group_key(r), []).append(r)
     return g
 
 
-def verdict(w: Any, a: Any, b: Any, alpha: float, none_a: Any = 0, none_b: Any = 0, of_a: Any = 0, of_b: Any = 0) -> Any:
+def verdict(w: Welch, a: Sequence[float], b: Sequence[float], alpha: float, none_a: int = 0, none_b: int = 0, of_a: int = 0, of_b: int = 0) -> str:
     """'yes' / 'no' (Welch, p < alpha), 'n < 2', 'same', '-'; where a side has runs without a value
     (no estimate), no test is made and the verdict names them: 'no estimate in 1 of 3 runs (B)'."""
     if none_a or none_b:
         if (none_a, of_a) == (none_b, of_b):
-            return f"{M.no_estimate_text(none_a, of_a)} (A and B)"
-        return "; ".join(f"{M.no_estimate_text(k, n)} ({side})" for side, k, n in (("A", none_a, of_a), ("B", none_b, of_b)) if k)
+            return f"{metrics.no_estimate_text(none_a, of_a)} (A and B)"
+        return "; ".join(f"{metrics.no_estimate_text(k, n)} ({side})" for side, k, n in (("A", none_a, of_a), ("B", none_b, of_b)) if k)
     if len(a) == len(b) and a and all(x == y for x, y in zip(sorted(a), sorted(b))):
         return "same"
-    if w["diff"] is None:
+    if w.diff is None:
         return "-"
-    if w["p"] is None:
+    if w.p is None:
         return "n < 2"
-    return "yes" if w["p"] < alpha else "no"
+    return "yes" if w.p < alpha else "no"
 
 
-def mutual_nearest(left_a: Any, left_b: Any, same: Any, skip_localizer: Any = False) -> Any:
+def mutual_nearest(left_a: list[GroupKey], left_b: list[GroupKey], same: Callable[[GroupKey, GroupKey], bool],
+                   skip_localizer: bool = False) -> list[tuple[GroupKey, GroupKey]]:
     """Pairs (ka, kb) of leftover groups for which same(ka, kb) holds and each is the other's unique
     nearest (fewest differing configuration values): a variant finds its counterpart even when
     every run of one side also differs in some value (e.g. a default a newer build added)."""
-    def nearest(k: Any, pool: Any, fk: Any) -> Any:
+    def nearest(k: GroupKey, pool: list[GroupKey], fk: dict[str, str]) -> Optional[GroupKey]:
         cands = [(len(differing(fk, flat_config(o), skip_localizer)), o) for o in pool if same(k, o)]
         if not cands:
             return None
@@ -164,7 +185,8 @@ def mutual_nearest(left_a: Any, left_b: Any, same: Any, skip_localizer: Any = Fa
     return pairs
 
 
-def compare_pairs(runs_a: list[Run], runs_b: list[Run]) -> Any:
+def compare_pairs(runs_a: list[Run], runs_b: list[Run]) -> tuple[list[Pair], list[GroupKey], list[GroupKey],
+                                                                 dict[GroupKey, list[Run]], dict[GroupKey, list[Run]]]:
     """The conditions of A and B paired BY KEY: [(ka, kb, differences)], then A's and B's unpaired
     keys. First identical keys (scenario, localizer, configuration); then, among the rest, the
     same scenario and localizer with the nearest configuration; then the same scenario with
@@ -183,7 +205,7 @@ def compare_pairs(runs_a: list[Run], runs_b: list[Run]) -> Any:
         pairs += found
         left_a = [k for k in left_a if k not in {p[0] for p in found}]
         left_b = [k for k in left_b if k not in {p[1] for p in found}]
-    out = []
+    out: list[Pair] = []
     for ka, kb in sorted(pairs, key=lambda p: (p[0][0], p[0][1], p[0][2], sort_key(p[0]))):
         diffs = [] if ka[1] == kb[1] else [f"localizer: {ka[1]} -> {kb[1]}"]
         fa, fb = flat_config(ka), flat_config(kb)
@@ -192,32 +214,32 @@ def compare_pairs(runs_a: list[Run], runs_b: list[Run]) -> Any:
     return out, left_a, left_b, ga, gb
 
 
-def sort_key(k: Any) -> Any:
+def sort_key(k: GroupKey) -> tuple[Optional[str], Optional[str], str, int]:
     """Keys sort with their start pose (None, False, True do not compare with each other)."""
-    return (k[0], k[1], k[2], {None: 0, False: 1, True: 2}[k[3]])
+    return (k.scenario, k.localizer, k.config, 0 if k.start_pose_given is None else 2 if k.start_pose_given else 1)
 
 
-def unpaired_reason(k: Any, other: Any) -> Any:
+def unpaired_reason(k: GroupKey, other: Union[dict[GroupKey, list[Run]], list[GroupKey]]) -> str:
     """Why condition `k` of one side has no counterpart: '' (the other side did not run it), or
     'not comparable: ...' when the other side ran the same scenario with the other start-pose task."""
-    clash = [o for o in other if o[0] == k[0] and not same_task(k, o)]
+    clash = [o for o in other if o.scenario == k.scenario and not same_task(k, o)]
     if not clash:
         return ""
-    return (f"not comparable: {PR.start_pose_text(k[3])} here, {PR.start_pose_text(clash[0][3])} on the other side "
+    return (f"not comparable: {pairing.start_pose_text(k.start_pose_given)} here, {pairing.start_pose_text(clash[0].start_pose_given)} on the other side "
             "(tracking from the true start pose and global localization are different tasks)")
 
 
-def compare_rows(runs_a: list[Run], runs_b: list[Run], alpha: float = ALPHA, metrics: Any = METRICS) -> Any:
+def compare_rows(runs_a: list[Run], runs_b: list[Run], alpha: float = ALPHA, wanted: Sequence[str] = METRICS) -> tuple[list[str], list[list[Cell]]]:
     """[header, rows]: one row per paired condition and metric, then the unpaired conditions."""
     pairs, only_a, only_b, ga, gb = compare_pairs(runs_a, runs_b)
     names = side_labels(ga, gb)
     header = ["scenario / localizer / differing configuration", "metric", "A mean", "n", "B mean", "n", "B - A", "p (Welch)", "exceeds spread"]
-    rows = []
+    rows: list[list[Cell]] = []
     for ka, kb, diffs in pairs:
         label = names[ka] + (f" (A vs B: {'; '.join(diffs)})" if diffs else "")
-        for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, metrics):
-            rows.append([label, m, mean_text(sa), sa["n"], mean_text(sb), sb["n"],
-                         ST.fnum(w["diff"], 4), ST.fnum(w["p"], 3) if w["p"] is not None else "-", v])
+        for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, wanted):
+            rows.append([label, m, mean_text(sa), sa.n, mean_text(sb), sb.n,
+                         stats.fnum(w.diff, 4), stats.fnum(w.p, 3) if w.p is not None else "-", v])
     for k in only_a:
         why = unpaired_reason(k, gb)
         rows.append([names[k], f"(only in A{': ' + why if why else ''})", "", len(ga[k]), "", "", "", "", ""])
@@ -227,7 +249,7 @@ def compare_rows(runs_a: list[Run], runs_b: list[Run], alpha: float = ALPHA, met
     return header, rows
 
 
-def side_labels(ga: Any, gb: Any) -> Any:
+def side_labels(ga: dict[GroupKey, list[Run]], gb: dict[GroupKey, list[Run]]) -> dict[GroupKey, str]:
     """Labels made within each side (A's variants told apart among A's, B's among B's): what tells
     A from B is listed separately, as the pair's differences."""
     names = labels(set(gb))
@@ -235,35 +257,38 @@ def side_labels(ga: Any, gb: Any) -> Any:
     return names
 
 
-def mean_text(st: Any, digits: int = 4) -> Any:
+def mean_text(st: SeedStats, digits: int = 4) -> str:
     """A side's mean over seeds; 'no estimate' where every run has the statistic null."""
-    return M.NO_ESTIMATE if not st["n"] and st.get("no_value") else ST.fnum(st["mean"], digits)
+    return metrics.NO_ESTIMATE if not st.n and st.no_value else stats.fnum(st.mean, digits)
 
 
-def metric_rows(ra: list[Run], rb: list[Run], alpha: float, metrics: Any = None) -> Any:
+def metric_rows(ra: list[Run], rb: list[Run], alpha: float, wanted: Optional[Sequence[str]] = None) -> Iterator[tuple[str, SeedStats, SeedStats, Welch, str]]:
     """(metric, stats A, stats B, Welch, verdict) per metric that either side has (metrics_for's
-    order: coverage first). stats are M.run_stats: n counts the runs with a value, no_value those
-    where it is null. No difference and no test where a side has runs without a value."""
-    for m in metrics_for(list(ra) + list(rb), metrics):
-        sa, sb = M.run_stats(ra, m), M.run_stats(rb, m)
-        if not sa["of"] and not sb["of"]:
+    order: coverage first). stats are metrics.run_stats: n counts the runs with a value, no_value
+    those where it is null. No difference and no test where a side has runs without a value."""
+    for m in metrics_for(list(ra) + list(rb), wanted):
+        sa, sb = metrics.run_stats(ra, m), metrics.run_stats(rb, m)
+        if not sa.of and not sb.of:
             continue
-        a, b = sa["values"], sb["values"]
-        w = ST.welch(a, b)
-        if sa["no_value"] or sb["no_value"]:
-            w = {"diff": None, "t": None, "df": None, "p": None}
-        yield m, sa, sb, w, verdict(w, a, b, alpha, sa["no_value"], sb["no_value"], sa["of"], sb["of"])
+        a, b = sa.values, sb.values
+        w = stats.welch(a, b)
+        if sa.no_value or sb.no_value:
+            w = Welch(diff=None, t=None, df=None, p=None)
+        yield m, sa, sb, w, verdict(w, a, b, alpha, sa.no_value, sb.no_value, sa.of, sb.of)
 
 
-def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: Any = 100) -> None:
+def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: int = 100) -> None:
     """Readable at `width` columns: a block per paired condition, its name and every difference on
     lines of their own (wrapped, never cut), then the metrics in narrow columns."""
     pairs, only_a, only_b, ga, gb = compare_pairs(runs_a, runs_b)
     names = side_labels(ga, gb)
-    wrap = lambda text, indent: textwrap.fill(text, width, initial_indent=indent, subsequent_indent=indent + "    ")
+    def wrap(text: str, indent: str) -> str:
+        return textwrap.fill(text, width, initial_indent=indent, subsequent_indent=indent + "    ")
     head = ["metric", "A mean", "n", "B mean", "n", "B - A", "p", "exceeds"]
     widths = [31, 11, 3, 11, 3, 11, 6, 8]
-    line = lambda cells: "  " + "  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+    def line(cells: list[str]) -> str:
+        return "  " + "  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
     for ka, kb, diffs in pairs:
         print(wrap(names[ka], ""))
         for d in diffs:
@@ -271,8 +296,8 @@ def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: Any = 
         print(line(head))
         for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha):
             short = v if len(v) <= widths[-1] else "no test"  # the runs without a value: on a line of their own
-            print(line([m, mean_text(sa), str(sa["n"]), mean_text(sb), str(sb["n"]), ST.fnum(w["diff"], 4),
-                        ST.fnum(w["p"], 3) if w["p"] is not None else "-", short]))
+            print(line([m, mean_text(sa), str(sa.n), mean_text(sb), str(sb.n), stats.fnum(w.diff, 4),
+                        stats.fnum(w.p, 3) if w.p is not None else "-", short]))
             if short != v:
                 print(wrap(v, "    "))
         print()
@@ -284,8 +309,9 @@ def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: Any = 
     print(textwrap.fill(EXPLANATION + " p: Welch's t-test over seeds.", width))
 
 
-def versions(runs: list[Run]) -> Any:
-    v: dict[Any, Any] = {}
+def versions(runs: list[Run]) -> str:
+    """'v1.2-3-gabc (20 runs), v1.2 (4 runs)': the builds that made the runs."""
+    v: dict[str, int] = {}
     for r in runs:
-        v[r.version] = v.get(r.version, 0) + 1
+        v[str(r.version)] = v.get(str(r.version), 0) + 1
     return ", ".join(f"{k} ({n} runs)" for k, n in sorted(v.items()))

@@ -8,9 +8,9 @@ import unittest
 from helpers import ROOT, robot, write_occlusion_sweep, write_run
 from omniloc.core import pairing as PR
 from omniloc.core import rundir as RD
+from omniloc.core import verdicts
 from omniloc.paper import causes as K
 from omniloc.paper import claims as C
-from omniloc.paper import data as D
 from omniloc.paper import quantity as Q
 from omniloc.paper import tables as T
 from omniloc.report import headline as RHL
@@ -28,33 +28,35 @@ class Claims(unittest.TestCase):
         ctx = T.Context(PR.load_papers(), [], [])
         claims = C.evaluate_claims(ctx)
         self.assertGreaterEqual(len(claims), 12)
-        self.assertTrue(all(c["verdict"] in ("not run", "n/a") for c in claims))
-        self.assertTrue(any("not run: build/omniloc sweep" in c["ours_text"] for c in claims))
+        self.assertTrue(all(c.verdict in ("not run", "n/a") for c in claims))
+        self.assertTrue(any("not run: build/omniloc sweep" in c.ours_text for c in claims))
 
     def test_occlusion_claim_from_keyed_rows(self):
         with tempfile.TemporaryDirectory() as tmp:
             write_occlusion_sweep(pathlib.Path(tmp) / "s", [0.5, 0.25, 0.125, 0.0])
             runs, _, _ = RD.discover([tmp])
             ctx = T.Context(PR.load_papers(), runs, [])
-            c = [c for c in C.evaluate_claims(ctx) if c["id"] == "occlusion_mild"][0]
-            self.assertEqual(c["kind"], "robustness")
+            c = [c for c in C.evaluate_claims(ctx) if c.id == "occlusion_mild"][0]
+            self.assertEqual(c.kind, "robustness")
             # Judged on every axis the paper states (its own y and heading ratios are in the rule's
             # 1-2 as well): the fixture's y and heading do not change with occlusion (ratio 1).
-            checks = {ch["label"]: ch for ch in c["checks"]}
+            checks = {ch.label: ch for ch in c.checks}
             self.assertEqual(sorted(checks), ["mean heading", "mean x", "mean y"])
-            self.assertAlmostEqual(checks["mean x"]["ours"], 4.02 / 2.02, places=9)
-            self.assertAlmostEqual(checks["mean y"]["ours"], 1.0, places=9)
-            self.assertEqual(c["verdict"], "holds")
+            self.assertAlmostEqual(checks["mean x"].ours, 4.02 / 2.02, places=9)
+            self.assertAlmostEqual(checks["mean y"].ours, 1.0, places=9)
+            self.assertEqual(c.verdict, "holds")
 
 
 class Verdicts(unittest.TestCase):
     def test_claims_are_counted_apart_by_kind(self):
         ctx = T.Context(PR.load_papers(), [], [])
-        kinds = {c["id"]: c["kind"] for c in C.evaluate_claims(ctx)}
+        kinds = {c.id: c.kind for c in C.evaluate_claims(ctx)}
         self.assertEqual({k for k, v in kinds.items() if v == "timing"}, {"timing_mcl", "timing_matching", "timing_global", "timing_tracking"})
         self.assertEqual(kinds["tracking_accuracy"], "accuracy")
         self.assertEqual(kinds["kidnap_002"], "robustness")
-        t = C.totals([{"kind": "accuracy", "verdict": "holds"}, {"kind": "accuracy", "verdict": "does not"}, {"kind": "timing", "verdict": "holds"}])
+        judged = [C.Claim(id=str(k), paper="", kind=kind, claim="", published=None, unit="", rule_text="", uses_runs=False, verdict=verdict)
+                  for k, (kind, verdict) in enumerate([("accuracy", "holds"), ("accuracy", "does not"), ("timing", "holds")])]
+        t = C.totals(judged)
         self.assertEqual(C.totals_text(t), "accuracy: 1 holds, 1 does not; timing: 1 holds")
 
     def test_tracking_claim_is_judged_on_heading_too(self):
@@ -64,13 +66,13 @@ class Verdicts(unittest.TestCase):
             for seed in (1, 2, 3):
                 write_run(pathlib.Path(tmp) / f"t{seed}", "tracking", "matching", seed, {}, robot(5.907, 5.967, 0.0066))
             runs, _, _ = RD.discover([tmp])
-            c = [c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, [])) if c["id"] == "tracking_accuracy"][0]
-            self.assertEqual([(ch["label"], ch["verdict"]) for ch in c["checks"]],
+            c = [c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, [])) if c.id == "tracking_accuracy"][0]
+            self.assertEqual([(ch.label, ch.verdict) for ch in c.checks],
                              [("mean x", "holds"), ("mean y", "holds"), ("mean heading", "does not")])
-            self.assertAlmostEqual(c["checks"][2]["ratio"], 0.15, places=9)
-            self.assertEqual(c["verdict"], "partly")
-            self.assertEqual(c["seeds"], 3)
-            self.assertFalse(c["weak"])
+            self.assertAlmostEqual(c.checks[2].ratio, 0.15, places=9)
+            self.assertEqual(c.verdict, "partly")
+            self.assertEqual(c.seeds, 3)
+            self.assertFalse(c.weak)
             self.assertEqual(C.verdict_text(c), "partly")
 
     def test_a_verdict_on_one_seed_is_marked_weak_evidence(self):
@@ -78,12 +80,12 @@ class Verdicts(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             write_run(pathlib.Path(tmp) / "t1", "tracking", "matching", 1, {}, robot(5.9, 5.9, 0.044))
             runs, _, _ = RD.discover([tmp])
-            c = [c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, [])) if c["id"] == "tracking_accuracy"][0]
-            self.assertEqual((c["verdict"], c["seeds"], c["weak"]), ("holds", 1, True))
+            c = [c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, [])) if c.id == "tracking_accuracy"][0]
+            self.assertEqual((c.verdict, c.seeds, c.weak), ("holds", 1, True))
             self.assertEqual(C.verdict_text(c), "holds (1 seed: weak evidence)")
-            occ = [c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, [])) if c["id"] == "occlusion_mild"][0]
-            self.assertEqual(occ["verdict"], "not run")
-            self.assertFalse(occ["weak"])  # nothing judged: nothing to call weak
+            occ = [c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, [])) if c.id == "occlusion_mild"][0]
+            self.assertEqual(occ.verdict, "not run")
+            self.assertFalse(occ.weak)  # nothing judged: nothing to call weak
             rep = MU.Report(pathlib.Path(tmp) / "out", "t")
             RSC.scorecard(rep, T.Context(PR.load_papers(), runs, []))
             rep.write()
@@ -96,10 +98,10 @@ class Verdicts(unittest.TestCase):
             runs, _, _ = RD.discover([tmp])
             rep = MU.Report(pathlib.Path(tmp) / "out", "t")
             claims, field, totals = RSC.scorecard(rep, T.Context(PR.load_papers(), runs, []))
-            robot_c = [c for c in claims if c["id"] == "tracking_accuracy"][0]
-            self.assertEqual(robot_c["verdict"], "holds")
-            self.assertAlmostEqual(field["tracking_accuracy"]["checks"][0]["ours"], 30.0)
-            self.assertEqual(field["tracking_accuracy"]["verdict"], "partly")  # x 5.1x the paper's: does not; y, heading hold
+            robot_c = [c for c in claims if c.id == "tracking_accuracy"][0]
+            self.assertEqual(robot_c.verdict, "holds")
+            self.assertAlmostEqual(field["tracking_accuracy"].checks[0].ours, 30.0)
+            self.assertEqual(field["tracking_accuracy"].verdict, "partly")  # x 5.1x the paper's: does not; y, heading hold
             self.assertIn("| field_robot: accuracy: 1 partly", totals)
             rep.write()
             self.assertIn("verdict (field_robot)", (pathlib.Path(tmp) / "out" / "report.md").read_text())
@@ -119,25 +121,25 @@ class Causes(unittest.TestCase):
             runs, _, _ = RD.discover([tmp])
             ctx = T.Context(self.papers(causes), runs, [])
             claims = C.evaluate_claims(ctx)
-            return claims[0]["verdict"], K.explain(claims, ctx)
+            return claims[0].verdict, K.explain(claims, ctx)
 
     def test_status_follows_the_evidence(self):
         y = {"row": ["T", "r"], "metric": "y_cm/mean"}
         cause = lambda expect: [{"text": "because y", "doc": "docs/x.md", "evidence": [{"label": "y", "ours": y, "unit": "cm", "expect": expect}]}]
         verdict, ex = self.verdict_and_cause(1.5, cause([1.5, 2.5]))
         self.assertEqual(verdict, "partly")
-        self.assertEqual([(e["id"], e["status"]) for e in ex], [("c1", D.EXPLAINED)])
-        self.assertAlmostEqual(ex[0]["evidence"][0]["value"], 2.0)
+        self.assertEqual([(e.id, e.status) for e in ex], [("c1", verdicts.EXPLAINED)])
+        self.assertAlmostEqual(ex[0].evidence[0].value, 2.0)
         _, ex = self.verdict_and_cause(1.5, cause([0, 1]))
-        self.assertEqual(ex[0]["status"], D.CONTRADICTED)
-        self.assertIn("CONTRADICTS", K.evidence_text(ex[0]["evidence"][0]))
+        self.assertEqual(ex[0].status, verdicts.CONTRADICTED)
+        self.assertIn("CONTRADICTS", K.evidence_text(ex[0].evidence[0]))
         _, ex = self.verdict_and_cause(1.5, [{"text": "t", "evidence": [{"label": "z", "ours": {"row": ["T", "r"], "metric": "nothing/here"}}]}])
-        self.assertEqual(ex[0]["status"], D.NOT_MEASURED)
+        self.assertEqual(ex[0].status, verdicts.NOT_MEASURED)
         _, ex = self.verdict_and_cause(1.5, [])
-        self.assertEqual(ex[0]["status"], D.UNEXPLAINED)
+        self.assertEqual(ex[0].status, verdicts.UNEXPLAINED)
         # A cause written for "does not" only does not explain a "partly"; a holding claim needs none.
         _, ex = self.verdict_and_cause(1.5, [dict(cause([1.5, 2.5])[0], verdicts=["does not"])])
-        self.assertEqual(ex[0]["status"], D.UNEXPLAINED)
+        self.assertEqual(ex[0].status, verdicts.UNEXPLAINED)
         verdict, ex = self.verdict_and_cause(0.5, [], y_mean=0.5)
         self.assertEqual((verdict, ex), ("holds", []))
 
@@ -170,12 +172,12 @@ class Causes(unittest.TestCase):
             write_run(pathlib.Path(tmp) / "m", "tracking", "matching", 1, {}, robot(2.5))
             runs, _, _ = RD.discover([tmp])
             ctx = T.Context(PR.load_papers(), runs, [])
-            c = [c for c in C.evaluate_claims(ctx) if c["id"] == "mcl_alone"][0]
-            self.assertAlmostEqual(c["checks"][0]["ours"], 3.0, places=9)
-            self.assertAlmostEqual(c["checks"][1]["ours"], 3.0 / 2.5, places=9)
-            self.assertEqual(c["verdict"], "does not")
-            ex = [e for e in K.explain([c], ctx) if e["id"] == "mcl_alone"][0]
-            ev = {e["label"]: e["value"] for e in ex["evidence"]}
+            c = [c for c in C.evaluate_claims(ctx) if c.id == "mcl_alone"][0]
+            self.assertAlmostEqual(c.checks[0].ours, 3.0, places=9)
+            self.assertAlmostEqual(c.checks[1].ours, 3.0 / 2.5, places=9)
+            self.assertEqual(c.verdict, "does not")
+            ex = [e for e in K.explain([c], ctx) if e.id == "mcl_alone"][0]
+            ev = {e.label: e.value for e in ex.evidence}
             self.assertAlmostEqual(ev["MCL runs that ended on the right pose"], 2 / 3)
             self.assertAlmostEqual(ev["MCL particle spread while right (mean)"], 10.0)
 

@@ -23,7 +23,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 from helpers import OMNILOC, PY, ROOT, needs_omniloc
-from omniloc import gate as GT
+from omniloc import gate
 
 GATE = [PY, "-m", "omniloc.commands.gate"]
 SUITE = ROOT / "scenarios" / "sweeps" / "ci_quick.json"
@@ -154,13 +154,13 @@ class Gate(unittest.TestCase):
         self.assertIn("[regression: mean", line)
         self.assertEqual(self.gate(self.good, "--rules", r, "--baseline", self.bad).returncode, 0)
         # The same for valid_fraction, and a "max" on recall does not turn the direction round.
-        self.assertTrue(GT.higher_is_better("r0/tracking_phase/recall/25cm_10deg"))
-        self.assertTrue(GT.higher_is_better("valid_fraction"))
-        self.assertTrue(GT.higher_is_better("r0/recovery/recovered_fraction"))
-        self.assertFalse(GT.higher_is_better("r0/position_m/rmse"))
-        rules = GT.load_rules(self.rules([{"metric": "r0/recall/10cm_5deg", "max": 1.0}, {"metric": "r0/position_m/rmse", "min": 0.0},
+        self.assertTrue(gate.higher_is_better("r0/tracking_phase/recall/25cm_10deg"))
+        self.assertTrue(gate.higher_is_better("valid_fraction"))
+        self.assertTrue(gate.higher_is_better("r0/recovery/recovered_fraction"))
+        self.assertFalse(gate.higher_is_better("r0/position_m/rmse"))
+        rules = gate.load_rules(self.rules([{"metric": "r0/recall/10cm_5deg", "max": 1.0}, {"metric": "r0/position_m/rmse", "min": 0.0},
                                             {"metric": "r0/recall/10cm_5deg", "better": "lower"}]), True)
-        self.assertEqual([r["better"] for r in rules], ["higher", "higher", "lower"])  # min alone: higher, as before
+        self.assertEqual([r.better for r in rules], ["higher", "higher", "lower"])  # min alone: higher, as before
 
     def test_higher_is_better_direction(self):
         # valid_fraction is 1 on both sides; a rule saying higher is better on the position error

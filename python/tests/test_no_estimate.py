@@ -42,9 +42,9 @@ class NoEstimate(unittest.TestCase):
             self.assertEqual(a.why_null("x_cm/mean"), "no estimate in any of the 40 scored frames")
             self.assertEqual(b.lookup("position_m/mean"), (False, None))
             st = M.run_stats([a, b], "x_cm/mean")
-            self.assertEqual((st["n"], st["no_value"], st["of"], st["mean"]), (1, 1, 2, 3.0))
+            self.assertEqual((st.n, st.no_value, st.of, st.mean), (1, 1, 2, 3.0))
             st = M.run_stats([a, b], "position_m/mean")
-            self.assertEqual((st["n"], st["no_value"], st["of"]), (0, 1, 1))
+            self.assertEqual((st.n, st.no_value, st.of), (0, 1, 1))
             self.assertEqual(M.stat_cell(st), "no estimate")
             self.assertEqual(M.no_value_note([st]), "no estimate in 1 of 1 runs")
             self.assertEqual((a.headline, b.headline, M.headline_key([a, b])), ("25cm_10deg", None, "25cm_10deg"))
@@ -93,9 +93,9 @@ class NoEstimate(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             tmp = pathlib.Path(tmp)
             runs = self.tracking_without_estimate(tmp)
-            rows = {p["label"]: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
-            st = rows["tracking"]["stats"]["x_cm/mean"]
-            self.assertEqual((st["n"], st["no_value"], st["mean"]), (0, 3, None))
+            rows = {p.label: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
+            st = rows["tracking"].stats["x_cm/mean"]
+            self.assertEqual((st.n, st.no_value, st.mean), (0, 3, None))
             out = subprocess.run([PY, "-m", "omniloc.commands.paper_table", str(tmp / "res"), "--paper", "000_tracking"], capture_output=True, text=True)
             self.assertEqual(out.returncode, 0, out.stderr)
             head = out.stdout.splitlines()[0]
@@ -110,11 +110,11 @@ class NoEstimate(unittest.TestCase):
             ratio = [l for l in out.stdout.splitlines() if l.startswith("tracking ") and "ours/paper" in l][0]
             self.assertNotIn("0.00", ratio)
             # The claim on the tracking row is not judged on nothing: "does not", with the reason.
-            claims = {c["id"]: c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, []))}
+            claims = {c.id: c for c in C.evaluate_claims(T.Context(PR.load_papers(), runs, []))}
             t = claims["tracking_accuracy"]
-            self.assertEqual(t["verdict"], "does not")
-            self.assertIn("no estimate in 3 of 3 runs", t["ours_text"])
-            self.assertIn("answered 0.0 %", C.coverage_text(t["coverage"]))
+            self.assertEqual(t.verdict, "does not")
+            self.assertIn("no estimate in 3 of 3 runs", t.ours_text)
+            self.assertIn("answered 0.0 %", C.coverage_text(t.coverage))
             self.assertTrue(C.no_estimate("no estimate in 1 of 3 runs"))
             self.assertEqual(C.judge(None, {"kind": "range", "holds": [0, 1]}, note="not run: x"), "not run")
 

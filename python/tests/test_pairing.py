@@ -30,7 +30,7 @@ class Pairing(unittest.TestCase):
                 self.assertEqual(len(sweeps), 1)
                 self.assertEqual(len(runs), 12)
                 rows = T.pair_table(papers, "002_table1_occlusion", runs, include_extra=False)
-                tables.append([(p["label"], p["stats"]["x_cm/mean"]["mean"], p["stats"]["x_cm/mean"]["n"]) for p in rows])
+                tables.append([(p.label, p.stats["x_cm/mean"].mean, p.stats["x_cm/mean"].n) for p in rows])
         self.assertEqual(tables[0], tables[1])
         got = {label: (m, n) for label, m, n in tables[0]}
         for label, frac in (("0 %", 0.0), ("12.5 %", 0.125), ("25 %", 0.25), ("50 %", 0.5)):
@@ -47,12 +47,12 @@ class Pairing(unittest.TestCase):
             runs, _, _ = RD.discover([pathlib.Path(tmp)])
             self.assertEqual(len(runs), 3)
             row = T.pair_table(papers, "002_table1_occlusion", runs, labels=["0 %"])[0]
-            self.assertEqual(row["stats"]["x_cm/mean"]["n"], 2)
-            self.assertAlmostEqual(row["stats"]["x_cm/mean"]["mean"], OCCLUSION[0.0] + 0.015, places=9)
+            self.assertEqual(row.stats["x_cm/mean"].n, 2)
+            self.assertAlmostEqual(row.stats["x_cm/mean"].mean, OCCLUSION[0.0] + 0.015, places=9)
             with PR.pairing_profile("field_robot"):
                 row = T.pair_table(papers, "002_table1_occlusion", runs, labels=["0 %"])[0]
-            self.assertEqual(row["stats"]["x_cm/mean"]["n"], 1)
-            self.assertAlmostEqual(row["stats"]["x_cm/mean"]["mean"], 50.0, places=9)
+            self.assertEqual(row.stats["x_cm/mean"].n, 1)
+            self.assertAlmostEqual(row.stats["x_cm/mean"].mean, 50.0, places=9)
 
     def test_missing_rows_say_not_run_with_the_command(self):
         papers = PR.load_papers()
@@ -250,23 +250,23 @@ class StartPoseAndPositionMean(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             tmp = pathlib.Path(tmp)
             runs = self.tracking_table(tmp)
-            rows = {p["label"]: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
+            rows = {p.label: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
             mcl = rows["tracking path, MCL alone (global start)"]
-            self.assertEqual([q["name"] for q in mcl["peers"]], [])
-            self.assertEqual(mcl["stats"]["x_cm/mean"]["n"], 2)
+            self.assertEqual([q.name for q in mcl.peers], [])
+            self.assertEqual(mcl.stats["x_cm/mean"].n, 2)
             track = rows["tracking"]
-            self.assertEqual([(q["name"], q["row"]) for q in track["peers"]], [("js_client", "tracking (given the start pose)")])
-            self.assertEqual(track["shown"], "tracking (given the start pose)")  # the table holds both kinds
+            self.assertEqual([(q.name, q.row) for q in track.peers], [("js_client", "tracking (given the start pose)")])
+            self.assertEqual(track.shown, "tracking (given the start pose)")  # the table holds both kinds
             # A global-start row with only a given client beside it: the client gets a row of its own.
             only = T.pair_table(PR.load_papers(), "000_tracking", runs, labels=["tracking path, MCL alone (global start)"])[0]
-            self.assertEqual(len(only["peers"]), 1)
-            self.assertNotIn("global start", only["peers"][0]["row"])
-            self.assertTrue(only["peers"][0]["row"].endswith("(given the start pose)"))
+            self.assertEqual(len(only.peers), 1)
+            self.assertNotIn("global start", only.peers[0].row)
+            self.assertTrue(only.peers[0].row.endswith("(given the start pose)"))
             # A built-in MCL run somebody gave the start pose is not taken into the global-start row.
             write_run(tmp / "res" / "mcl_given", "tracking", "mcl", 9, {}, robot(1.0), start_pose_given=True)
             runs = RD.discover([tmp / "res"])[0]
-            mcl = {p["label"]: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}["tracking path, MCL alone (global start)"]
-            self.assertEqual(sorted(r.seed for r in mcl["runs"]), [1, 2])
+            mcl = {p.label: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}["tracking path, MCL alone (global start)"]
+            self.assertEqual(sorted(r.seed for r in mcl.runs), [1, 2])
             out = subprocess.run([PY, "-m", "omniloc.commands.paper_table", str(tmp / "res"), "--paper", "000_tracking"], capture_output=True, text=True)
             self.assertEqual(out.returncode, 0, out.stderr)
             ext = [l for l in out.stdout.splitlines() if "external: js_client" in l]
@@ -276,9 +276,9 @@ class StartPoseAndPositionMean(unittest.TestCase):
     def test_a_global_client_sits_beside_the_global_start_rows(self):
         with tempfile.TemporaryDirectory() as tmp:
             runs = self.tracking_table(pathlib.Path(tmp), external_given=False)
-            rows = {p["label"]: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
-            self.assertEqual(rows["tracking"]["peers"], [])
-            self.assertEqual([q["name"] for q in rows["tracking path, MCL alone (global start)"]["peers"]], ["js_client"])
+            rows = {p.label: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
+            self.assertEqual(rows["tracking"].peers, [])
+            self.assertEqual([q.name for q in rows["tracking path, MCL alone (global start)"].peers], ["js_client"])
 
     def test_runs_without_the_new_keys_are_read_as_before(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -291,9 +291,9 @@ class StartPoseAndPositionMean(unittest.TestCase):
             runs = RD.discover([tmp / "res"])[0]
             self.assertIsNone(runs[0].start_pose_given)
             self.assertIsNone(runs[2].metric("position_m/mean"))
-            rows = {p["label"]: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
-            self.assertEqual(rows["tracking path, MCL alone (global start)"]["stats"]["x_cm/mean"]["n"], 2)
-            self.assertEqual([q["name"] for q in rows["tracking path, MCL alone (global start)"]["peers"]], ["js_client"])
+            rows = {p.label: p for p in T.pair_table(PR.load_papers(), "000_tracking", runs)}
+            self.assertEqual(rows["tracking path, MCL alone (global start)"].stats["x_cm/mean"].n, 2)
+            self.assertEqual([q.name for q in rows["tracking path, MCL alone (global start)"].peers], ["js_client"])
             out = subprocess.run([PY, "-m", "omniloc.commands.report", str(tmp / "res"), "-o", str(tmp / "rep"), "--history", "none"],
                                  capture_output=True, text=True)
             self.assertEqual(out.returncode, 0, out.stderr)

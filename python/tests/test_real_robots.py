@@ -44,22 +44,22 @@ class RealRobots(unittest.TestCase):
             twin1 = real_reference("robot1")["twin"]
             write_real_run(loose, "robot1", "grid_global", 2, [tuple(twin1)] * 30)
             runs, sweeps, _ = RD.discover([tmp / "results"])
-            judged = {(x["label"], x["folder"].name, x["run"].seed): x["judged"] for x in RR.real_runs(runs)}
-            self.assertEqual(judged[("grid_global", "robot1", 1)]["outcome"], "found")  # the exhaustive grid: reference or twin, here the reference
-            self.assertLess(judged[("grid_global", "robot1", 1)]["error_m"], 0.05)
-            self.assertEqual(judged[("grid_global", "robot1", 1)]["first_fix_s"], 0.0)
-            self.assertIn(judged[("mcl_as_published", "robot1", 1)]["outcome"], ("found", "twin", "wrong", "none"))
+            judged = {(x.label, x.folder.name, x.run.seed): x.judged for x in RR.real_runs(runs)}
+            self.assertEqual(judged[("grid_global", "robot1", 1)].outcome, "found")  # the exhaustive grid: reference or twin, here the reference
+            self.assertLess(judged[("grid_global", "robot1", 1)].error_m, 0.05)
+            self.assertEqual(judged[("grid_global", "robot1", 1)].first_fix_s, 0.0)
+            self.assertIn(judged[("mcl_as_published", "robot1", 1)].outcome, ("found", "twin", "wrong", "none"))
             j = judged[("mcl", "robot2", 1)]
-            self.assertEqual(j["outcome"], "twin")
-            self.assertAlmostEqual(j["error_m"], 0.02, places=6)
-            self.assertAlmostEqual(j["error_deg"], math.degrees(0.01), delta=0.001)  # the header's twin is rounded to 1e-5 rad
-            self.assertAlmostEqual(j["answered"], 20 / 30)
-            self.assertAlmostEqual(j["first_fix_s"], 10 / 30, places=3)
-            self.assertEqual(judged[("hybrid", "robot4", 1)]["outcome"], "wrong")
-            self.assertAlmostEqual(judged[("hybrid", "robot4", 1)]["error_m"], 1.2, places=6)
-            self.assertEqual(judged[("hybrid", "robot4", 1)]["first_fix_s"], 0.0)
-            self.assertEqual(judged[("hybrid", "robot5", 1)]["outcome"], "none")
-            self.assertEqual(judged[("grid_global", "robot1", 2)]["outcome"], "twin")
+            self.assertEqual(j.outcome, "twin")
+            self.assertAlmostEqual(j.error_m, 0.02, places=6)
+            self.assertAlmostEqual(j.error_deg, math.degrees(0.01), delta=0.001)  # the header's twin is rounded to 1e-5 rad
+            self.assertAlmostEqual(j.answered, 20 / 30)
+            self.assertAlmostEqual(j.first_fix_s, 10 / 30, places=3)
+            self.assertEqual(judged[("hybrid", "robot4", 1)].outcome, "wrong")
+            self.assertAlmostEqual(judged[("hybrid", "robot4", 1)].error_m, 1.2, places=6)
+            self.assertEqual(judged[("hybrid", "robot4", 1)].first_fix_s, 0.0)
+            self.assertEqual(judged[("hybrid", "robot5", 1)].outcome, "none")
+            self.assertEqual(judged[("grid_global", "robot1", 2)].outcome, "twin")
             # The report: the section right after the scorecard, every case as classified.
             out = subprocess.run([PY, "-m", "omniloc.commands.report", str(tmp / "results"), "-o", str(tmp / "rep"), "--history", "none"],
                                  capture_output=True, text=True, cwd=str(tmp))
@@ -92,14 +92,14 @@ class RealRobots(unittest.TestCase):
             # The real figures equal those the recordings' headers carry (the converter's).
             for robot in ("robot1", "robot2", "robot4", "robot5"):
                 head = json.loads((REAL / robot / "recording.json").read_text())
-                got = RR.real_noise(REAL / robot, head)
+                got = RR.real_noise(RR.read_header(REAL / robot))
                 for g, want in zip(got, head["reference"]["line_point_noise"]["bands"]):
-                    self.assertEqual((g["range_m"], g["points"]), (want["range_m"], want["points"]))
+                    self.assertEqual((g.range_m, g.points), (want["range_m"], want["points"]))
                     for k in ("median_cm", "p90_cm"):
                         if want[k] is None:
-                            self.assertIsNone(g[k])
+                            self.assertIsNone(getattr(g, k))
                         else:
-                            self.assertAlmostEqual(g[k], want[k], delta=0.006, msg=f"{robot} {k}")
+                            self.assertAlmostEqual(getattr(g, k), want[k], delta=0.006, msg=f"{robot} {k}")
             write_sim_recording(tmp / "paper_suite")
             _, sweeps, _ = RD.discover([tmp / "paper_suite"])
             rep = MU.Report(tmp / "out", "t")

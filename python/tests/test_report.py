@@ -17,6 +17,7 @@ from omniloc.report import cdf as RCDF
 from omniloc.report import experiments as REXP
 from omniloc.report import history as RHIST
 from omniloc.report import seeds as RSEED
+from omniloc.tools import citations
 from omniloc.tools import markup as MU
 
 
@@ -50,37 +51,37 @@ class FewSeeds(unittest.TestCase):
     def test_outlier_cause_is_read_from_the_frames(self):
         with tempfile.TemporaryDirectory() as tmp:
             mcl_runs_with_outlier(tmp)
-            run = RD.Run(pathlib.Path(tmp) / "mcl_s2")
+            run = RD.Run.read(pathlib.Path(tmp) / "mcl_s2")
             self.assertEqual(RSEED.outlier_cause(run), "converged to a wrong pose at t = 0.5 s: 8.06 m from the truth (median), "
                              "mode 'converged' in 91 % of the frames from the start to the end; never within 0.5 m")
             lost = pathlib.Path(tmp) / "lost"
             write_run(lost, "kidnap_002", "hybrid", 1, {}, robot(50.0))
             write_frames(lost, [(0.5 * k, 0.1, True, "tracking") for k in range(5)] + [(2.5 + 0.5 * k, 3.0, False, "lost") for k in range(4)],
                          [{"type": "kidnap", "t": 2.4, "robot": 0}])
-            self.assertEqual(RSEED.outlier_cause(RD.Run(lost)),
+            self.assertEqual(RSEED.outlier_cause(RD.Run.read(lost)),
                              "lost from t = 2.5 s, after the kidnap at t = 2.4 s: no estimate, no confident estimate (mode 'lost') to the end")
             fine = pathlib.Path(tmp) / "fine"
             write_run(fine, "tracking", "matching", 1, {}, robot(2.0))
             write_frames(fine, [(0.0, 0.1, True, "tracking"), (1.0, 0.9, True, "tracking"), (2.0, 0.2, True, "tracking")])
-            self.assertEqual(RSEED.outlier_cause(RD.Run(fine)),
+            self.assertEqual(RSEED.outlier_cause(RD.Run.read(fine)),
                              "on a wrong pose (> 0.5 m off) for 1.0 s of 3.0 s, from t = 1.0 to 2.0 s, 0.90 m off (median); within 0.5 m at the end")
             # A seed 8.8 m off from the start for 37 s of 60, right afterwards, is described by
             # the time it spent on the wrong pose, never as an error "peak".
             back = pathlib.Path(tmp) / "back"
             write_run(back, "tracking", "mcl", 2, {}, robot(300.0))
             write_frames(back, [(0.5 * k, 8.8 if k < 74 else 0.1, True, "converged") for k in range(120)])
-            cause = RSEED.outlier_cause(RD.Run(back))
+            cause = RSEED.outlier_cause(RD.Run.read(back))
             self.assertEqual(cause, "on a wrong pose (> 0.5 m off) for 37.0 s of 60.0 s, from t = 0.0 to 37.0 s, 8.80 m off (median); within 0.5 m at the end")
             self.assertNotIn("peak", cause)
             twice = pathlib.Path(tmp) / "twice"
             write_run(twice, "tracking", "mcl", 3, {}, robot(100.0))
             write_frames(twice, [(1.0 * k, 2.0 if k in (1, 4, 5) else 0.1, k != 7, "tracking") for k in range(10)])
-            self.assertEqual(RSEED.outlier_cause(RD.Run(twice)),
+            self.assertEqual(RSEED.outlier_cause(RD.Run.read(twice)),
                              "on a wrong pose (> 0.5 m off) for 3.0 s of 10.0 s, longest from t = 4.0 to 6.0 s, 2.00 m off (median); within 0.5 m at the end")
             calm = pathlib.Path(tmp) / "calm"
             write_run(calm, "tracking", "mcl", 4, {}, robot(10.0))
             write_frames(calm, [(0.0, 0.1, True, "tracking"), (1.0, 0.3, True, "tracking"), (2.0, 0.2, True, "tracking")])
-            self.assertEqual(RSEED.outlier_cause(RD.Run(calm)), "never on a wrong pose (> 0.5 m off): at most 0.30 m at t = 1.0 s")
+            self.assertEqual(RSEED.outlier_cause(RD.Run.read(calm)), "never on a wrong pose (> 0.5 m off): at most 0.30 m at t = 1.0 s")
 
     def test_seed_table_shows_every_seed_and_flags_the_outlier(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -221,12 +222,12 @@ class ReaderLanguage(unittest.TestCase):
     """The reader's language: papers cited with a bibliography, no ids or tracker numbers, abbreviations spelled out."""
 
     def test_citations(self):
-        self.assertEqual(L.cite_text("Lu et al. 2013 (paper 002), Table 1"), "Lu et al. 2013 [3], Table 1")
-        self.assertEqual(L.cite_text("Xiong, Lu, Zheng (paper 000), tracking"), "Xiong et al. 2012 [1], tracking")
-        self.assertEqual(L.cite_text("Kidnap recovery (papers 002 and 000)"), "Kidnap recovery (Lu et al. 2013 [3] and Xiong et al. 2012 [1])")
+        self.assertEqual(citations.cite_text("Lu et al. 2013 (paper 002), Table 1"), "Lu et al. 2013 [3], Table 1")
+        self.assertEqual(citations.cite_text("Xiong, Lu, Zheng (paper 000), tracking"), "Xiong et al. 2012 [1], tracking")
+        self.assertEqual(citations.cite_text("Kidnap recovery (papers 002 and 000)"), "Kidnap recovery (Lu et al. 2013 [3] and Xiong et al. 2012 [1])")
         self.assertEqual(L.cite_field("002 refs [7], [8]"), "Lu et al. 2013 [3], its refs [7], [8]")
-        self.assertEqual(len(D.BIBLIOGRAPHY), 5)
-        self.assertTrue(all(b["year"] and b["title"] and b["authors"] for b in D.BIBLIOGRAPHY))
+        self.assertEqual(len(citations.BIBLIOGRAPHY), 5)
+        self.assertTrue(all(b.year and b.title and b.authors for b in citations.BIBLIOGRAPHY))
         for c in PR.load_papers()["claims"]:
             self.assertIn(c["id"], D.CLAIM_LABELS)
 

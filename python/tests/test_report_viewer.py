@@ -170,8 +170,8 @@ class ReportViewerTest(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             run_dir = write_viewable_run(pathlib.Path(tmp) / "run")
             from omniloc.core.rundir import Run
-            self.assertEqual(V.cell(MU.TextReport(), Run(run_dir)), "-")
-            V.line(MU.TextReport(), Run(run_dir), own=True)  # prints nothing, writes nothing
+            self.assertEqual(V.cell(MU.TextReport(), Run.read(run_dir)), "-")
+            V.line(MU.TextReport(), Run.read(run_dir), own=True)  # prints nothing, writes nothing
             self.assertFalse((pathlib.Path(tmp) / "viewers").exists())
 
     def test_the_link_check_catches_missing_and_wrong_pages(self):

@@ -35,8 +35,7 @@ import os
 import sys
 from typing import Optional, Sequence
 
-from omniloc.core import pairing as PR
-from omniloc.core import rundir as RD
+from omniloc.core import pairing, rundir
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -48,7 +47,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--markdown", action="store_true")
     ap.add_argument("--accept-incomplete", action="store_true", help="use sweep folders whose aggregate is not final (said in the output)")
     a = ap.parse_args(argv)
-    papers = PR.load_papers()
+    papers = pairing.load_papers()
     published = [k for k in papers if k not in ("comment", "claims")]
     if a.paper == "list":
         print("\n".join(published))
@@ -57,26 +56,26 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"error: no published table \"{a.paper}\" in papers.json; tables: {', '.join(published)}", file=sys.stderr)
         return 2
     try:
-        runs, _, experiments = RD.discover(a.results, a.accept_incomplete)
+        runs, _, experiments = rundir.discover(a.results, a.accept_incomplete)
     except SystemExit as e:
         print(f"error: cannot read results: {e}", file=sys.stderr)
         return 2
-    from omniloc.paper import text_tables as TT  # after the results are found: its imports take a second
-    tables = TT.error_tables(papers)
-    profile, how = TT.choose_profile(runs, a.profile)
+    from omniloc.report import text_tables  # after the results are found: its imports take a second
+    tables = text_tables.error_tables(papers)
+    profile, how = text_tables.choose_profile(runs, a.profile)
     if profile is None:
         print(f"error: {how}", file=sys.stderr)
         return 2
-    with PR.pairing_profile(profile):
+    with pairing.pairing_profile(profile):
         for key in (published if a.paper == "all" else [a.paper]):
             if key in tables:
-                code = TT.print_error_table(papers, key, runs, a.rows, a.markdown)
+                code = text_tables.print_error_table(papers, key, runs, a.rows, a.markdown)
             else:
-                code = TT.print_other_table(papers, key, runs, experiments, a.markdown)
+                code = text_tables.print_other_table(papers, key, runs, experiments, a.markdown)
             if code:
                 return code
     print(f"noise profile: {profile} ({how})")
-    for d in RD.INCOMPLETE:
+    for d in rundir.INCOMPLETE:
         print(f"note: {d} is an incomplete sweep (--accept-incomplete): only its finished runs are in these tables")
     return 0
 

@@ -34,7 +34,7 @@ such folders (searched recursively). The report is laid out for a reader with te
     --debug-view runs, its particles);
   - on a page of its own (history.html, linked), for developers: instruction counts and benchmark
     wall times per workload over the commits (--history DIR, default results/history);
-  - the references: the five papers, cited in the text as 'Lu et al. 2013 [3]' (omniloc.paper.data.BIBLIOGRAPHY).
+  - the references: the five papers, cited in the text as 'Lu et al. 2013 [3]' (omniloc.tools.citations.BIBLIOGRAPHY).
 Coverage first (docs/results.md "Coverage and recall"): an error is over the frames a localizer
 answered, so wherever the report shows one it shows the share of frames answered beside it, and
 wherever localizers or conditions stand side by side (the scorecard, the published tables, the sweep
@@ -43,7 +43,7 @@ threshold ("within 25 cm / 10 deg": the share of ALL frames within it, a frame w
 counting as outside) comes first. A statistic over no answered frame reads "no estimate" (or "no
 estimate in k of n runs"), never a number; results made before recall was scored show as before.
 The text speaks to a reader: claims and tables by readable labels, never papers.json keys or tracker
-numbers, abbreviations spelled out at first use (omniloc.paper.labels; scripts/check_report_html.py checks).
+numbers, abbreviations spelled out at first use (omniloc.paper.labels, omniloc.tools.citations; scripts/check_report_html.py checks).
 Pictures are embedded, compressed (palette PNG, JPEG for camera frames) so that report.html stays
 under 3 MB; no absolute path reaches the report (omniloc.tools.markup.Report.clean).
 Everything except the published numbers is read from the result files. Needs Python 3 and
@@ -56,7 +56,7 @@ import os
 import sys
 from typing import Optional, Sequence
 
-from omniloc.core import pathcheck as PC
+from omniloc.core import pathcheck
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -75,13 +75,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     # the option and the reason.
     try:
         for r in a.results:
-            PC.require_folder(r, "RESULTS", "a folder of results")
+            pathcheck.require_folder(r, "RESULTS", "a folder of results")
         for r in a.baseline or []:
-            PC.require_folder(r, "--baseline", "a folder of results")
+            pathcheck.require_folder(r, "--baseline", "a folder of results")
         if a.history and a.history != "none":
-            PC.require_folder(a.history, "--history", "a folder with icount.jsonl / bench.jsonl")
-        PC.require_writable(a.out, "-o", True)
-    except PC.PathError as e:
+            pathcheck.require_folder(a.history, "--history", "a folder with icount.jsonl / bench.jsonl")
+        pathcheck.require_writable(a.out, "-o", True)
+    except pathcheck.PathError as e:
         print(f"{prog}: error: {e}", file=sys.stderr)
         return 2
     from omniloc.report.assemble import build  # after the checks: its imports take a second

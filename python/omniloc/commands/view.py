@@ -14,8 +14,9 @@ import tempfile
 from pathlib import Path
 from typing import Callable, List, NoReturn, Optional
 
-from omniloc.core import pathcheck as PC
-from omniloc.view.load import ViewInputError, load_run
+from omniloc.core import pathcheck
+from omniloc.core.files import InputFileError
+from omniloc.view.load import load_run
 from omniloc.view.page import render
 
 DESCRIPTION = """\
@@ -120,21 +121,21 @@ def main(argv: Optional[List[str]] = None) -> int:
                   (args.recording, "--recording", "a recording folder (omniloc record)"),
                   (args.frames, "--frames", "the folder omniloc run --frames DIR wrote")]
         for path, where, what in checks:
-            why = PC.why_not_readable_folder(path) if path is not None else None
+            why = pathcheck.why_not_readable_folder(path) if path is not None else None
             if why:
-                raise ViewInputError(PC.shown(path), f"{why}: {where} expects {what}")
-        why = PC.why_not_writable(out, False)
+                raise InputFileError(pathcheck.shown(path), f"{why}: {where} expects {what}")
+        why = pathcheck.why_not_writable(out, False)
         if why:
-            raise ViewInputError(PC.shown(out), f"{why}: {'-o' if args.output else 'the page RUN_DIR/view.html'} is written there")
+            raise InputFileError(pathcheck.shown(out), f"{why}: {'-o' if args.output else 'the page RUN_DIR/view.html'} is written there")
         if out.is_dir():
-            raise ViewInputError(out, "a folder: expected the name of the HTML file to write")
+            raise InputFileError(out, "a folder: expected the name of the HTML file to write")
         if not out.parent.is_dir() and run_dir.is_dir():
-            raise ViewInputError(out.parent, "missing: expected an existing folder to write the page into")
+            raise InputFileError(out.parent, "missing: expected an existing folder to write the page into")
         run = load_run(run_dir, Path(args.recording) if args.recording else None, image_every=args.image_every,
                        images=not args.no_images, frames_dir=Path(args.frames) if args.frames else None)
         page = render(run, max_particles=args.particles, particles_every=args.particles_every)
         _write_atomically(out, page)
-    except ViewInputError as e:
+    except InputFileError as e:
         print(f"{prog}: {e}", file=sys.stderr)
         return 2
     except OSError as e:

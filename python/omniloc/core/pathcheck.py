@@ -10,7 +10,10 @@ from __future__ import annotations
 import errno
 import os
 import stat
-from typing import Any, Optional
+from typing import Optional, Union
+
+# What a command hands over: the option's text or a pathlib.Path made of it.
+UserPath = Union[str, "os.PathLike[str]"]
 
 # Writers put a temporary name beside their target (".NAME.XXXX.tmp"): the target's own name must
 # leave this many characters of NAME_MAX for it (core/path_check.cpp uses the same room).
@@ -39,7 +42,7 @@ def _words(e: OSError) -> str:
     return e.strerror or os.strerror(e.errno or 0)
 
 
-def _stat(path: str) -> Any:
+def _stat(path: str) -> Union[os.stat_result, str]:
     """os.stat's result, or the reason in words (a str) when it fails."""
     if path == "":
         return "an empty path"
@@ -53,7 +56,7 @@ def _stat(path: str) -> Any:
         return str(e)
 
 
-def why_not_readable_file(path: Any) -> Optional[str]:
+def why_not_readable_file(path: UserPath) -> Optional[str]:
     """Why `path` cannot be read as a regular file; None when it can."""
     st = _stat(os.fspath(path))
     if isinstance(st, str):
@@ -65,7 +68,7 @@ def why_not_readable_file(path: Any) -> Optional[str]:
     return None
 
 
-def why_not_readable_folder(path: Any) -> Optional[str]:
+def why_not_readable_folder(path: UserPath) -> Optional[str]:
     """Why `path` cannot be read as a folder (listed and entered); None when it can."""
     st = _stat(os.fspath(path))
     if isinstance(st, str):
@@ -77,7 +80,7 @@ def why_not_readable_folder(path: Any) -> Optional[str]:
     return None
 
 
-def why_not_writable(path: Any, folder: bool) -> Optional[str]:
+def why_not_writable(path: UserPath, folder: bool) -> Optional[str]:
     """Why a regular file (`folder` False) or a folder cannot be written at `path`: another kind is
     there, a parent is not a folder or not writable, a name is over NAME_MAX or the path over
     PATH_MAX; None when nothing seen now stands in the way."""
@@ -128,7 +131,7 @@ def why_not_writable(path: Any, folder: bool) -> Optional[str]:
     return None
 
 
-def shown(path: Any) -> str:
+def shown(path: UserPath) -> str:
     """`path` for a message: cut in the middle past 200 characters, so the reason stays readable."""
     s = os.fspath(path).replace("\0", "\\u0000")
     return s if len(s) <= 200 else f"{s[:100]}...({len(s)} characters)...{s[-60:]}"
@@ -138,23 +141,23 @@ class PathError(Exception):
     """A path the user gave that cannot be used: str(e) is "WHERE: got "PATH" (why), expected WHAT"."""
 
 
-def _fail(where: str, path: Any, why: str, what: str) -> PathError:
+def _fail(where: str, path: UserPath, why: str, what: str) -> PathError:
     return PathError(f"{where}: got \"{shown(path)}\" ({why}), expected {what}")
 
 
-def require_file(path: Any, where: str, what: str = "a readable file") -> None:
+def require_file(path: UserPath, where: str, what: str = "a readable file") -> None:
     why = why_not_readable_file(path)
     if why:
         raise _fail(where, path, why, what)
 
 
-def require_folder(path: Any, where: str, what: str = "a readable folder") -> None:
+def require_folder(path: UserPath, where: str, what: str = "a readable folder") -> None:
     why = why_not_readable_folder(path)
     if why:
         raise _fail(where, path, why, what)
 
 
-def require_writable(path: Any, where: str, folder: bool) -> None:
+def require_writable(path: UserPath, where: str, folder: bool) -> None:
     why = why_not_writable(path, folder)
     if why:
         raise _fail(where, path, why, "a folder it can create or write into" if folder else "a file it can create or replace")

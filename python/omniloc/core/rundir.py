@@ -1,65 +1,73 @@
-"""Reading result folders: run folders (summary.json, config.json, frames.csv, timing.csv), sweep
-folders (aggregate.json, runs.csv, runs/) and experiment folders (docs/results.md).
+"""Reading result folders: run folders (summary.json, config.json, frames.csv, timing.csv, field.json),
+sweep folders (aggregate.json, runs.csv, runs/) and experiment folders (docs/results.md).
 
-discover() finds them under any folders given; Run reads one run folder on demand. A sweep folder
-whose aggregate is not final stops discover() unless the caller accepts incomplete sweeps; those
-are listed in INCOMPLETE so a tool can say so. find() / pointer() read a value by path or JSON
-pointer and tell a null (a statistic over no frame: (True, None)) from an absent key.
+discover() finds them under any folders given; Run is one run folder, its summary.json read as a
+Summary and the rest on demand. A sweep folder whose aggregate is not final stops discover() unless
+the caller accepts incomplete sweeps; those are listed in INCOMPLETE so a tool can say so. find() /
+pointer() read a value by path or JSON pointer and tell a null (a statistic over no frame: (True,
+None)) from an absent key.
 """
 from __future__ import annotations
 
-import csv
-import json
 import os
 import pathlib
-from typing import Any, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Iterable, Optional, Sequence, Union
 
-from omniloc.core import pathcheck as PC
+from omniloc.core import pathcheck
+from omniloc.core.aggregate import read_aggregate, read_run_ids, summary_metrics
+from omniloc.core.files import read_csv
+from omniloc.core.jsonvalue import JSON, JSONObject, flag, integer, load_file, lst, number, obj, parse, text
 
-# The events of events.jsonl that the report marks on a run, with their colours.
-EVENT_COLOURS = {"kidnap": "red", "cover": "black", "teleport": "red", "occlude": "grey", "lights": "orange", "camera": "purple"}
+# A robot's block of summary.json (statistics by path: "x_cm/mean", "recall/25cm_10deg", and its
+# "tracking_phase" block of the same shape), or any other object of it.
+Block = JSONObject
 
-def _skip_dir(d: Any) -> Any:
+
+def skip_dir(d: pathlib.Path) -> bool:
+    """Folders discover() never enters: hidden ones and those of an unfinished write."""
     return d.name.startswith(".") or ".staging" in d.name or d.name.endswith(".tmp") or ".partial" in d.name
 
 
 # Sweep folders used although their aggregate was not final (discover(..., accept_incomplete=True)),
 # so a tool can say so in its output.
-INCOMPLETE = []
+INCOMPLETE: list[pathlib.Path] = []
 
 
-def incomplete_reason(d: Any, files: Any) -> Any:
+def incomplete_reason(d: pathlib.Path, files: Sequence[str]) -> Optional[str]:
     """Why sweep folder `d` is not final, or None: only the merge (or a local sweep that ran every
     run) writes aggregate.json, with "complete" (batch/aggregate.hpp); a folder with runs/ and
     specs/ but no aggregate.json is a sweep whose shards or merge have not finished."""
     if "aggregate.json" in files:
         try:
-            agg = json.loads((d / "aggregate.json").read_text())
+            agg = read_aggregate(d)
         except (OSError, ValueError):
             return "its aggregate.json cannot be read"
-        if agg.get("complete") is False:
-            return f"its aggregate covers {agg.get('done')} of {agg.get('expected')} runs"
+        if agg.complete is False:
+            return f"its aggregate covers {agg.done} of {agg.expected} runs"
         return None
     if (d / "runs").is_dir() and (d / "specs").is_dir():
         return "it has no final aggregate yet (shards still running, or the merge `omniloc sweep SPEC --aggregate-only` not run)"
     return None
 
 
-def discover(paths: Sequence[Any], accept_incomplete: bool = False) -> Any:
+def discover(paths: Sequence[Union[str, pathlib.Path]], accept_incomplete: bool = False) -> tuple[list[Run], list[pathlib.Path], list[pathlib.Path]]:
     """(runs, sweeps, experiments) under the given folders: run folders (summary.json, including those
     inside sweeps), sweep folders (aggregate.json) and experiment folders (PNG / JSON pictures).
     A sweep folder whose aggregate is not final stops it (SystemExit naming the folder) unless
     `accept_incomplete`; then its finished runs are used and the folder is listed in INCOMPLETE."""
-    runs, sweeps, experiments = [], [], []
-    stale: set[Any] = set()
-    for p in paths:
-        why = PC.why_not_readable_folder(p)
+    runs: list[pathlib.Path] = []
+    sweeps: list[pathlib.Path] = []
+    experiments: list[pathlib.Path] = []
+    stale: set[str] = set()
+    for given in paths:
+        why = pathcheck.why_not_readable_folder(given)
         if why:
-            raise SystemExit(f"{PC.shown(p)}: {why}, expected a folder of results")
-        p = pathlib.Path(p)
-        for d, subdirs, files in os.walk(p):
-            d = pathlib.Path(d)
-            if _skip_dir(d):
+            raise SystemExit(f"{pathcheck.shown(given)}: {why}, expected a folder of results")
+        p = pathlib.Path(given)
+        for dirpath, subdirs, files in os.walk(p):
+            d = pathlib.Path(dirpath)
+            if skip_dir(d):
                 subdirs[:] = []
                 continue
             subdirs.sort()
@@ -73,7 +81,7 @@ def discover(paths: Sequence[Any], accept_incomplete: bool = False) -> Any:
             if "aggregate.json" in files:
                 sweeps.append(d)
                 # Only the runs this sweep lists: a folder reused with another spec keeps old runs.
-                listed = {row["id"] for row in read_csv(d / "runs.csv")}
+                listed = read_run_ids(d)
                 if listed and (d / "runs").is_dir():
                     stale.update(str(x) for x in (d / "runs").iterdir() if x.name not in listed)
             if str(d) in stale:
@@ -84,76 +92,141 @@ def discover(paths: Sequence[Any], accept_incomplete: bool = False) -> Any:
                 subdirs[:] = []
             elif "aggregate.json" not in files and d.name != "img" and (any(f.endswith(".png") for f in files) or d.name + ".json" in files):
                 experiments.append(d)  # an experiment's folder: its pictures, or its JSON named after it
-    uniq = lambda xs: sorted(set(xs))
-    return [Run(r) for r in uniq(runs)], uniq(sweeps), uniq(experiments)
+    return [Run.read(r) for r in sorted(set(runs))], sorted(set(sweeps)), sorted(set(experiments))
 
 
-class Run:
-    """One run folder: summary.json (+ config.json, frames.csv, timing.csv on demand)."""
+@dataclass(frozen=True)
+class Summary:
+    """summary.json of a run (docs/results.md): what ran (scenario, localizer, seed, the build in
+    `omniloc`), per robot its statistics (robots: the blocks, read by path with find()), and the
+    sweep-level `metrics`. raw is the whole document."""
+    raw: JSONObject
+    scenario: Optional[str]
+    localizer: Optional[str]
+    localizer_type: Optional[str]
+    seed: Optional[int]
+    start_pose_given: Optional[bool]
+    headline: Optional[str]
+    omniloc: JSONObject
+    robots: list[Block]
+    metrics: JSONObject
 
-    def __init__(self, folder: Any) -> None:
-        self.folder = pathlib.Path(folder)
-        why = PC.why_not_readable_file(self.folder / "summary.json")
-        if why:  # a FIFO named summary.json would block read_text() for ever
-            raise SystemExit(f"{PC.shown(self.folder / 'summary.json')}: {why}, expected a run's summary")
-        self.summary = json.loads((self.folder / "summary.json").read_text())
-        self._config = None
-
-    scenario = property(lambda self: self.summary.get("scenario"))
-    localizer = property(lambda self: self.summary.get("localizer"))
-    seed = property(lambda self: self.summary.get("seed"))
-    version = property(lambda self: (self.summary.get("omniloc") or {}).get("version", "unrecorded"))
+    @staticmethod
+    def from_json(raw: JSON) -> Summary:
+        s = obj(raw)
+        return Summary(raw=s, scenario=text(s.get("scenario")), localizer=text(s.get("localizer")), localizer_type=text(s.get("localizer_type")),
+                       seed=integer(s.get("seed")), start_pose_given=flag(s.get("start_pose_given")),
+                       headline=text(obj(s.get("scoring")).get("headline")), omniloc=obj(s.get("omniloc")),
+                       robots=[obj(r) for r in lst(s.get("robots"))], metrics=obj(s.get("metrics")))
 
     @property
-    def start_pose_given(self) -> Any:
+    def version(self) -> JSON:
+        """The build that made the run (git describe), "unrecorded" where summary.json does not say."""
+        return self.omniloc.get("version", "unrecorded")
+
+    @property
+    def replay(self) -> JSONObject:
+        """omniloc.replay of a replayed run: the recording's path, what recorded it; {} for a live run."""
+        return obj(self.omniloc.get("replay"))
+
+    @property
+    def external_version(self) -> JSON:
+        """An external client's version (summary.json external.version), "" where it gives none."""
+        return obj(self.raw.get("external")).get("version", "")
+
+
+@dataclass(eq=False)
+class Run:
+    """One run folder: summary.json read, config.json, frames.csv, timing.csv and field.json on
+    demand. Runs compare by identity (the same folder read twice is two runs)."""
+    folder: pathlib.Path
+    summary: Summary
+    _config: Optional[JSONObject] = field(default=None, repr=False)
+    _metrics: Optional[dict[str, Optional[float]]] = field(default=None, repr=False)
+
+    @staticmethod
+    def read(folder: Union[str, pathlib.Path]) -> Run:
+        folder = pathlib.Path(folder)
+        summary = folder / "summary.json"
+        why = pathcheck.why_not_readable_file(summary)
+        if why:  # a FIFO named summary.json would block read_text() for ever
+            raise SystemExit(f"{pathcheck.shown(summary)}: {why}, expected a run's summary")
+        return Run(folder=folder, summary=Summary.from_json(parse(summary.read_text())))
+
+    @property
+    def scenario(self) -> Optional[str]:
+        return self.summary.scenario
+
+    @property
+    def localizer(self) -> Optional[str]:
+        return self.summary.localizer
+
+    @property
+    def seed(self) -> Optional[int]:
+        return self.summary.seed
+
+    @property
+    def version(self) -> JSON:
+        return self.summary.version
+
+    @property
+    def start_pose_given(self) -> Optional[bool]:
         """Whether the localizer was reset with the true start pose (summary.json start_pose_given):
         True, False, or None for a run made before omniloc recorded it."""
-        v = self.summary.get("start_pose_given")
-        return v if isinstance(v, bool) else None
+        return self.summary.start_pose_given
 
     @property
-    def config(self) -> Any:
+    def headline(self) -> Optional[str]:
+        """The key of the headline recall threshold ("25cm_10deg", summary.json scoring.headline);
+        None for a run made before recall was scored."""
+        return self.summary.headline
+
+    @property
+    def config(self) -> JSONObject:
+        """config.json: the effective configuration ({} where the folder has none)."""
         if self._config is None:
             f = self.folder / "config.json"
-            self._config = json.loads(f.read_text()) if f.exists() else {}
+            self._config = obj(parse(f.read_text())) if f.exists() else {}
         return self._config
 
-    def robot(self, index: int = 0) -> Any:
-        robots = self.summary.get("robots") or []
+    def robot(self, index: int = 0) -> Optional[Block]:
+        robots = self.summary.robots
         return robots[index] if index < len(robots) else None
 
-    def metric(self, path: Any, phase: str = "tracking", robot: int = 0) -> Any:
+    def metric(self, path: str, phase: str = "tracking", robot: int = 0) -> Optional[float]:
         """A number of robot `robot`'s summary, e.g. "x_cm/mean" or "recovery/recovered". With
         phase "tracking" it is read from the tracking-phase block where the run has one (kidnaps,
         covers) and the block has the key; otherwise from the all-frames figures. None when absent
         AND when null (no estimate): lookup() tells the two apart. A null of the tracking phase is
         never replaced by the all-frames figure."""
         found, v = self.lookup(path, phase, robot)
-        return _plain(v) if found else None
+        return number(v) if found else None
 
-    def lookup(self, path: Any, phase: str = "tracking", robot: int = 0) -> Any:
+    def lookup(self, path: str, phase: str = "tracking", robot: int = 0) -> tuple[bool, JSON]:
         """(found, value): found False when the summary has no such key (a run made before it);
         (True, None) when the statistic is null: no frame with an estimate (see why_null())."""
         r = self.robot(robot)
         if r is None:
             return False, None
-        if phase == "tracking" and isinstance(r.get("tracking_phase"), dict):
-            found, v = find(r["tracking_phase"], path)
+        tp = r.get("tracking_phase")
+        if phase == "tracking" and isinstance(tp, dict):
+            found, v = find(tp, path)
             if found:
                 return True, v
         return find(r, path)
 
-    def why_null(self, path: Any, phase: str = "tracking", robot: int = 0) -> Any:
+    def why_null(self, path: str, phase: str = "tracking", robot: int = 0) -> Optional[str]:
         """The reason summary.json gives beside a null statistic ("no estimate in any of the 30
         scored frames", "no kidnap recovered"): the "why_null" of the innermost block on the path
         that has one; None when there is none."""
         r = self.robot(robot)
         if r is None:
             return None
-        block = r
-        if phase == "tracking" and isinstance(r.get("tracking_phase"), dict) and find(r["tracking_phase"], path)[0]:
-            block = r["tracking_phase"]
-        why = block.get("why_null")
+        block: JSON = r
+        tp = r.get("tracking_phase")
+        if phase == "tracking" and isinstance(tp, dict) and find(tp, path)[0]:
+            block = tp
+        why = obj(block).get("why_null")
         for part in path.strip("/").split("/")[:-1]:
             block = block.get(part) if isinstance(block, dict) else None
             if not isinstance(block, dict):
@@ -161,64 +234,54 @@ class Run:
             why = block.get("why_null", why)
         return why if isinstance(why, str) else None
 
-    @property
-    def headline(self) -> Any:
-        """The key of the headline recall threshold ("25cm_10deg", summary.json scoring.headline);
-        None for a run made before recall was scored."""
-        h = (self.summary.get("scoring") or {}).get("headline")
-        return h if isinstance(h, str) else None
+    def aggregate_metrics(self) -> dict[str, Optional[float]]:
+        """Every number of summary.json under its aggregate.csv name (core.aggregate.summary_metrics),
+        flattened once per run."""
+        if self._metrics is None:
+            self._metrics = summary_metrics(self.summary.raw)
+        return self._metrics
 
-    def frames(self) -> Any:
+    def frames(self) -> list[dict[str, str]]:
+        """frames.csv: one row per frame and robot, each cell as text ([] without the file)."""
         return read_csv(self.folder / "frames.csv")
 
-    def timing(self) -> Any:
+    def timing(self) -> list[dict[str, str]]:
+        """timing.csv: one row per frame, the stages' wall times in ms as text ([] without the file)."""
         return read_csv(self.folder / "timing.csv")
 
-
-def read_csv(path: Any) -> Any:
-    path = pathlib.Path(path)
-    if not path.exists():
-        return []
-    with path.open(newline="") as fh:
-        return list(csv.DictReader(fh))
+    def field_json(self) -> Optional[JSON]:
+        """field.json (the field's markings); None without the file. ValueError when it is not JSON."""
+        f = self.folder / "field.json"
+        return load_file(f) if f.exists() else None
 
 
-def dig(obj: Any, path: Any) -> Any:
-    """obj["a"]["b"] for path "a/b" (numbers only); None when absent or null."""
-    found, v = find(obj, path)
-    return _plain(v) if found else None
+def find(value: JSON, path: str) -> tuple[bool, JSON]:
+    """(found, value) of value["a"]["b"] for path "a/b": (True, None) for a null (a statistic over
+    no frame), (False, None) for an absent key."""
+    return walk(value, path.strip("/").split("/"))
 
 
-def find(obj: Any, path: Any) -> Any:
-    """(found, value) of obj["a"]["b"] for path "a/b": (True, None) for a null (a statistic over no
-    frame), (False, None) for an absent key."""
-    return _walk(obj, path.strip("/").split("/"))
-
-
-def _walk(obj: Any, parts: Iterable[str]) -> tuple[bool, Any]:
-    """(found, value) of obj[part0][part1]...: a list is indexed by a part of digits."""
+def walk(value: JSON, parts: Iterable[str]) -> tuple[bool, JSON]:
+    """(found, value) of value[part0][part1]...: a list is indexed by a part of digits."""
     for part in parts:
-        if isinstance(obj, dict) and part in obj:
-            obj = obj[part]
-        elif isinstance(obj, list) and part.isdigit() and int(part) < len(obj):
-            obj = obj[int(part)]
+        if isinstance(value, dict) and part in value:
+            value = value[part]
+        elif isinstance(value, list) and part.isdigit() and int(part) < len(value):
+            value = value[int(part)]
         else:
             return False, None
-    return True, obj
+    return True, value
 
 
-def _plain(v: Any) -> Any:
-    return v if isinstance(v, (int, float)) and not isinstance(v, bool) else (v if isinstance(v, (dict, list, str, bool)) else None)
-
-
-def pointer(obj: Any, ptr: str) -> Any:
-    """(found, value) of a JSON pointer (RFC 6901) in obj."""
+def pointer(value: JSON, ptr: str) -> tuple[bool, JSON]:
+    """(found, value) of a JSON pointer (RFC 6901) in value."""
     if ptr in ("", "/"):
-        return True, obj
-    return _walk(obj, (raw.replace("~1", "/").replace("~0", "~") for raw in ptr[1:].split("/")))
+        return True, value
+    return walk(value, (raw.replace("~1", "/").replace("~0", "~") for raw in ptr[1:].split("/")))
 
 
-def same_value(a: Any, b: Any) -> Any:
+def same_value(a: JSON, b: JSON) -> bool:
+    """Whether two JSON values are the same: numbers to a relative 1e-9, true never equal to 1."""
     if isinstance(a, bool) or isinstance(b, bool):
         return a is b or a == b and type(a) is type(b)
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
@@ -228,3 +291,4 @@ def same_value(a: Any, b: Any) -> Any:
     if isinstance(a, list) and isinstance(b, list):
         return len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b))
     return a == b
+

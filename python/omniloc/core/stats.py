@@ -11,7 +11,8 @@ for two result sets. wilson(): the Wilson score interval of a success rate.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from dataclasses import dataclass
+from typing import Optional, Sequence, TypeGuard, Union
 
 
 # The interval rule (one for every tool; batch/aggregate.cpp applies the same in C++): the kind
@@ -31,7 +32,46 @@ MIN_T_SEEDS = 5  # below this no candidate covered the mean reliably (scripts/in
 STUDENT_T = T95  # old name
 
 
-def percentile(sorted_vals: Any, q: Any) -> Any:
+@dataclass(frozen=True)
+class Interval:
+    """The interval of the mean of a few seeds' values (interval()): kind T95, RANGE or NO_INTERVAL;
+    everything None over no value."""
+    n: int
+    mean: Optional[float]
+    lo: Optional[float]
+    hi: Optional[float]
+    kind: Optional[str]
+
+
+@dataclass
+class SeedStats:
+    """A statistic over seeds (stats()): the values used (None and NaN left out), their mean, median
+    and standard deviation, and interval()'s lo / hi / kind as method (None where n < 2). Over runs
+    (core.metrics.run_stats) also no_value (runs where the statistic is null: no estimate), of (runs
+    that have the key) and why (the reason to print where no run has a value)."""
+    n: int
+    mean: Optional[float]
+    median: Optional[float]
+    sd: Optional[float]
+    lo: Optional[float]
+    hi: Optional[float]
+    values: list[float]
+    method: Optional[str]
+    no_value: int = 0
+    of: int = 0
+    why: Optional[str] = None
+
+
+@dataclass(frozen=True)
+class Welch:
+    """Welch's t-test of mean(b) - mean(a): diff, t, df, p (None where a side has fewer than two values)."""
+    diff: Optional[float]
+    t: Optional[float]
+    df: Optional[float]
+    p: Optional[float]
+
+
+def percentile(sorted_vals: Sequence[float], q: float) -> float:
     """The q-quantile (0..1) of sorted values, linear interpolation between order statistics."""
     pos = q * (len(sorted_vals) - 1)
     k = int(math.floor(pos))
@@ -40,9 +80,9 @@ def percentile(sorted_vals: Any, q: Any) -> Any:
     return sorted_vals[k] + (pos - k) * (sorted_vals[k + 1] - sorted_vals[k])
 
 
-def interval(values: Sequence[Any]) -> Any:
+def interval(values: Sequence[Optional[float]]) -> Interval:
     """The interval of the mean of a few seeds' values, by omniloc's one rule (docs/results.md
-    "Intervals"): {"n", "mean", "lo", "hi", "kind"}.
+    "Intervals"): an Interval (n, mean, lo, hi, kind).
       n >= 5: kind T95, the 95 % Student t interval; a sample without negative values (an error, a
               count) never gets a negative bound: the lower one is clipped at 0.
       2..4:   kind RANGE, lo / hi the seeds' minimum and maximum: with so few seeds no interval is
@@ -53,32 +93,32 @@ def interval(values: Sequence[Any]) -> Any:
     v = [float(x) for x in values if x is not None and not (isinstance(x, float) and math.isnan(x))]
     n = len(v)
     if n == 0:
-        return {"n": 0, "mean": None, "lo": None, "hi": None, "kind": None}
+        return Interval(n=0, mean=None, lo=None, hi=None, kind=None)
     m = sum(v) / n
     if n == 1:
-        return {"n": 1, "mean": m, "lo": m, "hi": m, "kind": NO_INTERVAL}
+        return Interval(n=1, mean=m, lo=m, hi=m, kind=NO_INTERVAL)
     if n < MIN_T_SEEDS:
-        return {"n": n, "mean": m, "lo": min(v), "hi": max(v), "kind": RANGE}
+        return Interval(n=n, mean=m, lo=min(v), hi=max(v), kind=RANGE)
     sd = math.sqrt(sum((x - m) ** 2 for x in v) / (n - 1))
     half = t_quantile_975(n - 1) * sd / math.sqrt(n)
     lo = m - half
     if min(v) >= 0:
         lo = max(lo, 0.0)
-    return {"n": n, "mean": m, "lo": lo, "hi": m + half, "kind": T95}
+    return Interval(n=n, mean=m, lo=lo, hi=m + half, kind=T95)
 
 
-def interval_text(iv: Any, digits: int = 3) -> Any:
+def interval_text(iv: Union[Interval, SeedStats, None], digits: int = 3) -> str:
     """How every tool prints an interval (stats() or interval() output):
     'mean [lo, hi] (n=5, t95)', "mean (seeds' range lo to hi, n=3)", 'mean (n=1, no interval)', '-'."""
-    if not iv or not iv["n"]:
+    if not iv or not iv.n:
         return "-"
-    m = fnum(iv["mean"], digits)
-    kind = iv.get("kind", iv.get("method"))
-    if iv["n"] == 1 or kind == NO_INTERVAL:
+    m = fnum(iv.mean, digits)
+    kind = iv.kind if isinstance(iv, Interval) else iv.method
+    if iv.n == 1 or kind == NO_INTERVAL:
         return f"{m} (n=1, no interval)"
     if kind == RANGE:
-        return f"{m} (seeds' range {fnum(iv['lo'], digits)} to {fnum(iv['hi'], digits)}, n={iv['n']})"
-    return f"{m} [{fnum(iv['lo'], digits)}, {fnum(iv['hi'], digits)}] (n={iv['n']}, {kind})"
+        return f"{m} (seeds' range {fnum(iv.lo, digits)} to {fnum(iv.hi, digits)}, n={iv.n})"
+    return f"{m} [{fnum(iv.lo, digits)}, {fnum(iv.hi, digits)}] (n={iv.n}, {kind})"
 
 
 INTERVAL_RULE_TEXT = ("intervals: n >= 5 seeds, the 95 % Student t interval of the mean, never below 0 for a non-negative quantity (t95); "
@@ -86,51 +126,41 @@ INTERVAL_RULE_TEXT = ("intervals: n >= 5 seeds, the 95 % Student t interval of t
                       "1 seed, none (docs/results.md \"Intervals\")")
 
 
-def aggregate_interval(metric: Any) -> Any:
-    """(lo, hi, kind) of one metric of an aggregate.json group ({"n", "mean", "ci95", "interval"}).
-    Aggregates written before the rule have no "interval" and hold an unclipped Student t interval
-    for every n >= 2: the kind returned is then "t95 (old aggregate)" for n >= 2, so a reader never
-    takes it for the current rule's."""
-    ci = metric.get("ci95") or [None, None]
-    kind = metric.get("interval")
-    if kind is None:
-        kind = NO_INTERVAL if metric.get("n", 0) < 2 else "t95 (old aggregate)"
-    return ci[0], ci[1], kind
-
-
-def stats(values: Sequence[Any], method: Any = None) -> Any:
-    """{"n", "mean", "median", "sd", "lo", "hi", "values", "method"} over the seeds' values: lo / hi /
-    method are interval()'s lo / hi / kind (the one rule; None where n < 2). `method` is accepted for
-    old callers and ignored: every tool uses the same rule."""
+def stats(values: Sequence[Optional[float]]) -> SeedStats:
+    """The seeds' values (None and NaN left out) with their mean, median, standard deviation and
+    interval()'s lo / hi / kind as method (the one rule; None where n < 2)."""
     v = [x for x in values if x is not None and not (isinstance(x, float) and math.isnan(x))]
     n = len(v)
-    out: dict[str, Any] = {"n": n, "mean": None, "median": None, "sd": None, "lo": None, "hi": None, "values": v, "method": None}
+    out = SeedStats(n=n, mean=None, median=None, sd=None, lo=None, hi=None, values=v, method=None)
     if n == 0:
         return out
     iv = interval(v)
-    out["mean"] = iv["mean"]
-    out["median"] = percentile(sorted(v), 0.5)
+    mean = iv.mean if iv.mean is not None else math.nan
+    out.mean = iv.mean
+    out.median = percentile(sorted(v), 0.5)
     if n < 2:
         return out
-    out["sd"] = math.sqrt(sum((x - iv["mean"]) ** 2 for x in v) / (n - 1))
-    out["lo"], out["hi"], out["method"] = iv["lo"], iv["hi"], iv["kind"]
+    out.sd = math.sqrt(sum((x - mean) ** 2 for x in v) / (n - 1))
+    out.lo, out.hi, out.method = iv.lo, iv.hi, iv.kind
     return out
 
 
-def is_number(v: Any) -> Any:
+def is_number(v: object) -> TypeGuard[float]:
+    """Whether v is a number (not a bool, not NaN)."""
     return isinstance(v, (int, float)) and not isinstance(v, bool) and not (isinstance(v, float) and math.isnan(v))
 
 
-def outliers(values: list[Any], factor: float = 3.0) -> Any:
+def outliers(values: Sequence[Optional[float]], factor: float = 3.0) -> list[int]:
     """Indices of the seeds whose (non-negative) error lies far above the others: above `factor`
     times the median of the other seeds AND further from it than `factor` times their range. Both
     conditions, so that three close small values (2.9, 3.0, 3.3 cm) flag nothing and one seed at
     806 cm beside two at 3 cm is flagged. Needs n >= 3 (with two seeds neither is "the odd one")."""
-    out: list[Any] = []
-    if len(values) < 3 or any(v is None for v in values):
+    out: list[int] = []
+    vals = [v for v in values if v is not None]
+    if len(values) < 3 or len(vals) < len(values):
         return out
-    for i, x in enumerate(values):
-        others = sorted(values[:i] + values[i + 1:])
+    for i, x in enumerate(vals):
+        others = sorted(vals[:i] + vals[i + 1:])
         med = percentile(others, 0.5)
         spread = others[-1] - others[0]
         if x > factor * med and x - med > factor * spread and x - med > 1e-9:
@@ -138,7 +168,7 @@ def outliers(values: list[Any], factor: float = 3.0) -> Any:
     return out
 
 
-def _betacf(a: Any, b: Any, x: Any) -> Any:
+def _betacf(a: float, b: float, x: float) -> float:
     # Continued fraction of the incomplete beta function (modified Lentz), as in Numerical Recipes' derivation.
     tiny, qab, qap, qam = 1e-300, a + b, a + 1.0, a - 1.0
     c, d = 1.0, 1.0 - qab * x / qap
@@ -164,7 +194,7 @@ def _betacf(a: Any, b: Any, x: Any) -> Any:
     return h
 
 
-def betainc(a: Any, b: Any, x: Any) -> Any:
+def betainc(a: float, b: float, x: float) -> float:
     """Regularised incomplete beta I_x(a, b)."""
     if x <= 0:
         return 0.0
@@ -176,14 +206,14 @@ def betainc(a: Any, b: Any, x: Any) -> Any:
     return 1.0 - math.exp(lbt) * _betacf(b, a, 1 - x) / b
 
 
-def t_two_sided_p(t: Any, df: float) -> Any:
+def t_two_sided_p(t: float, df: float) -> float:
     """P(|T| >= |t|) for Student's t with df degrees of freedom (df may be fractional: Welch)."""
     if df <= 0 or math.isnan(t):
         return float("nan")
     return betainc(df / 2.0, 0.5, df / (df + t * t))
 
 
-def t_quantile_975(df: float) -> Any:
+def t_quantile_975(df: float) -> float:
     """The 0.975 quantile of Student's t by bisection on t_two_sided_p (exact enough for intervals)."""
     lo, hi = 0.0, 1000.0
     for _ in range(100):
@@ -195,37 +225,35 @@ def t_quantile_975(df: float) -> Any:
     return 0.5 * (lo + hi)
 
 
-def welch(a: Any, b: Any) -> Any:
-    """Welch's unequal-variance t-test of mean(b) - mean(a): {"diff", "t", "df", "p"}; t, df and p are
-    None when either side has fewer than two values (no seed-to-seed spread to compare with)."""
+def welch(a: Sequence[Optional[float]], b: Sequence[Optional[float]]) -> Welch:
+    """Welch's unequal-variance t-test of mean(b) - mean(a): diff, t, df, p; t, df and p are None
+    when either side has fewer than two values (no seed-to-seed spread to compare with)."""
     sa, sb = stats(a), stats(b)
-    out: dict[str, Any] = {"diff": None if sa["mean"] is None or sb["mean"] is None else sb["mean"] - sa["mean"], "t": None, "df": None, "p": None}
-    if sa["n"] < 2 or sb["n"] < 2:
-        return out
-    va, vb = sa["sd"] ** 2 / sa["n"], sb["sd"] ** 2 / sb["n"]
+    diff = None if sa.mean is None or sb.mean is None else sb.mean - sa.mean
+    if sa.n < 2 or sb.n < 2 or diff is None or sa.sd is None or sb.sd is None:
+        return Welch(diff=diff, t=None, df=None, p=None)
+    va, vb = sa.sd ** 2 / sa.n, sb.sd ** 2 / sb.n
     if va + vb == 0:
         # No spread on either side (deterministic metric): any difference is exact.
-        out.update(t=math.inf if out["diff"] else 0.0, df=float(sa["n"] + sb["n"] - 2), p=0.0 if out["diff"] else 1.0)
-        return out
-    t = out["diff"] / math.sqrt(va + vb)
-    df = (va + vb) ** 2 / (va ** 2 / (sa["n"] - 1) + vb ** 2 / (sb["n"] - 1))
-    out.update(t=t, df=df, p=t_two_sided_p(t, df))
-    return out
+        return Welch(diff=diff, t=math.inf if diff else 0.0, df=float(sa.n + sb.n - 2), p=0.0 if diff else 1.0)
+    t = diff / math.sqrt(va + vb)
+    df = (va + vb) ** 2 / (va ** 2 / (sa.n - 1) + vb ** 2 / (sb.n - 1))
+    return Welch(diff=diff, t=t, df=df, p=t_two_sided_p(t, df))
 
 
-def fnum(v: Any, digits: int = 3) -> Any:
+def fnum(v: Optional[float], digits: int = 3) -> str:
     if v is None or (isinstance(v, float) and (math.isnan(v) or math.isinf(v))):
         return "-"
     return f"{v:.{digits}f}"
 
 
-def fstat(s: Any, digits: int = 3) -> Any:
+def fstat(s: SeedStats, digits: int = 3) -> str:
     """interval_text of a stats() result: 'mean [lo, hi] (n=5, t95)', "mean (seeds' range lo to hi,
     n=3)", 'mean (n=1, no interval)'."""
     return interval_text(s, digits)
 
 
-def wilson(k: Any, n: Any, z: float = 1.959963984540054) -> Any:
+def wilson(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
     """Wilson score interval (lo, hi) for k successes out of n; (0, 1) for n = 0."""
     if n == 0:
         return 0.0, 1.0

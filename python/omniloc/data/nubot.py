@@ -37,53 +37,77 @@ import math
 import os
 import sys
 import time
-from typing import Any
+from typing import Optional, Sequence, TypedDict, Union
 
 import numpy as np
 
-from omniloc.core import paths as PATHS
-from omniloc.core.rundir import Run
+from omniloc.core import paths
+from omniloc.core.jsonvalue import JSON, JSONObject, lst, number, obj
 
 
-REPO = str(PATHS.ROOT)
+REPO = str(paths.ROOT)
 
 
-def field_markings(field: Any) -> Any:
+class Markings(TypedDict):
+    """A field's markings (a recording's "field_markings"): its size, and the centre lines of its
+    segments [x1, y1, x2, y2], arcs [cx, cy, r, start, sweep] and filled spots [cx, cy, r] (metres,
+    radians)."""
+    name: str
+    length: float
+    width: float
+    margin: float
+    segments: list[list[float]]
+    arcs: list[list[float]]
+    spots: list[list[float]]
+
+
+Pose = Sequence[float]  # x, y (m), theta (rad)
+
+
+def floats(v: JSON) -> list[float]:
+    """A marking's numbers (ValueError where one is not a number)."""
+    return [float(x) if isinstance(x, (int, float)) else float(str(x)) for x in lst(v)]
+
+
+def field_markings(field: Union[str, JSON]) -> Markings:
     """Markings of a field: a preset name (data/fields/<name>.json), or a field object as a scenario's
     "field" holds it (type "msl" only, as core/field.cpp builds it: touch, goal and centre lines,
     centre circle, penalty and goal areas, penalty and centre spots, corner arcs), or an object that
     already has "segments" (the "field_markings" of an omniloc recording). Returns a dict with
     length, width, margin, segments [x1, y1, x2, y2], arcs [cx, cy, r, start, sweep], spots [cx, cy, r]."""
-    f: dict[str, Any]
+    f: JSONObject
     if isinstance(field, str):
         with open(os.path.join(REPO, "data", "fields", field + ".json"), encoding="utf-8") as fh:
-            f = json.load(fh)
+            f = obj(json.load(fh))
         name = field
     else:
-        f = dict(field)
-        name = f.get("name", "custom")
+        f = dict(obj(field))
+        name = str(f.get("name", "custom"))
     if "segments" in f and "type" not in f:  # already markings
-        return {"name": f.get("name", name), "length": float(f["length"]), "width": float(f["width"]),
-                "margin": float(f.get("margin", 1.0)), "segments": [list(map(float, s)) for s in f["segments"]],
-                "arcs": [list(map(float, a)) for a in f.get("arcs", [])], "spots": [list(map(float, s)) for s in f.get("spots", [])]}
+        return Markings(name=str(f.get("name", name)), length=size(f["length"]), width=size(f["width"]),
+                        margin=size(f.get("margin", 1.0)), segments=[floats(s) for s in lst(f["segments"])],
+                        arcs=[floats(a) for a in lst(f.get("arcs", []))], spots=[floats(s) for s in lst(f.get("spots", []))])
     if f.get("type", "msl") != "msl":
         raise ValueError("only MSL fields (type msl) are supported")
-    L, W = float(f.get("length", 18.0)), float(f.get("width", 12.0))
+    L, W = size(f.get("length", 18.0)), size(f.get("width", 12.0))
     hx, hy = 0.5 * L, 0.5 * W
-    circle_r = float(f.get("centre_circle_radius", 2.0))
-    corner_r = float(f.get("corner_arc_radius", 0.75))
-    pen_mark = float(f.get("penalty_mark_distance", 3.0))
-    spot_r = float(f.get("spot_radius", 0.075))
-    pa = f.get("penalty_area", {})
-    ga = f.get("goal_area", {}) or {}
-    seg, arcs, spots = [], [], []
+    circle_r = size(f.get("centre_circle_radius", 2.0))
+    corner_r = size(f.get("corner_arc_radius", 0.75))
+    pen_mark = size(f.get("penalty_mark_distance", 3.0))
+    spot_r = size(f.get("spot_radius", 0.075))
+    raw_pa = f.get("penalty_area", {})
+    pa = obj(raw_pa) if raw_pa is not None else None
+    ga = obj(f.get("goal_area", {}) or {})
+    seg: list[list[float]] = []
+    arcs: list[list[float]] = []
+    spots: list[list[float]] = []
     seg += [[-hx, -hy, hx, -hy], [-hx, hy, hx, hy], [-hx, -hy, -hx, hy], [hx, -hy, hx, hy], [0.0, -hy, 0.0, hy]]
     arcs.append([0.0, 0.0, circle_r, 0.0, 2 * math.pi])
-    ga_d, ga_w = float(ga.get("depth", 0.75)), float(ga.get("width", 3.5))
+    ga_d, ga_w = size(ga.get("depth", 0.75)), size(ga.get("width", 3.5))
     for s in (-1, 1):
         gx = s * hx
         if pa is not None:
-            pa_d, pa_w = float(pa.get("depth", 2.25)), float(pa.get("width", 6.5))
+            pa_d, pa_w = size(pa.get("depth", 2.25)), size(pa.get("width", 6.5))
             seg += [[gx, -0.5 * pa_w, gx - s * pa_d, -0.5 * pa_w], [gx, 0.5 * pa_w, gx - s * pa_d, 0.5 * pa_w],
                     [gx - s * pa_d, -0.5 * pa_w, gx - s * pa_d, 0.5 * pa_w]]
         seg += [[gx, -0.5 * ga_w, gx - s * ga_d, -0.5 * ga_w], [gx, 0.5 * ga_w, gx - s * ga_d, 0.5 * ga_w],
@@ -95,10 +119,16 @@ def field_markings(field: Any) -> Any:
     if corner_r > 0:
         arcs += [[-hx, -hy, corner_r, 0.0, 0.5 * math.pi], [hx, -hy, corner_r, 0.5 * math.pi, 0.5 * math.pi],
                  [hx, hy, corner_r, math.pi, 0.5 * math.pi], [-hx, hy, corner_r, 1.5 * math.pi, 0.5 * math.pi]]
-    return {"name": name, "length": L, "width": W, "margin": float(f.get("margin", 1.0)), "segments": seg, "arcs": arcs, "spots": spots}
+    return Markings(name=name, length=L, width=W, margin=size(f.get("margin", 1.0)), segments=seg, arcs=arcs, spots=spots)
 
 
-def distance_to_markings(m: Any, px: Any, py: Any) -> Any:
+def size(v: JSON) -> float:
+    """A size of the field's JSON (metres) as a float (ValueError where it is not a number)."""
+    n = number(v)
+    return float(n) if n is not None else float(str(v))
+
+
+def distance_to_markings(m: Markings, px: "np.ndarray", py: "np.ndarray") -> "np.ndarray":
     """Exact distance (m) of the world points (arrays px, py, any shape) to the nearest marking: a
     segment's or arc's centre line, or a spot's rim (0 inside a filled spot)."""
     px = np.asarray(px, dtype=float)
@@ -130,7 +160,7 @@ class DistanceMap:
     """Exact distances sampled on a lattice of `cell` metres covering the lines plus `pad`; lookups by
     bilinear interpolation; beyond the lattice the distance is taken as `far` (>= any truncation)."""
 
-    def __init__(self, m: Any, cell: Any = 0.01, pad: Any = 1.0, far: Any = 10.0) -> None:
+    def __init__(self, m: Markings, cell: float = 0.01, pad: float = 1.0, far: float = 10.0) -> None:
         self.cell = cell
         self.x0 = -0.5 * m["length"] - pad
         self.y0 = -0.5 * m["width"] - pad
@@ -144,7 +174,7 @@ class DistanceMap:
             self.d[i0:i0 + 256] = distance_to_markings(m, gx, gy)
         self.far = far
 
-    def lookup(self, wx: Any, wy: Any) -> Any:
+    def lookup(self, wx: "np.ndarray", wy: "np.ndarray") -> "np.ndarray":
         fx = (np.asarray(wx) - self.x0) / self.cell
         fy = (np.asarray(wy) - self.y0) / self.cell
         inside = (fx >= 0) & (fy >= 0) & (fx < self.nx - 1) & (fy < self.ny - 1)
@@ -156,36 +186,37 @@ class DistanceMap:
         return np.where(inside, v, self.far)
 
 
-def world_points(pose: Any, pts: Any) -> Any:
+def world_points(pose: Pose, pts: "np.ndarray") -> tuple["np.ndarray", "np.ndarray"]:
+    """Robot-frame points (N, 2) placed in the world with `pose`: (x, y) arrays."""
     x, y, th = pose
     c, s = math.cos(th), math.sin(th)
     return x + c * pts[:, 0] - s * pts[:, 1], y + s * pts[:, 0] + c * pts[:, 1]
 
 
-def score_exact(m: Any, pose: Any, pts: Any, c: Any) -> Any:
+def score_exact(m: Markings, pose: Pose, pts: "np.ndarray", c: float) -> float:
     wx, wy = world_points(pose, pts)
     d = distance_to_markings(m, wx, wy)
     return float(np.mean(np.minimum(d, c) ** 2))
 
 
-def wrap(a: Any) -> Any:
+def wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
-def twin_of(pose: Any) -> Any:
+def twin_of(pose: Pose) -> tuple[float, float, float]:
     return (-pose[0], -pose[1], wrap(pose[2] + math.pi))
 
 
-def pose_distance(p: Any, q: Any) -> Any:
+def pose_distance(p: Pose, q: Pose) -> tuple[float, float]:
     """(metres, radians) between two poses."""
     return math.hypot(p[0] - q[0], p[1] - q[1]), abs(wrap(p[2] - q[2]))
 
 
-def _apart(dist: Any, metres: Any, radians: Any) -> Any:
+def apart(dist: tuple[float, float], metres: float, radians: float) -> bool:
     return dist[0] > metres or dist[1] > radians
 
 
-def _nice(n: Any) -> Any:
+def fft_size(n: int) -> int:
     """Smallest 2^a 3^b 5^c >= n (fast FFT sizes)."""
     best = 1 << (n - 1).bit_length()
     f5 = 1
@@ -201,11 +232,11 @@ def _nice(n: Any) -> Any:
     return best
 
 
-def _refine(dmap: Any, pose: Any, pts: Any, c: Any, step_xy: Any = 0.04, step_th: Any = math.radians(1.0), min_xy: Any = 0.0005, min_th: Any = math.radians(0.01),
-            bounds: Any = None) -> Any:
+def refine(dmap: DistanceMap, pose: Pose, pts: "np.ndarray", c: float, step_xy: float = 0.04, step_th: float = math.radians(1.0), min_xy: float = 0.0005,
+           min_th: float = math.radians(0.01), bounds: Optional[tuple[float, float]] = None) -> tuple[tuple[float, ...], float]:
     """Pattern search (compass search) on the 1 cm map: tries +-step in each coordinate, moves to the
     best improvement, halves the steps when none improves."""
-    def f(p: Any) -> Any:
+    def f(p: Pose) -> float:
         wx, wy = world_points(p, pts)
         return float(np.mean(np.minimum(dmap.lookup(wx, wy), c) ** 2))
     p = list(pose)
@@ -231,8 +262,9 @@ def _refine(dmap: Any, pose: Any, pts: Any, c: Any, step_xy: Any = 0.04, step_th
     return tuple(p), best
 
 
-def search(points: Any, field: Any = "msl2012", c: Any = 0.30, xy_step: Any = 0.05, theta_step_deg: Any = 1.0, distinct_m: Any = 0.5, distinct_deg: Any = 20.0,
-           candidates: Any = 40, per_theta: Any = 6, max_range: Any = None, verbose: bool = False, dmap: Any = None) -> Any:
+def search(points: "Union[np.ndarray, Sequence[Sequence[float]]]", field: Union[str, JSON] = "msl2012", c: float = 0.30, xy_step: float = 0.05,
+           theta_step_deg: float = 1.0, distinct_m: float = 0.5, distinct_deg: float = 20.0, candidates: int = 40, per_theta: int = 6,
+           max_range: Optional[float] = None, verbose: bool = False, dmap: Optional[DistanceMap] = None) -> dict[str, JSON]:
     """Exhaustive search for the pose that fits `points` ((N, 2) robot frame, metres) to the field.
 
     Returns a dict: reference [x, y, theta], twin, residual_m (sqrt of the mean truncated squared
@@ -262,7 +294,7 @@ def search(points: Any, field: Any = "msl2012", c: Any = 0.30, xy_step: Any = 0.
     rmax = float(np.max(np.hypot(pts[:, 0], pts[:, 1])))
     half = int(math.ceil(rmax / h)) + 1
     npw = 2 * half + 1
-    Lx, Ly = _nice(gnx + npw - 1), _nice(gny + npw - 1)
+    Lx, Ly = fft_size(gnx + npw - 1), fft_size(gny + npw - 1)
     FG = np.fft.rfft2(G, s=(Lx, Ly))
     # Translations (x, y) = (gx0 + a h, gy0 + b h) inside the floor.
     a_lo, a_hi = int(math.ceil((-hxf - gx0) / h)), int(math.floor((hxf - gx0) / h))
@@ -272,7 +304,7 @@ def search(points: Any, field: Any = "msl2012", c: Any = 0.30, xy_step: Any = 0.
     rows = (a_idx - half) % Lx  # s = a + umin, umin = -half
     cols = (b_idx - half) % Ly
     thetas = np.radians(np.arange(0.0, 360.0, theta_step_deg))
-    cand = []
+    cand: list[tuple[float, float, float, float]] = []
     for th in thetas:
         cth, sth = math.cos(th), math.sin(th)
         u = np.rint((cth * pts[:, 0] - sth * pts[:, 1]) / h).astype(np.int64) + half
@@ -296,15 +328,15 @@ def search(points: Any, field: Any = "msl2012", c: Any = 0.30, xy_step: Any = 0.
     t_grid = time.time() - t0
     cand.sort(key=lambda z: z[0])
     # Greedy suppression in pose space, then local refinement of the best `candidates`.
-    kept: list[Any] = []
+    kept: list[tuple[float, float, float, float]] = []
     for s_, x, y, th in cand:
-        if all(_apart(pose_distance((x, y, th), k[1:]), 0.25, math.radians(5)) for k in kept):
+        if all(apart(pose_distance((x, y, th), k[1:]), 0.25, math.radians(5)) for k in kept):
             kept.append((s_, x, y, th))
         if len(kept) >= candidates:
             break
     refined = []
     for s_, x, y, th in kept:
-        p, v = _refine(dmap, (x, y, th), pts, c, bounds=(hxf, hyf))
+        p, v = refine(dmap, (x, y, th), pts, c, bounds=(hxf, hyf))
         refined.append((score_exact(m, p, pts, c), p, s_))
     refined.sort(key=lambda z: z[0])
     best_score, best, _ = refined[0]
@@ -321,7 +353,7 @@ def search(points: Any, field: Any = "msl2012", c: Any = 0.30, xy_step: Any = 0.
             break
     wx, wy = world_points(ref, pts)
     d = distance_to_markings(m, wx, wy)
-    out = {
+    out: dict[str, JSON] = {
         "reference": [round(v, 5) for v in ref],
         "twin": [round(v, 5) for v in twin],
         "residual_m": round(math.sqrt(best_score), 5),

@@ -9,47 +9,81 @@ whose numbers change under a later model says so ("evidence contradicts") instea
 from __future__ import annotations
 
 import math
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Optional, Sequence
 
-from omniloc.paper.data import CONTRADICTED, EXPLAINED, NOT_MEASURED, UNEXPLAINED
+from omniloc.core.jsonvalue import JSON, JSONObject, lst, number, obj, text
+from omniloc.core.verdicts import CONTRADICTED, EXPLAINED, NOT_MEASURED, UNEXPLAINED
+from omniloc.paper.claims import Claim
 from omniloc.paper.labels import cause_summary
 from omniloc.paper.quantity import quantity
 from omniloc.paper.tables import Context
 
 
-def _applies(cause: Any, verdict: Any, profile: Any) -> Any:
-    return verdict in cause.get("verdicts", ["partly", "does not"]) and profile in cause.get("profiles", ["robot", "field_robot"])
+@dataclass(frozen=True)
+class Evidence:
+    """One measurement a cause rests on: its label, our value (None: not measured, note says why)
+    and unit, the range in which it supports the argument, and whether it lies there."""
+    label: str
+    value: Optional[float]
+    unit: str
+    expect: Optional[list[float]]
+    ok: Optional[bool]
+    note: str
 
 
-def explain(claims: Any, ctx: Context, profile: Any = "robot") -> Any:
-    """One row per claim of `claims` (evaluate_claims' output for ctx) whose verdict is neither
-    "holds" nor "not run" / "n/a": {"id", "paper", "claim", "verdict", "profile", "status", "text",
-    "doc", "evidence": [{"label", "value", "unit", "expect", "ok", "note"}]}. status: explained (every
-    evidence item measured and inside its range), evidence not in these results, evidence contradicts
-    the cause, or no cause recorded."""
-    by_id = {c["id"]: c for c in ctx.papers.get("claims", [])}
+@dataclass
+class Cause:
+    """Why a claim's verdict under one noise profile is not "holds" (explain()): the claim, its
+    verdict, the status of its cause (explained, evidence not in these results, evidence contradicts
+    the cause, no cause recorded), the argument, its one-sentence summary, the doc that details it,
+    and the evidence read from the results."""
+    id: str
+    paper: JSON
+    claim: str
+    verdict: str
+    profile: str
+    status: str = UNEXPLAINED
+    text: str = ""
+    summary: str = ""
+    doc: str = ""
+    evidence: list[Evidence] = field(default_factory=list)
+
+
+def applies(cause: JSONObject, verdict: str, profile: str) -> bool:
+    """Whether a cause of causes.json speaks to this verdict under this profile."""
+    return verdict in lst(cause.get("verdicts", ["partly", "does not"])) and profile in lst(cause.get("profiles", ["robot", "field_robot"]))
+
+
+def explain(claims: Sequence[Claim], ctx: Context, profile: str = "robot") -> list[Cause]:
+    """One Cause per claim of `claims` (evaluate_claims' output for ctx) whose verdict is neither
+    "holds" nor "not run" / "n/a". Its status is explained where every evidence item is measured
+    and inside its range."""
+    by_id = {str(obj(c).get("id")): obj(c) for c in lst(ctx.papers.get("claims", []))}
     out = []
     for c in claims:
-        if c["verdict"] in ("holds", "not run", "n/a"):
+        if c.verdict in ("holds", "not run", "n/a"):
             continue
-        causes = [k for k in by_id.get(c["id"], {}).get("causes", []) if _applies(k, c["verdict"], profile)]
-        row = {"id": c["id"], "paper": c["paper"], "claim": c["claim"], "verdict": c["verdict"], "profile": profile,
-               "status": UNEXPLAINED, "text": "", "summary": "", "doc": "", "evidence": []}
+        causes = [obj(k) for k in lst(by_id.get(c.id, {}).get("causes", [])) if applies(obj(k), c.verdict, profile)]
+        row = Cause(id=c.id, paper=c.paper, claim=c.claim, verdict=c.verdict, profile=profile)
         if causes:
             k = causes[0]
-            row["text"], row["doc"], row["summary"] = k["text"], k.get("doc", ""), cause_summary(k)
-            for ev in k.get("evidence", []):
+            row.text, row.doc, row.summary = str(k["text"]), str(k.get("doc", "")), cause_summary(k)
+            for raw in lst(k.get("evidence", [])):
+                ev = obj(raw)
                 v, note = quantity(ev["ours"], ctx)
-                lo, hi = ev.get("expect", [-math.inf, math.inf])
-                ok = None if v is None else (lo - 1e-12 <= v <= hi + 1e-12)
-                row["evidence"].append({"label": ev["label"], "value": v, "unit": ev.get("unit", ""), "expect": ev.get("expect"), "ok": ok, "note": note})
-            oks = [e["ok"] for e in row["evidence"]]
-            row["status"] = CONTRADICTED if False in oks else NOT_MEASURED if (None in oks or not oks) else EXPLAINED
+                expect = [number(x) for x in lst(ev["expect"])] if "expect" in ev else None
+                lo, hi = (expect[0], expect[1]) if expect and len(expect) >= 2 else (-math.inf, math.inf)
+                ok = None if v is None else (lo is not None and hi is not None and lo - 1e-12 <= v <= hi + 1e-12)
+                row.evidence.append(Evidence(label=str(ev["label"]), value=v, unit=text(ev.get("unit", "")) or "",
+                                             expect=[x for x in expect if x is not None] if expect is not None else None, ok=ok, note=note))
+            oks = [e.ok for e in row.evidence]
+            row.status = CONTRADICTED if False in oks else NOT_MEASURED if (None in oks or not oks) else EXPLAINED
         out.append(row)
     return out
 
 
-def _sig(v: Any) -> Any:
+def significant(v: Optional[float]) -> str:
     """Three significant figures, no exponent for the magnitudes the causes use."""
     if v is None or not math.isfinite(v):
         return "-"
@@ -59,14 +93,14 @@ def _sig(v: Any) -> Any:
     return f"{v:.{digits}f}"
 
 
-def evidence_text(e: Any) -> Any:
+def evidence_text(e: Evidence) -> str:
     """'label: 0.12 deg/cm (expected 0-0.2)' for the report and the terminal."""
-    if e["value"] is None:
-        return f"{e['label']}: not measured ({e['note']})"
+    if e.value is None:
+        return f"{e.label}: not measured ({e.note})"
     rng = ""
-    if e["expect"]:
-        lo, hi = e["expect"]
-        rng = f" (argument needs {_sig(lo)} to {_sig(hi)})" if lo > -1e11 and hi < 1e11 else \
-              f" (argument needs at least {_sig(lo)})" if hi >= 1e11 else f" (argument needs at most {_sig(hi)})"
-    mark = "" if e["ok"] else " — CONTRADICTS"
-    return f"{e['label']}: {_sig(e['value'])}{(' ' + e['unit']) if e['unit'] else ''}{rng}{mark}"
+    if e.expect:
+        lo, hi = e.expect
+        rng = f" (argument needs {significant(lo)} to {significant(hi)})" if lo > -1e11 and hi < 1e11 else \
+              f" (argument needs at least {significant(lo)})" if hi >= 1e11 else f" (argument needs at most {significant(hi)})"
+    mark = "" if e.ok else " — CONTRADICTS"
+    return f"{e.label}: {significant(e.value)}{(' ' + e.unit) if e.unit else ''}{rng}{mark}"

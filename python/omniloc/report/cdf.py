@@ -3,25 +3,29 @@
 from __future__ import annotations
 
 import statistics
-from typing import Any
+from typing import Optional
 
-from omniloc.core import metrics as M
-from omniloc.core import stats as ST
+from omniloc.core import metrics, stats
+from omniloc.core.jsonvalue import lst, numbers, obj
 from omniloc.core.pairing import profile_of
+from omniloc.core.rundir import Run
 from omniloc.core.stats import fnum
 from omniloc.report.provenance import machine_text
 from omniloc.tools import plot
-from omniloc.core.rundir import Run
-from omniloc.tools.markup import Writer
+from omniloc.tools.markup import Cell, Writer
+
+# (localizer, noise profile): what the CDF and the timing are per.
+Key = tuple[str, str]
 
 
-def tracking_errors(run: Run, counts: Any = None) -> Any:
+def tracking_errors(run: Run, counts: Optional[dict[str, int]] = None) -> list[float]:
     """Position errors (m) of the valid frames of the tracking phase (outside the excluded intervals).
     `counts`, a dict, receives "frames": every tracking-phase frame, answered or not."""
-    excl = {}
-    for r in run.summary.get("robots", []):
-        excl[str(r.get("robot"))] = (r.get("tracking_phase") or {}).get("excluded", [])
-    out, total = [], 0
+    excl: dict[str, list[list[float]]] = {}
+    for r in run.summary.robots:
+        excl[str(r.get("robot"))] = [numbers(iv) or [] for iv in lst(obj(r.get("tracking_phase") or {}).get("excluded", []))]
+    out: list[float] = []
+    total = 0
     for f in run.frames():
         if f.get("err_pos") in (None, ""):  # no truth: not scored
             continue
@@ -37,18 +41,19 @@ def tracking_errors(run: Run, counts: Any = None) -> Any:
     return out
 
 
-def pooled_coverage(runs: list[Run], key: Any) -> Any:
+def pooled_coverage(runs: list[Run], key: str) -> tuple[Optional[float], Optional[float]]:
     """(recall at threshold `key`, share answered) pooled over every robot's tracking-phase frames
     of the runs, from their summary.json (recall x frames_total summed); None where unknown."""
     within = answered = total = 0.0
     for run in runs:
-        for r in run.summary.get("robots", []):
-            b = r.get("tracking_phase") if isinstance(r.get("tracking_phase"), dict) else r
+        for r in run.summary.robots:
+            tp = r.get("tracking_phase")
+            b = tp if isinstance(tp, dict) else r
             n = b.get("frames_total")
-            if not ST.is_number(n) or not n:
+            if not stats.is_number(n) or not n:
                 continue
-            rec, vf = (b.get("recall") or {}).get(key), b.get("valid_fraction")
-            if not (ST.is_number(rec) and ST.is_number(vf)):
+            rec, vf = obj(b.get("recall") or {}).get(key), b.get("valid_fraction")
+            if not (stats.is_number(rec) and stats.is_number(vf)):
                 continue
             within, answered, total = within + rec * n, answered + vf * n, total + n
     return (within / total, answered / total) if total else (None, None)
@@ -58,14 +63,13 @@ def cdf_and_timing(rep: Writer, runs: list[Run]) -> None:
     """Error CDF and timing per localizer AND noise profile: frames of robot and
     field_robot runs are never pooled into one curve, row or bar; every row names its profile and
     how many runs its frames come from."""
-    errs: dict[tuple[str, str], list[float]]
-    timing: dict[tuple[str, str], dict[str, list[float]]]
-    nruns: dict[tuple[str, str], int]
-    frames: dict[tuple[str, str], dict[str, int]]
-    by_key: dict[tuple[str, str], list[Run]]
-    errs, timing, nruns, frames, by_key = {}, {}, {}, {}, {}
+    errs: dict[Key, list[float]] = {}
+    timing: dict[Key, dict[str, list[float]]] = {}
+    nruns: dict[Key, int] = {}
+    frames: dict[Key, dict[str, int]] = {}
+    by_key: dict[Key, list[Run]] = {}
     for run in runs:
-        key = (run.localizer, profile_of(run))  # (localizer, noise profile)
+        key = (str(run.localizer), profile_of(run))  # (localizer, noise profile)
         nruns[key] = nruns.get(key, 0) + 1
         by_key.setdefault(key, []).append(run)
         errs.setdefault(key, []).extend(tracking_errors(run, frames.setdefault(key, {})))
@@ -77,30 +81,40 @@ def cdf_and_timing(rep: Writer, runs: list[Run]) -> None:
     # A localizer that answered no frame stays in the table ("no estimate"); it has no curve.
     errs = {k: v for k, v in errs.items() if v or frames[k].get("frames")}
     profiles = sorted({p for _, p in list(errs) + list(timing)})
-    head = M.headline_key(runs)
-    name = lambda key: f"{key[0]} ({key[1]} profile)"
-    runs_text = lambda key: f"{nruns[key]} run{'s' if nruns[key] != 1 else ''}"
+    head = metrics.headline_key(runs)
+
+    def name(key: Key) -> str:
+        return f"{key[0]} ({key[1]} profile)"
+
+    def runs_text(key: Key) -> str:
+        return f"{nruns[key]} run{'s' if nruns[key] != 1 else ''}"
     apart = (f"Per localizer and noise profile ({', '.join(profiles)}): runs of different profiles are never pooled." if len(profiles) > 1
              else f"All runs here are of the {profiles[0]} profile." if profiles else "")
     if errs:
         rep.heading("Error CDF per localizer and noise profile (tracking phase)", 2)
-        curve = lambda key, answered, n: f"{name(key)}: {answered} of {n} frames answered, {runs_text(key)}"
+
+        def curve(key: Key, answered: int, n: int) -> str:
+            return f"{name(key)}: {answered} of {n} frames answered, {runs_text(key)}"
         rep.figure(plot.cdf_figure(errs, frames, profiles, curve), "cdf", "position error CDF over the reported runs' tracking phases (carried periods and recoveries left out), "
                    "one curve per localizer and noise profile (line style: profile), over all their frames: a frame without an estimate "
                    "counts as never within, so each curve levels off at the share of frames answered. " + apart)
-        q = lambda e, f: fnum(sorted(e)[int(f * (len(e) - 1))], 4) if e else M.NO_ESTIMATE
+
+        def q(e: list[float], f: float) -> str:
+            return fnum(sorted(e)[int(f * (len(e) - 1))], 4) if e else metrics.NO_ESTIMATE
         cov = {key: pooled_coverage(by_key[key], head) if head else (None, None) for key in errs}
-        rep.table(["localizer", "profile", "runs"] + ([f"within {M.recall_label(head)}", "answered"] if head else []) + ["frames", "median m", "p90 m", "p99 m"],
-                  [[key[0], key[1], nruns[key]] + ([M.percent(cov[key][0]), M.percent(cov[key][1])] if head else []) +
-                   [len(e), fnum(statistics.median(e), 4) if e else M.NO_ESTIMATE, q(e, 0.9), q(e, 0.99)] for key, e in sorted(errs.items())],
+        table: list[list[Cell]] = [[key[0], key[1], nruns[key], *([metrics.percent(cov[key][0]), metrics.percent(cov[key][1])] if head else []),
+                                    len(e), fnum(statistics.median(e), 4) if e else metrics.NO_ESTIMATE, q(e, 0.9), q(e, 0.99)]
+                                   for key, e in sorted(errs.items())]
+        rep.table(["localizer", "profile", "runs"] + ([f"within {metrics.recall_label(head)}", "answered"] if head else []) + ["frames", "median m", "p90 m", "p99 m"],
+                  table,
                   ("Coverage first: the share of all tracking-phase frames within the headline threshold (a frame without an estimate "
                    "counts as outside) and the share answered, pooled over the localizer's runs; then " if head else "")
                   + "the errors of the valid (answered) tracking-phase frames pooled over the localizer's runs (seeds and scenarios) under that one profile. " + apart)
     if timing:
         rep.heading("Timing per stage, per localizer and noise profile", 2)
-        rows = []
+        rows: list[list[Cell]] = []
         for key, d in sorted(timing.items()):
-            rows.append([key[0], key[1], nruns[key]] + [fnum(statistics.median(v), 3) if v else "-" for v in d.values()] + [len(d["render_ms"])])
+            rows.append([key[0], key[1], nruns[key], *[fnum(statistics.median(v), 3) if v else "-" for v in d.values()], len(d["render_ms"])])
         rep.table(["localizer", "profile", "runs", "render ms (median)", "vision ms", "localize ms", "client's own ms", "frames"], rows,
                   f"wall time per frame on {machine_text()}; runs in a sweep share the cores. " + apart + " "
                   "For an external localizer (docs/protocol.md) 'localize' is the protocol's round trip: frame sent to estimate read, "

@@ -2,50 +2,46 @@
 """
 from __future__ import annotations
 
-import json
 import pathlib
-from typing import Any
+from typing import Callable, Optional, Union
 
-from omniloc.core import paths as PATHS
+from omniloc.core import paths
+from omniloc.core.files import read_json_lines
+from omniloc.core.jsonvalue import JSON, obj
 from omniloc.core.stats import fnum
 from omniloc.tools import plot
-from omniloc.core.rundir import Run
-from omniloc.tools.markup import Writer
+from omniloc.tools.markup import Cell, Writer
 
 
-def load_jsonl(path: Any) -> Any:
-    out = []
-    if path.exists():
-        for line in path.read_text().splitlines():
-            if line.strip():
-                try:
-                    out.append(json.loads(line))
-                except json.JSONDecodeError:
-                    pass  # a line cut by an interrupted append: the others still count
-    return out
+def load_jsonl(path: pathlib.Path) -> list[dict[str, JSON]]:
+    """The records of a history file (icount.jsonl, bench.jsonl): every line that is a JSON object; a
+    line cut by an interrupted append does not hide the others."""
+    return [r for r in read_json_lines(path) if isinstance(r, dict)]
 
 
-def history_plot(rep: Writer, records: Any, field: str, key: Any, ylabel: Any, caption: str, fmt: Any) -> None:
+def history_plot(rep: Writer, records: list[dict[str, JSON]], field: str, key: str, ylabel: str, caption: str, fmt: Callable[[float], str]) -> None:
     """One line per workload: `field` of every record, relative to the workload's first record, in
     the order the records were appended (one point per measured commit)."""
-    series: dict[Any, Any] = {}
+    series: dict[str, list[tuple[int, float]]] = {}
     for i, rec in enumerate(records):
-        for w, v in rec.get(field, {}).items():
+        for w, v in obj(rec.get(field, {})).items():
             if isinstance(v, (int, float)) and v > 0:
                 series.setdefault(w, []).append((i, v))
     if not series:
         return
     rep.figure(plot.history_figure(series, records, ylabel), key, caption)
-    rows = []
+    rows: list[list[Cell]] = []
     for w, pts in sorted(series.items()):
         (i0, v0), (i1, v1) = pts[0], pts[-1]
-        rows.append([w, records[i0].get("commit", "?"), fmt(v0), records[i1].get("commit", "?"), fmt(v1), fnum(v1 / v0, 3)])
+        rows.append([w, str(records[i0].get("commit", "?")), fmt(v0), str(records[i1].get("commit", "?")), fmt(v1), fnum(v1 / v0, 3)])
     rep.table(["workload", "first commit", "first", "last commit", "last", "last / first"], rows)
 
 
-def report_history(rep: Writer, folder: Any, reference: Any = None) -> Any:
+def report_history(rep: Writer, folder: pathlib.Path, reference: Optional[Union[str, pathlib.Path]] = None) -> bool:
+    """The developers' page: instruction counts and benchmark wall times over the commits; False
+    (nothing written) where there are no records."""
     # The committed baseline history (one record per baseline change) first, then this machine's runs.
-    reference = pathlib.Path(reference or PATHS.ROOT / "results" / "reference" / "icount_history.jsonl")
+    reference = pathlib.Path(reference or paths.ROOT / "results" / "reference" / "icount_history.jsonl")
     icount = load_jsonl(reference) + load_jsonl(folder / "icount.jsonl")
     bench = load_jsonl(folder / "bench.jsonl")
     if not (icount or bench):

@@ -6,13 +6,13 @@ import os
 import pathlib
 import platform
 import time
-from typing import Any
 
+from omniloc.core.jsonvalue import JSON, obj
 from omniloc.core.rundir import Run
-from omniloc.tools.markup import Writer
+from omniloc.tools.markup import Cell, Writer
 
 
-def cpu_model() -> Any:
+def cpu_model() -> str:
     """The CPU model of this machine (from /proc/cpuinfo; the platform's name elsewhere)."""
     try:
         for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
@@ -23,28 +23,30 @@ def cpu_model() -> Any:
     return platform.processor() or platform.machine()
 
 
-def machine_text() -> Any:
+def machine_text() -> str:
     return f"{cpu_model()}, {os.cpu_count()} cores, {platform.system()} {platform.machine()}"
 
 
-def provenance(rep: Writer, runs: list[Run], sweeps: list[Any]) -> None:
+def provenance(rep: Writer, runs: list[Run], sweeps: list[pathlib.Path]) -> None:
     """Which builds made the results, on what, when. summary.json's "omniloc" block names the build
     (version, compiler, build type) and, where the build records them, the machine (cpu, cores) and
     date; where it does not, the machine is the one that made this report (scripts/run.sh makes both
     on the same machine) and the date is the run files' modification time."""
-    versions: dict[Any, Any] = {}
+    counts: dict[tuple[str, str, str, str], int] = {}
+    dates: dict[tuple[str, str, str, str], set[str]] = {}
     for r in runs:
-        o = dict(r.summary.get("omniloc") or {})
-        o.update(o.get("host") or {})  # the run's machine (summary.json omniloc.host: cpu, cores)
-        when = o.get("date") or time.strftime("%Y-%m-%d", time.gmtime((r.folder / "summary.json").stat().st_mtime))
-        k = (o.get("version", "unrecorded"), o.get("compiler", "-"), o.get("build_type", "-"),
+        o = dict(r.summary.omniloc)
+        o.update(obj(o.get("host") or {}))  # the run's machine (summary.json omniloc.host: cpu, cores)
+        date: JSON = o.get("date")
+        when = str(date) if date else time.strftime("%Y-%m-%d", time.gmtime((r.folder / "summary.json").stat().st_mtime))
+        k = (str(o.get("version", "unrecorded")), str(o.get("compiler", "-")), str(o.get("build_type", "-")),
              f"{o['cpu']}, {o.get('cores', '?')} cores" if o.get("cpu") else "this report's machine (below)")
-        d = versions.setdefault(k, {"n": 0, "dates": set()})
-        d["n"] += 1
-        d["dates"].add(when)
+        counts[k] = counts.get(k, 0) + 1
+        dates.setdefault(k, set()).add(when)
     rep.heading("Provenance", 2, "provenance")
-    rows = [[v, c, b, m, " to ".join(sorted({min(d["dates"]), max(d["dates"])})), d["n"]] for (v, c, b, m), d in sorted(versions.items())]
+    # A row per build and machine: version, compiler, build type, machine, the runs' dates, how many.
+    rows: list[list[Cell]] = [[*k, " to ".join(sorted({min(dates[k]), max(dates[k])})), counts[k]] for k in sorted(counts)]
     rep.table(["omniloc version (git describe)", "compiler", "build type", "machine", "runs dated (UTC)", "runs"], rows,
               f"Builds that made these results. This report: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} on {machine_text()}.")
-    if len(versions) > 1:
+    if len(counts) > 1:
         rep.para("Warning: the results come from more than one build; compare like with like (omniloc compare).")

@@ -3,98 +3,106 @@ sweeps judged per run (omniloc.global_start).
 """
 from __future__ import annotations
 
-import json
-from typing import Any
+import pathlib
+from typing import Optional
 
-from omniloc import global_start as G
-from omniloc.core import metrics as M
-from omniloc.core import rundir as RD
-from omniloc.core.stats import fnum
-from omniloc.report import viewers as V
-from omniloc.report.runs import params_text, report_run, run_title
-from omniloc.report.seeds import flag_outliers, outlier_cause, seed_table
+from omniloc import global_start
+from omniloc.core import metrics, rundir
+from omniloc.core.aggregate import Aggregate, AggregateMetric, read_aggregate, read_runs_csv
 from omniloc.core.rundir import Run
-from omniloc.tools.markup import Writer
+from omniloc.core.stats import fnum
+from omniloc.report import viewers
+from omniloc.report.runs import params_text, report_run, run_title
+from omniloc.report.seeds import RowRuns, flag_outliers, outlier_cause, seed_table
+from omniloc.tools.markup import Cell, Writer
+
+# A run of a sweep with the parameters of its row (runs.csv) and its localizer's row name.
+SweepRun = tuple[Run, str, Optional[str]]
 
 
-def sweep_runs(sweep: Any, all_runs: list[Run]) -> Any:
+def sweep_runs(sweep: pathlib.Path, all_runs: list[Run]) -> list[SweepRun]:
     """The sweep's runs in the aggregate's order (group by group, seeds in run order), with their
     params and the localizer name of their row: runs.csv's, the name the aggregate gives the row
     (docs/protocol.md "Which name"; a run missing from runs.csv: the name in its summary.json)."""
     by_folder = {r.folder: r for r in all_runs}
-    order = {}
-    for row in RD.read_csv(sweep / "runs.csv"):
-        order[row["id"]] = (int(row["index"]), row["params"], row.get("localizer"))
-    agg = json.loads((sweep / "aggregate.json").read_text())
-    group_rank = {(g.get("scenario"), g.get("localizer"), g.get("params")): k for k, g in enumerate(agg["groups"])}
-    out = []
+    order = {row.id: (row.index, row.params, row.localizer) for row in read_runs_csv(sweep)}
+    agg = read_aggregate(sweep)
+    group_rank = {(g.scenario, g.localizer, g.params): k for k, g in enumerate(agg.groups)}
+    out: list[tuple[int, int, Run, str, Optional[str]]] = []
     for folder, run in by_folder.items():
         if folder.parent != sweep / "runs":
             continue
-        idx, params, name = order.get(folder.name, (10 ** 9, "default", None))
-        name = name or run.localizer
+        idx, params, label = order.get(folder.name, (10 ** 9, "default", None))
+        name = label or run.localizer
         rank = group_rank.get((run.scenario, name, params), 10 ** 9)
         out.append((rank, idx, run, params, name))
     return [(r, p, n) for _, _, r, p, n in sorted(out, key=lambda x: (x[0], x[1]))]
 
 
-def aggregate_cell(metric: Any, digits: int) -> Any:
-    """One metric of an aggregate.json group ({"n", "mean", "no_value", ...}): its mean; "no
-    estimate" where no run had a value; "-" where the group lacks the metric."""
+def aggregate_cell(metric: Optional[AggregateMetric], digits: int) -> str:
+    """One metric of an aggregate.json group: its mean; "no estimate" where no run had a value; "-"
+    where the group lacks the metric."""
     if not metric:
         return "-"
-    if metric.get("mean") is None:
-        return M.NO_ESTIMATE if metric.get("no_value") else "-"
-    return fnum(metric["mean"], digits)
+    if metric.mean is None:
+        return metrics.NO_ESTIMATE if metric.no_value else "-"
+    return fnum(metric.mean, digits)
 
 
-def middle_recall_key(agg: Any) -> Any:
+def middle_recall_key(agg: Aggregate) -> Optional[str]:
     """The middle recall threshold an aggregate names (its runs' headline where they do not say)."""
-    keys = sorted({k.split("/")[-1] for g in agg.get("groups", []) for k in g.get("metrics", {}) if k.startswith("r0/recall/")}, key=M.recall_order)
+    keys = sorted({k.split("/")[-1] for g in agg.groups for k in g.metrics if k.startswith("r0/recall/")}, key=metrics.recall_order)
     return keys[len(keys) // 2] if keys else None
 
 
-def report_sweep(rep: Writer, sweep: Any, all_runs: list[Run], max_runs: Any) -> Any:
-    agg = json.loads((sweep / "aggregate.json").read_text())
-    name = agg.get("sweep", agg.get("name", sweep.name))
+def report_sweep(rep: Writer, sweep: pathlib.Path, all_runs: list[Run], max_runs: int) -> list[Run]:
+    agg = read_aggregate(sweep)
+    name = agg.name
     rep.heading(f"Sweep {name}", 2)
-    o = agg.get("omniloc") or {}
-    rep.para(f"{sweep}: {agg.get('runs')} runs; aggregated by omniloc {o.get('version', 'unrecorded')}; runs made by "
-             + ", ".join(f"{v} ({n})" for v, n in (agg.get("run_versions") or {}).items()) + ".")
-    rows = []
+    rep.para(f"{sweep}: {agg.runs} runs; aggregated by omniloc {agg.version}; runs made by "
+             + ", ".join(f"{v} ({n})" for v, n in agg.run_versions.items()) + ".")
+    rows: list[list[Cell]] = []
     # Groups given the start pose say so where the sweep also has groups that were not (a sweep
     # from before start_pose_given has neither).
-    kinds = {g.get("start_pose_given") for g in agg["groups"]}
+    kinds = {g.start_pose_given for g in agg.groups}
     mark = True in kinds and (False in kinds or "mixed" in kinds)
     runs = sweep_runs(sweep, all_runs)
-    key = M.headline_key([r for r, _, _ in runs]) or middle_recall_key(agg)
-    answered = any("r0/valid_fraction" in g["metrics"] for g in agg["groups"])
-    for g in agg["groups"]:
-        m = g["metrics"]
+    key = metrics.headline_key([r for r, _, _ in runs]) or middle_recall_key(agg)
+    answered = any("r0/valid_fraction" in g.metrics for g in agg.groups)
+    for g in agg.groups:
+        m = g.metrics
         phase = "r0/tracking_phase/x_cm/mean" in m
-        name = lambda path: f"r0/tracking_phase/{path}" if phase else f"r0/{path}"
-        cell = lambda path, digits: aggregate_cell(m.get(name(path)), digits)
-        x = m.get("r0/x_cm/mean", {})
-        n, without = x.get("n", 0), x.get("no_value", 0)
-        given = g.get("start_pose_given")
+
+        def metric(path: str) -> Optional[AggregateMetric]:
+            return m.get(f"r0/tracking_phase/{path}" if phase else f"r0/{path}")
+
+        def cell(path: str, digits: int) -> str:
+            return aggregate_cell(metric(path), digits)
+
+        def mean_of(path: str) -> Optional[float]:
+            found = metric(path)
+            return found.mean if found else None
+        x = m.get("r0/x_cm/mean")
+        n, without = (x.n, x.no_value) if x else (0, 0)
+        given = g.start_pose_given
         task = " (given the start pose)" if mark and given is True else " (start pose: mixed)" if given == "mixed" else ""
-        rows.append([f"{g.get('scenario', '')} / {g.get('localizer', '')}{task} / {params_text(g.get('params', ''))}" + (" (tracking phase)" if phase else "")] +
-                    ([M.percent((m.get(name(f"recall/{key}")) or {}).get("mean"))] if key else []) +
-                    ([M.percent((m.get(name("valid_fraction")) or {}).get("mean"))] if answered else []) +
-                    [cell(f"{a}/{s}", 3) for a, s in M.TABLE_KEYS] + [cell("position_m/mean", 3), cell("position_m/rmse", 3)] +
-                    [f"{g.get('finished', '-')}/{g.get('failed', 0)}", f"{n}; {M.no_estimate_text(without, n + without)}" if without else n])
-    rep.table(["group"] + ([f"within {M.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + M.TABLE_COLS +
+        rows.append([f"{g.scenario or ''} / {g.localizer or ''}{task} / {params_text(g.params or '')}" + (" (tracking phase)" if phase else ""),
+                     *([metrics.percent(mean_of(f"recall/{key}"))] if key else []),
+                     *([metrics.percent(mean_of("valid_fraction"))] if answered else []),
+                     *[cell(f"{a}/{s}", 3) for a, s in metrics.TABLE_KEYS], cell("position_m/mean", 3), cell("position_m/rmse", 3),
+                     f"{g.finished}/{g.failed}", f"{n}; {metrics.no_estimate_text(without, n + without)}" if without else n])
+    rep.table(["group"] + ([f"within {metrics.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + metrics.TABLE_COLS +
               ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
               "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'."
-              + (f" 'within {M.recall_label(key)}': the share of all frames within that threshold (a frame without an estimate counts as outside); "
+              + (f" 'within {metrics.recall_label(key)}': the share of all frames within that threshold (a frame without an estimate counts as outside); "
                  "'answered': the share of frames with an estimate; the errors are over the answered frames, 'no estimate' where no run of the "
                  "group answered any, and n counts the runs with a value (aggregate.csv also counts those without one)." if key or answered else ""))
-    groups: dict[Any, Any] = {}
-    for run, params, name in runs:
-        groups.setdefault((run.scenario, name, params), []).append(run)
-    rows_runs = [(f"{k[0]} / {k[1]} / {params_text(k[2])}", sorted(v, key=lambda r: r.seed)) for k, v in groups.items()]
+    groups: dict[tuple[Optional[str], Optional[str], str], list[Run]] = {}
+    for run, params, row_name in runs:
+        groups.setdefault((run.scenario, row_name, params), []).append(run)
+    rows_runs: list[RowRuns] = [(f"{k[0]} / {k[1]} / {params_text(k[2])}", sorted(v, key=lambda r: r.seed or 0)) for k, v in groups.items()]
     # Groups whose every seed a published table above already showed are not shown again.
-    seeded = rep.__dict__.get("seeded", set())
+    seeded = rep.seeded
     shown = [k for k, (_, sel) in enumerate(rows_runs) if sel and all(r.folder in seeded for r in sel)]
     if shown:
         rep.para(f"{len(shown)} of this sweep's {len(rows_runs)} groups have every seed in a published table above (with their outlying seeds); "
@@ -104,42 +112,48 @@ def report_sweep(rep: Writer, sweep: Any, all_runs: list[Run], max_runs: Any) ->
     flagged = shown_flagged + seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json and aggregate.csv hold the same intervals by the same rule (column interval: t95 or range).")
     # Per run: its tables always; plots for the first seed of each group (every condition shown
     # once, at most max_runs) and for every outlying seed, collapsed: a reader opens what they need.
-    rep.details(f"Runs of sweep {name}: {len(runs)} runs, tables and plots")
-    plotted, seen = 0, set()
-    for run, params, name in runs:
-        first = (run.scenario, name, params) not in seen
-        seen.add((run.scenario, name, params))
+    # The title names the localizer row of the sweep's last run, not the sweep (as it always has: the
+    # same report byte for byte; naming the sweep is a change of its own).
+    last = runs[-1][2] if runs else name
+    rep.details(f"Runs of sweep {last}: {len(runs)} runs, tables and plots")
+    plotted = 0
+    seen: set[tuple[Optional[str], Optional[str], str]] = set()
+    for run, params, row_name in runs:
+        first = (run.scenario, row_name, params) not in seen
+        seen.add((run.scenario, row_name, params))
         report_run(rep, run, plots=(first and plotted < max_runs) or run in flagged, params=params,
-                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None, name=name)
+                   note=f"outlying seed: {outlier_cause(run)}" if run in flagged else None, name=row_name)
         plotted += first
     rep.end_details()
     return [r for r, _, _ in runs]
 
 
-def global_start_section(rep: Writer, sweeps: list[Any]) -> None:
+def global_start_section(rep: Writer, sweeps: list[pathlib.Path]) -> None:
     """Sweeps of scenarios/sweeps/global_tracking.json, each run judged apart by
     omniloc.global_start. A mean over all frames hides one run 8 m off among nineteen at 3 cm, so
     MCL alone is shown as a success rate (Wilson 95 %), the error while right, and the mean over all."""
     for sw in sweeps:
         if not sw.name.startswith("global_tracking"):
             continue
-        by = G.collect([sw])
+        by = global_start.collect([sw])
         if not by:
             continue
         rep.heading(f"Global start, judged per run: {sw.name}", 2, "global_start")
-        rows = []
-        table = {loc: G.summarise([r for _, r in by[loc]]) for loc in sorted(by, key=lambda k: (k not in ("mcl", "hybrid", "grid_global"), k))}
-        with_recall = any(g.get("recall_key") for g in table.values())
-        none = lambda v, d, g: (M.NO_ESTIMATE if g["runs_without_estimate"] == g["runs"] else "-") if v is None else fnum(v, d)
+        rows: list[list[Cell]] = []
+        table = {loc: global_start.summarise([r for _, r in by[loc]]) for loc in sorted(by, key=lambda k: (k not in ("mcl", "hybrid", "grid_global"), k))}
+        with_recall = any(g.recall_key for g in table.values())
+
+        def none(v: Optional[float], d: int, g: global_start.Summary) -> str:
+            return (metrics.NO_ESTIMATE if g.runs_without_estimate == g.runs else "-") if v is None else fnum(v, d)
         for loc, g in table.items():
-            rows.append([loc] + ([M.percent(g["recall_mean"]), M.percent(g["answered_mean"]),
-                                  fnum(g["first_within_median_s"], 2) + (f" ({g['runs_never_within']} never)" if g["runs_never_within"] else "")]
-                                 if with_recall else []) +
-                        [f"{g['ended_right']} / {g['runs']}", f"{100 * g['wilson95'][0]:.0f}-{100 * g['wilson95'][1]:.0f} %",
-                         fnum(g["t_first_median_s"], 2), none(g["right_mean_x_cm"], 2, g), none(g["right_mean_y_cm"], 2, g),
-                         none(g["right_mean_theta_rad"], 4, g), fnum(g["wrong_frame_fraction"] * 100 if g["wrong_frame_fraction"] is not None else None, 2),
-                         none(g["all_mean_pos_cm"], 1, g)])
-        head = G.recall_header(table)
+            rows.append([loc, *([metrics.percent(g.recall_mean), metrics.percent(g.answered_mean),
+                                 fnum(g.first_within_median_s, 2) + (f" ({g.runs_never_within} never)" if g.runs_never_within else "")]
+                                if with_recall else []),
+                         f"{g.ended_right} / {g.runs}", f"{100 * g.wilson95[0]:.0f}-{100 * g.wilson95[1]:.0f} %",
+                         fnum(g.t_first_median_s, 2), none(g.right_mean_x_cm, 2, g), none(g.right_mean_y_cm, 2, g),
+                         none(g.right_mean_theta_rad, 4, g), fnum(g.wrong_frame_fraction * 100 if g.wrong_frame_fraction is not None else None, 2),
+                         none(g.all_mean_pos_cm, 1, g)])
+        head = global_start.recall_header(table)
         rep.table(["localizer"] + ([head, "answered", "first within it: median s"] if with_recall else []) +
                   ["ended right", "Wilson 95 %", "first correct convergence median s", "while right: mean x cm", "mean y cm",
                    "mean th rad", "wrong frames %", "mean position error over all valid frames cm"], rows,
@@ -150,21 +164,16 @@ def global_start_section(rep: Writer, sweeps: list[Any]) -> None:
         per_run_table(rep, sw)
 
 
-def per_run_table(rep: Writer, sweep: Any) -> None:
+def per_run_table(rep: Writer, sweep: pathlib.Path) -> None:
     """Each run of a global-start sweep as omniloc.global_start judges it (ended right, first
     correct convergence, wrong frames), with its viewer page: the runs behind the rates above,
     collapsed."""
-    runs, _, _ = RD.discover([sweep])
-    rows = []
-    for run in sorted(runs, key=lambda r: (global_start_key(r), r.seed or 0)):
-        f = run.folder / "field.json"
-        half = None
-        if f.exists():
-            j = json.loads(f.read_text())
-            half = (0.5 * j["length"] + j.get("margin", 1.0), 0.5 * j["width"] + j.get("margin", 1.0))
-        sc = G.score_run(run.frames(), half)
-        rows.append([global_start_key(run), run.seed, "yes" if sc["ended_right"] else "no", fnum(sc["t_first"], 2) if sc["t_first"] is not None else "never",
-                     f"{sc['wrong_frames']} / {sc['frames']}", f"{sc['valid_frames']} / {sc['frames']}", V.cell(rep, run, title=run_title(run))])
+    runs, _, _ = rundir.discover([sweep])
+    rows: list[list[Cell]] = []
+    for run in sorted(runs, key=lambda r: (global_start.row_of(r), r.seed or 0)):
+        sc = global_start.score_run(run.frames(), global_start.floor_half(run))
+        rows.append([global_start.row_of(run), str(run.seed), "yes" if sc.ended_right else "no", fnum(sc.t_first, 2) if sc.t_first is not None else "never",
+                     f"{sc.wrong_frames} / {sc.frames}", f"{sc.valid_frames} / {sc.frames}", viewers.cell(rep, run, title=run_title(run))])
     if not rows:
         return
     rep.details(f"Each run of {sweep.name}: judged apart, with its viewer page ({len(rows)} runs)")
@@ -174,10 +183,3 @@ def per_run_table(rep: Writer, sweep: Any) -> None:
               "'viewer': the run frame by frame.")
     rep.end_details()
 
-
-def global_start_key(run: Run) -> str:
-    """The row a run counts in (omniloc.global_start.collect): the sweep's label of its localizer,
-    with '(given the start pose)' where it was."""
-    parts = run.folder.name.split("__")
-    key = parts[1] if len(parts) == 4 and run.summary.get("localizer_type") != "external" else str(run.localizer)
-    return key + (" (given the start pose)" if run.start_pose_given else "")

@@ -22,11 +22,12 @@ import os
 import pathlib
 import re
 import tempfile
-from typing import Any, Optional, Sequence
+from typing import Optional, Sequence, Union
 
+from omniloc.core.files import InputFileError
 from omniloc.core.rundir import Run
 from omniloc.tools.markup import Report, Writer
-from omniloc.view.load import ViewInputError, load_run
+from omniloc.view.load import load_run
 from omniloc.view.page import render
 
 # At most this many pages; a report showing more runs than this links only the runs shown on their own.
@@ -72,7 +73,7 @@ def size_text(n: int) -> str:
 
 def why_not(e: BaseException, folder: pathlib.Path) -> str:
     """One line saying why a run's page could not be made, naming files within the run folder."""
-    if isinstance(e, ViewInputError):
+    if isinstance(e, InputFileError):
         p = pathlib.Path(e.path)
         try:
             where = p.resolve().relative_to(folder.resolve()).as_posix()
@@ -87,7 +88,7 @@ class Viewers:
     """The viewer pages of one report: which runs have one (href), which could not (why), which
     were shown without one (over the limit)."""
 
-    def __init__(self, out: pathlib.Path, roots: Sequence[Any], shown_runs: int, limit: Optional[int] = None) -> None:
+    def __init__(self, out: pathlib.Path, roots: Sequence[Union[str, pathlib.Path]], shown_runs: int, limit: Optional[int] = None) -> None:
         self.dir = pathlib.Path(out) / FOLDER
         self.roots = [pathlib.Path(r).resolve() for r in roots]
         self.limit = LIMIT if limit is None else limit
@@ -207,7 +208,8 @@ class ViewerReport(Report):
 
     viewers: Viewers
 
-    def __init__(self, out: Any, title: str, roots: Sequence[Any], shown_runs: int, limit: Optional[int] = None) -> None:
+    def __init__(self, out: Union[str, pathlib.Path], title: str, roots: Sequence[Union[str, pathlib.Path]], shown_runs: int,
+                 limit: Optional[int] = None) -> None:
         super().__init__(out, title)
         self.viewers = Viewers(self.out, roots, shown_runs, limit)
 

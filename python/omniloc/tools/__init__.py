@@ -1,2 +1,3 @@
-"""Output tools: the one markdown / HTML writer (markup), picture compression (images) and the one
-plotting module (plot: the only importer of matplotlib)."""
+"""Output tools: the one markdown / HTML writer (markup) and its language for the papers (citations:
+the bibliography, citations, abbreviations), picture compression (images) and the one plotting module
+(plot: the only importer of matplotlib)."""

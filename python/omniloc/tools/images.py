@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import io
-from typing import Any
+import pathlib
 
 
-def compress_png(path: Any) -> Any:
+def compress_png(path: pathlib.Path) -> pathlib.Path:
     """Re-encodes a picture so that report.html, which embeds every one, stays under 3 MB without
     leaving one out: plots (few colours) as an optimised 256-colour palette PNG; camera frames and
     other photographic pictures, which stay large as a palette PNG, as JPEG (quality 85). Keeps the
@@ -16,12 +16,11 @@ def compress_png(path: Any) -> Any:
         from PIL import Image
     except ImportError:
         return path
-    import io
     with Image.open(path) as im:
         im.load()
     has_alpha = im.mode in ("RGBA", "LA") or (im.mode == "P" and "transparency" in im.info)
     src = im.convert("RGBA") if has_alpha else im.convert("RGB")
-    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if has_alpha else src.quantize(colors=256)  # type: ignore[arg-type]
+    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if has_alpha else src.quantize(colors=256)
     buf = io.BytesIO()
     q.save(buf, format="PNG", optimize=True)
     best, data = path.stat().st_size, None

@@ -4,7 +4,7 @@
 Sections are functions that call heading / para / table / figure / image / markdown; a heading of
 level 2 becomes an entry of the table of contents. Cells are numbers (right-aligned) only when the
 whole cell is one (NUMERIC_CELL). No absolute path reaches the report (Report.clean); abbreviations
-are spelled out at their first use (Report.expand) and papers cited (omniloc.paper.labels).
+are spelled out at their first use (Report.expand) and papers cited (omniloc.tools.citations).
 Figures come from omniloc.tools.plot (the only module that imports matplotlib): Report.figure saves
 and closes them through it.
 """
@@ -16,16 +16,22 @@ import os
 import pathlib
 import re
 import tempfile
-from typing import Any, Optional, Union
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
-from omniloc.core import paths as PATHS
-from omniloc.paper import data as D
-from omniloc.paper import labels as L
+from omniloc.core import paths
+from omniloc.core.verdicts import CONTRADICTED, DOES_NOT, EXPLAINED, HOLDS, NOT_APPLICABLE, NOT_MEASURED, NOT_RUN, PARTLY, UNEXPLAINED
+from omniloc.tools.citations import ABBREVIATIONS, cite_text
 from omniloc.tools.images import compress_png
 
+if TYPE_CHECKING:  # the writer takes figures; only omniloc.tools.plot imports matplotlib
+    from matplotlib.figure import Figure
 
-VERDICT_CLASS = {"holds": "ok", "partly": "partly", "does not": "no", "not run": "notrun", "n/a": "notrun",
-                 D.EXPLAINED: "ok", D.NOT_MEASURED: "notrun", D.CONTRADICTED: "no", D.UNEXPLAINED: "no"}
+# A table cell: text, or a number shown as str() shows it.
+Cell = Union[str, int, float]
+
+
+VERDICT_CLASS = {HOLDS: "ok", PARTLY: "partly", DOES_NOT: "no", NOT_RUN: "notrun", NOT_APPLICABLE: "notrun",
+                 EXPLAINED: "ok", NOT_MEASURED: "notrun", CONTRADICTED: "no", UNEXPLAINED: "no"}
 
 
 # A cell is a number (right-aligned) only when the WHOLE cell is one: a number with an optional
@@ -35,7 +41,7 @@ NUMERIC_CELL = re.compile(r"^[-+]?((0|[1-9]\d*)(\.\d*)?|\.\d+)(e[-+]?\d+)?( ?(%|
                           r"( \[[^\]]*\])?( \([^)]*\))?( / [-+]?\d+(\.\d+)?)?$")
 
 
-def numeric_class(cell: Any) -> Any:
+def numeric_class(cell: Cell) -> str:
     """Numbers right-aligned, text left-aligned (see NUMERIC_CELL)."""
     return " class='num'" if NUMERIC_CELL.match(str(cell).strip()) else ""
 
@@ -45,12 +51,12 @@ def numeric_class(cell: Any) -> Any:
 DOCS_HREF = "../../docs/"
 
 
-def md_links(text: str) -> Any:
+def md_links(text: str) -> str:
     """report.md's text with each doc of the repository (docs/x.md#anchor) as a markdown link."""
     return re.sub(r"(?<![\w/.\[`-])docs/([\w/.-]+?\.md)(#[\w-]+(?:\.[\w-]+)*)?", lambda m: f"[docs/{m.group(1)}]({DOCS_HREF}{m.group(1)}{m.group(2) or ''})", text)
 
 
-def inline_markdown(text: str) -> Any:
+def inline_markdown(text: str) -> str:
     """HTML of one line of markdown: `code`, **bold** and *italic*, and a doc of the repository
     (docs/x.md, optionally #anchor) as a link; everything else escaped. The report's own text and
     the experiments' markdown use these, and a reader must never see the raw markers in the HTML."""
@@ -70,7 +76,7 @@ def inline_markdown(text: str) -> Any:
     return "".join(out)
 
 
-def slug(text: str) -> Any:
+def slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:60] or "section"
 
 
@@ -90,41 +96,42 @@ class Report:
     para / table / figure; a heading of level 2 becomes an entry of the table of contents, which
     write() puts where mark_toc() was called (after the scorecard)."""
 
-    def __init__(self, out: Any, title: str, page: str = "report") -> None:
+    def __init__(self, out: Union[str, pathlib.Path], title: str, page: str = "report") -> None:
         self.out = pathlib.Path(out)
         self.page = page
         (self.out / "img").mkdir(parents=True, exist_ok=True)
         for old in (self.out / "img").glob(f"{page}_*"):  # pictures of an earlier report in the same folder
             old.unlink()
         self.md = [f"# {title}", ""]
-        self.html: list[Any] = []
-        self.toc: list[Any] = []
+        self.html: list[str] = []
+        self.toc: list[tuple[str, str]] = []
         self.n_img = 0
         self.title = title
-        self.anchors: set[Any] = set()
-        self.titles: dict[Any, Any] = {}
-        self.plotted: set[Any] = set()
+        self.anchors: set[str] = set()
+        self.titles: dict[str, str] = {}
+        self.plotted: set[pathlib.Path] = set()  # run folders whose figure the report has (each once)
+        self.seeded: set[pathlib.Path] = set()  # run folders a seed table has shown (a sweep does not repeat them)
         # Absolute paths never reach the report (it is shared): every folder the report could name
         # is shown relative to the working folder, or by its last two parts when outside it.
-        self.roots = sorted({str(p) for p in (pathlib.Path.cwd(), PATHS.ROOT, pathlib.Path.home(), pathlib.Path(tempfile.gettempdir()),
+        self.roots = sorted({str(p) for p in (pathlib.Path.cwd(), paths.ROOT, pathlib.Path.home(), pathlib.Path(tempfile.gettempdir()),
                                               self.out.resolve())}, key=len, reverse=True)
-        self.expanded: set[Any] = set()  # abbreviations already spelled out (expand)
+        self.expanded: set[str] = set()  # abbreviations already spelled out (expand)
         global DOCS_HREF
-        out = self.out.resolve()
-        DOCS_HREF = (os.path.relpath(PATHS.ROOT / "docs", out).replace(os.sep, "/") + "/") if out.is_relative_to(PATHS.ROOT) else "../../docs/"
+        resolved = self.out.resolve()
+        DOCS_HREF = (os.path.relpath(paths.ROOT / "docs", resolved).replace(os.sep, "/") + "/") if resolved.is_relative_to(paths.ROOT) else "../../docs/"
 
-    def add_root(self, path: Any) -> None:
+    def add_root(self, path: Union[str, pathlib.Path]) -> None:
         p = str(pathlib.Path(path).resolve())
         self.roots = sorted(set(self.roots) | {p}, key=len, reverse=True)
 
-    def clean(self, text: str) -> Any:
+    def clean(self, text: Cell) -> str:
         """text with every absolute path under a known root made relative (see __init__)."""
-        text = L.cite_text(text)  # 'paper 002' -> 'Lu et al. 2013 [3]' (the bibliography at the end)
+        text = cite_text(str(text))  # 'paper 002' -> 'Lu et al. 2013 [3]' (the bibliography at the end)
         if "/" not in text:
             return text
         cwd = pathlib.Path.cwd()
 
-        def rel(m: Any) -> Any:
+        def rel(m: re.Match[str]) -> str:
             p = pathlib.Path(m.group(0))
             try:
                 return p.relative_to(cwd).as_posix() or "."
@@ -138,11 +145,11 @@ class Report:
         # folder omniloc was built in): from the repository's own folder on. Commands as code.
         return COMMAND.sub(r"`\1`", REPO_PATH.sub("", text))
 
-    def expand(self, text: str) -> Any:
-        """The text with each abbreviation of D.ABBREVIATIONS spelled out at its first use in the
+    def expand(self, text: str) -> str:
+        """The text with each abbreviation of ABBREVIATIONS spelled out at its first use in the
         report (outside `code`): 'MCL (Monte Carlo localization)'. Headings are left as they are."""
         text = str(text)
-        for abbr, full in D.ABBREVIATIONS.items():
+        for abbr, full in ABBREVIATIONS.items():
             if abbr in self.expanded or abbr not in text:
                 continue
             for m in re.finditer(r"(?<![\w/.-])" + re.escape(abbr) + r"(?![\w-])", text):
@@ -153,7 +160,7 @@ class Report:
                 break
         return text
 
-    def heading(self, text: str, level: int = 2, anchor: Optional[str] = None) -> Any:
+    def heading(self, text: str, level: int = 2, anchor: Optional[str] = None) -> str:
         text = self.clean(text)
         anchor = anchor or slug(text)
         while anchor in self.anchors:  # unique ids: two runs can share a title
@@ -172,12 +179,12 @@ class Report:
         c = (f' class="{cls}"' if cls else "") + (f' id="{ident}"' if ident else "")
         self.html.append(f"<p{c}>{inline_markdown(text)}</p>")
 
-    def raw_html(self, fragment: Any, md: Any = None) -> None:
+    def raw_html(self, fragment: str, md: Optional[str] = None) -> None:
         self.html.append(fragment)
         if md:
             self.md += [md, ""]
 
-    def details(self, summary: Any) -> None:
+    def details(self, summary: str) -> None:
         """Opens a collapsed block (HTML <details>); end_details() closes it. report.md keeps it flat."""
         self.html.append(f"<details><summary>{inline_markdown(self.clean(summary))}</summary>")
 
@@ -187,24 +194,25 @@ class Report:
     def mark_toc(self) -> None:
         self.html.append(TOC_MARK)
 
-    def table(self, header: Any, rows: Any, caption: Optional[str] = None, row_classes: Any = None) -> None:
+    def table(self, header: Sequence[Cell], rows: Sequence[Sequence[Cell]], caption: Optional[str] = None,
+              row_classes: Optional[Sequence[str]] = None) -> None:
         """rows: lists of cells; row_classes: one CSS class per row (e.g. "paper" for published rows).
         A cell that is a verdict (holds, partly, ...) is coloured by itself."""
         if caption:
             self.para(caption, "caption")
-        header = [self.expand(self.clean(c)) for c in header]
-        rows = [[self.expand(self.clean(c)) for c in r] for r in rows]
-        self.md.append("| " + " | ".join(header) + " |")
+        head = [self.expand(self.clean(c)) for c in header]
+        body = [[self.expand(self.clean(c)) for c in r] for r in rows]
+        self.md.append("| " + " | ".join(head) + " |")
         # The first column labels the row (even "50 %"): left; the others by their cells.
-        self.md.append("|" + "|".join("---:" if i and rows and numeric_class(rows[0][i]) else "---" for i in range(len(header))) + "|")
-        for k, r in enumerate(rows):
+        self.md.append("|" + "|".join("---:" if i and body and numeric_class(body[0][i]) else "---" for i in range(len(head))) + "|")
+        for k, r in enumerate(body):
             cells = [md_links(str(c).replace("|", "\\|")) for c in r]
             if row_classes and row_classes[k] == "paper":
                 cells = [f"*{c}*" if c not in ("", "-") else c for c in cells]
             self.md.append("| " + " | ".join(cells) + " |")
         self.md.append("")
-        h = "<div class='scroll'><table><tr>" + "".join(f"<th>{inline_markdown(str(c))}</th>" for c in header) + "</tr>"
-        for k, r in enumerate(rows):
+        h = "<div class='scroll'><table><tr>" + "".join(f"<th>{inline_markdown(str(c))}</th>" for c in head) + "</tr>"
+        for k, r in enumerate(body):
             cls = row_classes[k] if row_classes and row_classes[k] else ""
             h += (f"<tr class='{cls}'>" if cls else "<tr>")
             for i, c in enumerate(r):
@@ -214,7 +222,7 @@ class Report:
             h += "</tr>"
         self.html.append(h + "</table></div>")
 
-    def markdown(self, text: str, skip: Any = ()) -> None:
+    def markdown(self, text: str, skip: Sequence[tuple[str, str]] = ()) -> None:
         """An experiment's markdown: headings, paragraphs and pipe tables as real HTML. skip: pairs
         (heading text, anchor): a table under a heading containing that text is left out, with a
         link to the section that shows it from the experiment's JSON (one copy of each table)."""
@@ -248,7 +256,8 @@ class Report:
                 kept.append("#" * level + " " + ln.lstrip("#").strip())  # below the report's own sections, as in the HTML
             elif ln.startswith("|"):
                 flush()
-                rows, block = [], []
+                rows: list[list[str]] = []
+                block: list[str] = []
                 while i < len(lines) and lines[i].strip().startswith("|"):
                     block.append(lines[i])
                     cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
@@ -278,22 +287,22 @@ class Report:
         flush()
         self.md += kept + [""]
 
-    def figure(self, fig: Any, name: str, caption: str, dpi: int = 80) -> None:
+    def figure(self, fig: Figure, name: str, caption: str, dpi: int = 80) -> None:
         self.n_img += 1
         path = self.out / "img" / f"{self.page}_{self.n_img:03d}_{name}.png"
         from omniloc.tools import plot  # matplotlib: only where there is a figure
         plot.save(fig, path, dpi)
         self._embed(compress_png(path), caption)
 
-    def image(self, path: Any, caption: str) -> None:
+    def image(self, source: Union[str, pathlib.Path], caption: str) -> None:
         """A picture an experiment wrote: copied next to the report, compressed, embedded."""
-        path = pathlib.Path(path)
+        path = pathlib.Path(source)
         self.n_img += 1
         dst = self.out / "img" / f"{self.page}_{self.n_img:03d}_{path.name}"
         dst.write_bytes(path.read_bytes())
         self._embed(compress_png(dst), caption)
 
-    def _embed(self, path: Any, caption: str) -> None:
+    def _embed(self, path: pathlib.Path, caption: str) -> None:
         caption = self.expand(self.clean(caption))
         rel = path.relative_to(self.out)
         self.md += [f"![{caption}]({rel.as_posix()})", "", f"*{caption}*", ""]
@@ -301,7 +310,7 @@ class Report:
         mime = "image/jpeg" if path.suffix == ".jpg" else "image/png"
         self.html.append(f'<figure><img src="data:{mime};base64,{b64}" alt="{html.escape(caption)}"><figcaption>{inline_markdown(caption)}</figcaption></figure>')
 
-    def toc_html(self) -> Any:
+    def toc_html(self) -> str:
         items = "".join(f'<li><a href="#{html.escape(a)}">{inline_markdown(t)}</a></li>' for a, t in self.toc)
         return f'<nav id="contents"><h2>Contents</h2><ol>{items}</ol></nav>'
 
@@ -336,15 +345,16 @@ class TextReport:
     """The Report interface written to the terminal (`omniloc paper-table`): tables aligned (or
     as markdown), figures left out. With only=ANCHOR just the section of that heading anchor."""
 
-    def __init__(self, only: Any = None, markdown: bool = False) -> None:
+    def __init__(self, only: Optional[str] = None, markdown: bool = False) -> None:
         self.only, self.markdown_tables, self.on, self.printed = only, markdown, only is None, False
-        self.plotted: set[Any]
-        self.plotted, self.n_img = set(), 0
+        self.plotted: set[pathlib.Path] = set()
+        self.seeded: set[pathlib.Path] = set()
+        self.n_img = 0
 
-    def clean(self, text: str) -> Any:
+    def clean(self, text: Cell) -> str:
         return str(text)
 
-    def heading(self, text: str, level: int = 2, anchor: Optional[str] = None) -> Any:
+    def heading(self, text: str, level: int = 2, anchor: Optional[str] = None) -> str:
         anchor = anchor or slug(text)
         if self.only is not None:
             self.on = anchor == self.only
@@ -357,7 +367,8 @@ class TextReport:
         if self.on:
             print(text + "\n")
 
-    def table(self, header: Any, rows: Any, caption: Optional[str] = None, row_classes: Any = None) -> None:
+    def table(self, header: Sequence[Cell], rows: Sequence[Sequence[Cell]], caption: Optional[str] = None,
+              row_classes: Optional[Sequence[str]] = None) -> None:
         if not self.on:
             return
         if caption:
@@ -374,18 +385,18 @@ class TextReport:
                 print("  ".join(c.rjust(w[i]) if i and numeric_class(c) else c.ljust(w[i]) for i, c in enumerate(r)).rstrip())
         print()
 
-    def figure(self, fig: Any, name: str, caption: str, dpi: int = 80) -> None:
+    def figure(self, fig: Figure, name: str, caption: str, dpi: int = 80) -> None:
         from omniloc.tools import plot  # matplotlib: only where there is a figure
         plot.close(fig)
 
-    def image(self, path: Any, caption: str) -> None:
+    def image(self, source: Union[str, pathlib.Path], caption: str) -> None:
         pass
 
-    def markdown(self, text: str, skip: Any = ()) -> None:
+    def markdown(self, text: str, skip: Sequence[tuple[str, str]] = ()) -> None:
         if self.on:
             print(text)
 
-    def details(self, summary: Any) -> None:
+    def details(self, summary: str) -> None:
         pass
 
     def end_details(self) -> None:
@@ -394,6 +405,8 @@ class TextReport:
     def mark_toc(self) -> None:
         pass
 
-    def raw_html(self, fragment: Any, md: Any = None) -> None:
+    def raw_html(self, fragment: str, md: Optional[str] = None) -> None:
         pass
+
+
 Writer = Union[Report, TextReport]  # what a section writes to: the report files, or the terminal

@@ -6,9 +6,9 @@ closes it. Nothing here reads result files beyond the run folder's own field.jso
 """
 from __future__ import annotations
 
-import json
 import math
-from typing import Any, Callable, Sequence
+import pathlib
+from typing import Callable, Sequence, Union
 
 import matplotlib
 
@@ -17,13 +17,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from omniloc.core import metrics as M  # noqa: E402
-from omniloc.core import stats as ST  # noqa: E402
-from omniloc.core.rundir import EVENT_COLOURS, Run  # noqa: E402
-from omniloc.core.rundir import Run
+from matplotlib.axes import Axes  # noqa: E402
+from matplotlib.axis import Axis  # noqa: E402
+
+from omniloc.core import metrics, stats  # noqa: E402
+from omniloc.core.events import EVENT_COLOURS, Event  # noqa: E402
+from omniloc.core.jsonvalue import JSON, lst, number, obj  # noqa: E402
+from omniloc.core.rundir import Run  # noqa: E402
 
 
-def save(fig: Figure, path: Any, dpi: int) -> None:
+def save(fig: Figure, path: Union[str, pathlib.Path], dpi: int) -> None:
     """Writes the figure as a PNG and closes it."""
     fig.savefig(path, dpi=dpi, bbox_inches="tight")
     plt.close(fig)
@@ -34,7 +37,7 @@ def close(fig: Figure) -> None:
     plt.close(fig)
 
 
-def log_axis(axis: Any, ax: Any, which: str) -> None:
+def log_axis(axis: Axis, ax: Axes, which: str) -> None:
     """A log axis with several labelled ticks (1, 2, 5 per decade) in plain numbers, not one lone 10^k."""
     (ax.set_xscale if which == "x" else ax.set_yscale)("log")
     lo, hi = ax.get_xlim() if which == "x" else ax.get_ylim()
@@ -54,11 +57,10 @@ def seeds_figure(rows_runs: Sequence[tuple[str, list[Run]]], phase: str) -> Figu
     for ax, (metric, unit) in zip(axes, [("x_cm/mean", "mean x error per seed (cm)"), ("theta_rad/mean", "mean heading error per seed (rad)")]):
         allv: list[float] = []
         for k, (label, sel) in enumerate(rows_runs):
-            vals = [r.metric(metric, phase) for r in sel]
-            vals = [v for v in vals if v is not None]
+            vals = [v for v in (r.metric(metric, phase) for r in sel) if v is not None]
             if not vals:
                 continue
-            out = set(ST.outliers(vals))
+            out = set(stats.outliers(vals))
             jitter = [(i - (len(vals) - 1) / 2) * 0.12 for i in range(len(vals))]
             ax.scatter([v for i, v in enumerate(vals) if i not in out], [k + jitter[i] for i in range(len(vals)) if i not in out],
                        s=18, color="#1f77b4", zorder=3)
@@ -80,32 +82,43 @@ def seeds_figure(rows_runs: Sequence[tuple[str, list[Run]]], phase: str) -> Figu
         if ax.get_legend_handles_labels()[1]:
             ax.legend(fontsize=7, loc="lower right")
     axes[0].set_yticks(range(len(rows_runs)))
-    axes[0].set_yticklabels([l + (f" ({M.no_estimate_text(k, len(sel))})" if k else "") for (l, sel), k in zip(rows_runs, missing)], fontsize=8)
+    axes[0].set_yticklabels([l + (f" ({metrics.no_estimate_text(k, len(sel))})" if k else "") for (l, sel), k in zip(rows_runs, missing)], fontsize=8)
     axes[0].invert_yaxis()
     return fig
 
 
-def field_lines(ax: Any, run: Run) -> None:
-    f = run.folder / "field.json"
-    if not f.exists():
+def numbers_of(item: JSON, count: int, what: str) -> list[float]:
+    """One marking of field.json: `count` numbers (ValueError where it is anything else)."""
+    values = [number(v) for v in lst(item)]
+    if len(values) != count or any(v is None for v in values):
+        raise ValueError(f"field.json: {what}: expected {count} numbers, got {item}")
+    return [v for v in values if v is not None]
+
+
+def field_lines(ax: Axes, run: Run) -> None:
+    raw = run.field_json()
+    if raw is None:
         return
-    fj = json.loads(f.read_text())
-    kw: dict[str, Any] = dict(color="#9a9a9a", lw=0.8, zorder=0)
-    for ax_, ay, bx, by in fj.get("segments", []):
-        ax.plot([ax_, bx], [ay, by], **kw)
-    for cx, cy, r, start, sweep in fj.get("arcs", []):
+    fj = obj(raw)
+    for seg in lst(fj.get("segments", [])):
+        ax_, ay, bx, by = numbers_of(seg, 4, "segments")
+        ax.plot([ax_, bx], [ay, by], color="#9a9a9a", lw=0.8, zorder=0)
+    for arc in lst(fj.get("arcs", [])):
+        cx, cy, r, start, sweep = numbers_of(arc, 5, "arcs")
         n = max(8, int(abs(sweep) / 0.05))
         ts = [start + sweep * i / n for i in range(n + 1)]
-        ax.plot([cx + r * math.cos(t) for t in ts], [cy + r * math.sin(t) for t in ts], **kw)
-    for gx, gw, gd in fj.get("goals", []):
+        ax.plot([cx + r * math.cos(t) for t in ts], [cy + r * math.sin(t) for t in ts], color="#9a9a9a", lw=0.8, zorder=0)
+    for goal in lst(fj.get("goals", [])):
+        gx, gw, gd = numbers_of(goal, 3, "goals")
         s = 1 if gx >= 0 else -1
         ax.plot([gx, gx + s * gd, gx + s * gd, gx], [-gw / 2, -gw / 2, gw / 2, gw / 2], color="#6a6a6a", lw=0.8, zorder=0)
-    hx, hy = fj["length"] / 2 + fj["margin"], fj["width"] / 2 + fj["margin"]
+    length, width, margin = numbers_of([fj["length"], fj["width"], fj["margin"]], 3, "length, width, margin")
+    hx, hy = length / 2 + margin, width / 2 + margin
     ax.set_xlim(-hx, hx)
     ax.set_ylim(-hy, hy)
 
 
-def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, Any]]) -> Figure:
+def run_figure(run: Run, frames: list[dict[str, str]], events: list[Event]) -> Figure:
     """A run's trajectory over the field, and its position and heading error over time with its events."""
     by_robot: dict[str, list[dict[str, str]]] = {}
     for f in frames:
@@ -131,7 +144,7 @@ def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, An
     ax.set_ylabel("y (m)")
     ax.set_title("trajectory on the field", fontsize=10)
     ax.legend(fontsize=7, loc="upper right")
-    kinds = sorted({e["type"] for e in events if e.get("type") in EVENT_COLOURS})
+    kinds = sorted({e.type for e in events if e.type is not None and e.marked})
     for k, (col, label, unit, scale) in enumerate([("err_pos", "position error", "cm", 100.0), ("err_theta", "heading error", "deg", 180.0 / math.pi)]):
         ax = axes[1 + k]
         for rid, fr in sorted(by_robot.items()):
@@ -140,13 +153,14 @@ def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, An
         # Events: a triangle above the plotting area and a faint dashed line BEHIND the data, so a
         # mark never hides the error it explains.
         for e in events:
-            c = EVENT_COLOURS.get(e.get("type") or "")
+            c = EVENT_COLOURS.get(e.type or "")
             if c:
-                ax.axvline(e["t"], color=c, lw=0.6, ls=(0, (3, 3)), alpha=0.45, zorder=1)
-                ax.plot([e["t"]], [1.0], marker="v", color=c, ms=6, transform=ax.get_xaxis_transform(), clip_on=False, zorder=4)
+                ax.axvline(e.t, color=c, lw=0.6, ls=(0, (3, 3)), alpha=0.45, zorder=1)
+                ax.plot([e.t], [1.0], marker="v", color=c, ms=6, transform=ax.get_xaxis_transform(), clip_on=False, zorder=4)
         t_end = max(float(f["t"]) for f in frames)
-        for r in run.summary.get("robots", []):  # left out of the tracking phase: shaded
-            for a, b in (r.get("tracking_phase") or {}).get("excluded", []):
+        for r in run.summary.robots:  # left out of the tracking phase: shaded
+            for interval in lst(obj(r.get("tracking_phase")).get("excluded", [])):
+                a, b = numbers_of(interval, 2, "tracking_phase.excluded")
                 ax.axvspan(a, min(b, t_end), color="#999999", alpha=0.15, lw=0)
         ax.set_ylim(bottom=0)
         ax.xaxis.set_major_locator(MaxNLocator(8))
@@ -158,7 +172,7 @@ def run_figure(run: Run, frames: list[dict[str, str]], events: list[dict[str, An
     return fig
 
 
-def robots_vs_error_figure(rv: list[dict[str, Any]]) -> Figure:
+def robots_vs_error_figure(rv: list[dict[str, float]]) -> Figure:
     """Paper 001's fig. 10 reproduced: the mean ball error against the number of robots."""
     fig, ax = plt.subplots(figsize=(6.5, 3.6))
     ks = [r["robots"] for r in rv]
@@ -173,13 +187,13 @@ def robots_vs_error_figure(rv: list[dict[str, Any]]) -> Figure:
     return fig
 
 
-def error_budget_figure(rows_by_source: dict[str, dict[str, dict[str, Any]]], locs: list[str]) -> Figure:
+def error_budget_figure(rows_by_source: dict[str, dict[str, dict[str, JSON]]], locs: list[str]) -> Figure:
     """Position RMSE of each error budget row, one bar per localizer, on a log axis."""
     sources = list(rows_by_source)
     fig, ax = plt.subplots(figsize=(9, 0.45 * len(sources) + 1.5))
     h = 0.8 / max(1, len(locs))
     for i, l in enumerate(locs):
-        vals = [v if ST.is_number(v := rows_by_source[s].get(l, {}).get("position_rmse_cm")) else float("nan") for s in sources]
+        vals = [v if stats.is_number(v := rows_by_source[s].get(l, {}).get("position_rmse_cm")) else float("nan") for s in sources]
         ax.barh([k + i * h for k in range(len(sources))], vals, height=h, label=l)
     ax.set_yticks([k + 0.4 - h / 2 for k in range(len(sources))])
     ax.set_yticklabels(sources)
@@ -230,7 +244,7 @@ def timing_figure(timing: dict[tuple[str, str], dict[str, list[float]]], median:
     return fig
 
 
-def history_figure(series: dict[str, list[tuple[int, float]]], records: list[dict[str, Any]], ylabel: str) -> Figure:
+def history_figure(series: dict[str, list[tuple[int, float]]], records: list[dict[str, JSON]], ylabel: str) -> Figure:
     """One line per workload, relative to its first record, one point per measured commit."""
     fig, ax = plt.subplots(figsize=(8, 4))
     for w, pts in sorted(series.items()):

@@ -20,9 +20,10 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
+from typing import Dict, Iterable, List, Optional, Sequence, Tuple, TypeVar
 
-from .load import Debug, RobotRun, RunData
+from omniloc.core.viewlog import Debug
+from omniloc.view.model import RobotRun, RunData
 
 HERE = Path(__file__).resolve().parent
 INT16 = 32767
@@ -51,7 +52,12 @@ def _wrap(theta: float) -> float:
     return (theta + math.pi) % (2 * math.pi) - math.pi
 
 
-def _packed_points(per_frame: Sequence[Optional[Sequence[Tuple[float, ...]]]], scale: Sequence[float]) -> Dict[str, Any]:
+# The page's JSON as it is built: numbers, text, lists and objects of them (json.dumps writes it).
+PageJSON = Dict[str, object]
+Item = TypeVar("Item")
+
+
+def _packed_points(per_frame: Sequence[Optional[Sequence[Tuple[float, ...]]]], scale: Sequence[float]) -> PageJSON:
     """{"counts": [points per frame], "data": base64 int16, "width": numbers per point}."""
     counts: List[int] = []
     values: List[int] = []
@@ -63,7 +69,7 @@ def _packed_points(per_frame: Sequence[Optional[Sequence[Tuple[float, ...]]]], s
     return {"counts": counts, "data": _pack(values), "width": len(scale)}
 
 
-def _subsample(items: Sequence[Any], n: int) -> List[Any]:
+def _subsample(items: Sequence[Item], n: int) -> List[Item]:
     """At most n items, an even stride through the list (keeps the spread of a particle set)."""
     if len(items) <= n:
         return list(items)
@@ -72,12 +78,12 @@ def _subsample(items: Sequence[Any], n: int) -> List[Any]:
     return [items[(i * len(items)) // n] for i in range(n)]
 
 
-def _particles(debug: Sequence[Debug], max_particles: int, every: int) -> Optional[Dict[str, Any]]:
-    if not any(d["particles"] for d in debug) or max_particles <= 0:
+def _particles(debug: Sequence[Debug], max_particles: int, every: int) -> Optional[PageJSON]:
+    if not any(d.particles for d in debug) or max_particles <= 0:
         return None
     frames: List[Optional[List[Tuple[float, ...]]]] = []
     for k, d in enumerate(debug):
-        ps = d["particles"]
+        ps = d.particles
         if not ps or k % every:
             frames.append(None)
             continue
@@ -99,16 +105,16 @@ def _ellipse(cov: Optional[List[float]]) -> Optional[List[Optional[float | int]]
             _num(math.sqrt(max(cov[8], 0.0)), 5)]
 
 
-def robot_json(r: RobotRun, max_particles: int, particles_every: int) -> Dict[str, Any]:
+def robot_json(r: RobotRun, max_particles: int, particles_every: int) -> PageJSON:
     modes: List[str] = []
     for m in r["mode"]:
         if m not in modes:
             modes.append(m)
-    out: Dict[str, Any] = {
+    out: PageJSON = {
         "id": r["id"], "radius": r["radius"],
         "t": [_num(t, 6) for t in r["t"]],
-        "est": [_num(v, 8) for p in r["estimate"] for v in (p["x"], p["y"], p["theta"])],
-        "gt": [_num(v, 8) for p in r["truth"] for v in (p["x"], p["y"], p["theta"])] if r["truth"] is not None else None,
+        "est": [_num(v, 8) for p in r["estimate"] for v in (p.x, p.y, p.theta)],
+        "gt": [_num(v, 8) for p in r["truth"] for v in (p.x, p.y, p.theta)] if r["truth"] is not None else None,
         "valid": [int(v) for v in r["valid"]],
         "modes": modes, "mode": [modes.index(m) for m in r["mode"]],
         "camOk": [None if v is None else int(v) for v in r["camera_ok"]],
@@ -122,18 +128,18 @@ def robot_json(r: RobotRun, max_particles: int, particles_every: int) -> Dict[st
     }
     debug = r["debug"]
     if debug is not None:
-        out["lp"] = _packed_points([d["line_points"] for d in debug], (1000.0, 1000.0))
-        if any(d["points"] for d in debug):
-            out["points"] = _packed_points([d["points"] for d in debug], (1000.0, 1000.0))
+        out["lp"] = _packed_points([d.line_points for d in debug], (1000.0, 1000.0))
+        if any(d.points for d in debug):
+            out["points"] = _packed_points([d.points for d in debug], (1000.0, 1000.0))
         out["particles"] = _particles(debug, max_particles, particles_every)
-        out["blobs"] = {str(k): [[b["colour"], b["kind"], _num(b["bearing"], 4), _num(b["distance"], 3)] for b in d["blobs"]]
-                        for k, d in enumerate(debug) if d["blobs"]}
-        if any(d["covariance"] is not None for d in debug):
-            out["cov"] = [_ellipse(d["covariance"]) for d in debug]
+        out["blobs"] = {str(k): [[b.colour, b.kind, _num(b.bearing, 4), _num(b.distance, 3)] for b in d.blobs]
+                        for k, d in enumerate(debug) if d.blobs}
+        if any(d.covariance is not None for d in debug):
+            out["cov"] = [_ellipse(d.covariance) for d in debug]
     return out
 
 
-def page_json(run: RunData, max_particles: int, particles_every: int) -> Dict[str, Any]:
+def page_json(run: RunData, max_particles: int, particles_every: int) -> PageJSON:
     s = run["summary"]
     om = s.get("omniloc") if isinstance(s.get("omniloc"), dict) else {}
     return {

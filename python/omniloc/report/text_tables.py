@@ -3,43 +3,45 @@
 from __future__ import annotations
 
 import json
+import pathlib
 import sys
-from typing import Any
+from typing import Optional, Sequence
 
-from omniloc.core import metrics as M
-from omniloc.core import pairing as PR
+from omniloc.core import metrics, pairing
+from omniloc.core.jsonvalue import JSONObject, lst, obj
 from omniloc.core.pairing import profile_of
-from omniloc.paper import tables as T
+from omniloc.core.rundir import Run
+from omniloc.paper import tables
 from omniloc.report.published import command, published_tables
 from omniloc.tools.markup import TextReport
-from omniloc.core.rundir import Run
 
 
 SHORT = ["mean x", "mean y", "mean th", "std x", "std y", "std th", "max x", "max y", "max th"]
 
 
-def error_tables(papers: dict[str, Any]) -> Any:
+def error_tables(papers: JSONObject) -> list[str]:
+    """The papers' error tables in their nine-column layout (the keys of papers.json)."""
     return [k for k, v in papers.items() if isinstance(v, dict) and "columns" in v and "reproduced_by" in v and isinstance(v.get("rows"), dict)
-            and len(v.get("columns", [])) == len(M.TABLE_KEYS)]
+            and len(lst(v.get("columns", []))) == len(metrics.TABLE_KEYS)]
 
 
-def choose_profile(runs: list[Run], wanted: Any) -> Any:
+def choose_profile(runs: list[Run], wanted: Optional[str]) -> tuple[Optional[str], str]:
     """(profile, how it was chosen) or (None, error): robot where the runs have it, else their one profile."""
     have = sorted({profile_of(r) for r in runs})
     if wanted:
         return wanted, "--profile" + ("" if wanted in have else f"; no runs of it here (the runs have: {', '.join(have) or 'none'})")
-    if not have or PR.SCENARIO_DEFAULT_PROFILE in have:
-        return PR.SCENARIO_DEFAULT_PROFILE, "the default" + (f"; the runs also have {', '.join(p for p in have if p != 'robot')}: --profile picks one"
+    if not have or pairing.SCENARIO_DEFAULT_PROFILE in have:
+        return pairing.SCENARIO_DEFAULT_PROFILE, "the default" + (f"; the runs also have {', '.join(p for p in have if p != 'robot')}: --profile picks one"
                                                            if len(have) > 1 else "")
     if len(have) == 1:
         return have[0], "read from the runs"
     return None, f"the runs have several noise profiles ({', '.join(have)}) and none is robot: name one with --profile"
 
 
-def print_other_table(papers: dict[str, Any], key: Any, runs: list[Run], experiments: list[Any], markdown: bool) -> Any:
+def print_other_table(papers: JSONObject, key: str, runs: list[Run], experiments: Sequence[pathlib.Path], markdown: bool) -> int:
     """A kidnap, timing or experiment table, as the report shows it (omniloc.report's section
     functions, written as text): one implementation of each table."""
-    ctx = T.Context(papers, runs, experiments)
+    ctx = tables.Context(papers, runs, experiments)
     anchor = "kidnapping" if key in ("002_kidnapping", "000_kidnapping") else key
     rep = TextReport(only=anchor, markdown=markdown)
     published_tables(rep, papers, ctx)
@@ -51,34 +53,35 @@ def print_other_table(papers: dict[str, Any], key: Any, runs: list[Run], experim
     return 0
 
 
-def report_command(cmd: str) -> Any:
+def report_command(cmd: str) -> str:
     return command(cmd)  # under field_robot: the field_robot suite's command
 
 
-def print_error_table(papers: dict[str, Any], key: Any, runs: list[Run], labels: Any, markdown: bool) -> Any:
+def print_error_table(papers: JSONObject, key: str, runs: list[Run], labels: Optional[Sequence[str]], markdown: bool) -> int:
     try:
-        rows = T.pair_table(papers, key, runs, labels)
+        rows = tables.pair_table(papers, key, runs, labels)
     except KeyError as e:
         print(f"error: {e.args[0]}", file=sys.stderr)
         return 2
-    cov, cov_head = T.table_coverage(rows)
+    cov, cov_head = tables.table_coverage(rows)
     head = ["row", "source"] + cov_head + SHORT + ["line points / frame", "seeds"]
-    lines, notes = [], []
+    lines: list[list[str]] = []
+    notes: list[str] = []
     for p in rows:
-        st = p["stats"]
-        if p["runs"]:
-            lines.append([p["shown"] + (" (tracking phase)" if p["phased"] else ""), "omniloc"] + T.row_cells(st, cov, p["runs"]))
+        st = p.stats
+        if p.runs:
+            lines.append([p.shown + (" (tracking phase)" if p.phased else ""), "omniloc"] + tables.row_cells(st, cov, p.runs))
         else:
-            lines.append([p["label"], "not run"] + ["-"] * (len(cov) + 9) + ["-", "0"])
-            notes.append(f"not run: {p['label']} ({PR.describe_key(p['key'])}); run: {report_command(p['command'])}")
-        for peer in p["peers"]:  # external localizers (docs/protocol.md) on the same scenario, configuration and start pose
-            lines.append([peer["row"], f"external: {peer['name']}"] + T.row_cells(peer["stats"], cov, peer["runs"]))
-        if p["published"]:
-            lines.append([p["label"], "paper"] + ["-"] * len(cov) + [f"{v:.3f}" for v in p["published"]] + ["-", "-"])
-            if p["runs"]:
-                mean = lambda m: st[m]["mean"]
-                lines.append([p["label"], "ours/paper"] + [""] * len(cov) + [f"{mean(f'{c}/{s}') / v:.2f}" if v and mean(f"{c}/{s}") is not None else "-"
-                                                                            for (c, s), v in zip(M.TABLE_KEYS, p["published"])] + ["", ""])
+            lines.append([p.label, "not run"] + ["-"] * (len(cov) + 9) + ["-", "0"])
+            notes.append(f"not run: {p.label} ({pairing.describe_key(p.key)}); run: {report_command(p.command)}")
+        for peer in p.peers:  # external localizers (docs/protocol.md) on the same scenario, configuration and start pose
+            lines.append([peer.row, f"external: {peer.name}"] + tables.row_cells(peer.stats, cov, peer.runs))
+        if p.published:
+            lines.append([p.label, "paper"] + ["-"] * len(cov) + [f"{v:.3f}" for v in p.published] + ["-", "-"])
+            if p.runs:
+                means = [st[f"{c}/{s}"].mean for c, s in metrics.TABLE_KEYS]
+                lines.append([p.label, "ours/paper"] + [""] * len(cov) + [f"{m / v:.2f}" if v and m is not None else "-"
+                                                                          for m, v in zip(means, p.published)] + ["", ""])
     if markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
@@ -90,7 +93,7 @@ def print_error_table(papers: dict[str, Any], key: Any, runs: list[Run], labels:
             print("  ".join(x.ljust(w[i]) if i < 2 else x.rjust(w[i]) for i, x in enumerate(l)))
     for n in notes:
         print(n)
-    print(f"\nunits: x, y in cm, th in rad; paper: {papers[key]['source']}"
+    print(f"\nunits: x, y in cm, th in rad; paper: {obj(papers[key])['source']}"
           + ("; ours: errors over the frames answered, " + ", ".join(
               f"'{h}': share of all frames " + ("within that threshold (a frame without an estimate counts as outside)" if h != "answered" else "with an estimate")
               for h in cov_head) + ", means over seeds" if cov_head else "") + "\n")
