@@ -291,4 +291,3 @@ def same_value(a: JSON, b: JSON) -> bool:
     if isinstance(a, list) and isinstance(b, list):
         return len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b))
     return a == b
-
