@@ -21,7 +21,7 @@ def compress_png(path: Any) -> Any:
         im.load()
     has_alpha = im.mode in ("RGBA", "LA") or (im.mode == "P" and "transparency" in im.info)
     src = im.convert("RGBA") if has_alpha else im.convert("RGB")
-    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if has_alpha else src.quantize(colors=256)  # type: ignore[arg-type]
+    q = src.quantize(colors=256, method=Image.Quantize.FASTOCTREE) if has_alpha else src.quantize(colors=256)
     buf = io.BytesIO()
     q.save(buf, format="PNG", optimize=True)
     best, data = path.stat().st_size, None
