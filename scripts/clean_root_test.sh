@@ -1,0 +1,143 @@
+#!/usr/bin/env bash
+# The README's test command on a fresh machine: a clean Debian 12 root (mmdebstrap --variant=apt:
+# apt and its essentials, the bookworm, bookworm-updates and bookworm-security suites) with a user
+# who is not root and may use sudo, a fresh clone of this clone's HEAD in that user's home, and there,
+# as that user from a login shell (no variable of this machine's environment, no locale):
+# scripts/test.sh, which installs with sudo apt what install-deps.sh lists, builds and runs ctest.
+# A test that passes here (.ci/run's tests stage) but fails there depends on something the scripts do
+# not install: a package, a pip module, a tool on PATH, a warm cache, root, a locale. .ci/run's
+# fresh_root stage (docs/ci.md "A fresh machine").
+# Usage: scripts/clean_root_test.sh [ctest arguments]   (passed to scripts/test.sh; default: every test)
+# The clone is of the commit HEAD names, never the working tree, so untracked or uncommitted files
+# cannot leak in. Two caches make a repeated run cheaper without changing what it tests: the root's
+# downloaded .debs (OMNILOC_CLEAN_ROOT_CACHE, shared with scripts/clean_root_check.sh; apt takes a
+# cached .deb only when its version and checksum are the ones the mirror lists) and this machine's
+# ccache ($CCACHE_DIR, else /var/cache/omniloc/ccache; OMNILOC_FRESH_ROOT_CCACHE="" starts cold): the
+# user's ~/.cache/ccache starts as hard links to its entries, in folders of the user's own, so the
+# user can neither write to nor remove this machine's entries. A miss costs time only.
+# Whole log: build/fresh_root.log; its check lines and last lines are printed. Exit 0: every test
+# passed in the root; 1: something failed in it; 3: no root could be made here (not root, no
+# mmdebstrap, no mirror): the reason is printed, and .ci/run fails unless OMNILOC_CI_FRESH_ROOT=0.
+# OMNILOC_CLEAN_ROOT_MIRROR: another Debian mirror (default http://deb.debian.org/debian);
+# OMNILOC_CLEAN_ROOT_SECURITY: another security mirror (default http://deb.debian.org/debian-security).
+set -euo pipefail
+case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
+cd "$(dirname "$0")/.."
+src=$PWD
+log=$src/build/fresh_root.log
+mkdir -p "$(dirname "$log")"
+: >"$log"
+work=$(mktemp -d /tmp/omniloc-fresh-root.XXXXXX)
+trap 'rm -rf "$work"' EXIT
+t0=$SECONDS start=$(date +%s)
+say() { echo "fresh-root: $*" | tee -a "$log"; }
+finish() {
+  local rc=$1
+  echo "--- the check's own lines in $log:"
+  grep -E '^(fresh-root:|install-deps:|[0-9]+% tests passed|The following tests|[[:space:]]+[0-9]+ - )' "$log" || true
+  echo "--- last 30 lines of $log:"
+  tail -n 30 "$log"
+  exit "$rc"
+}
+no_root() {
+  say "NO ROOT: $*"
+  say "the README's test command was not run on a fresh machine; OMNILOC_CI_FRESH_ROOT=0 runs CI without this check"
+  finish 3
+}
+
+user=tester  # uid 1000, like a first user
+sha=$(git rev-parse HEAD)
+# A clone through git's transport (--no-local: no hard links into this repository's objects); HEAD is
+# fetched by name too, so a detached CI checkout is found.
+git clone --quiet --no-local "$src" "$work/omniloc" >>"$log" 2>&1
+git -C "$work/omniloc" fetch --quiet "$src" HEAD >>"$log" 2>&1
+git -C "$work/omniloc" checkout --quiet --detach "$sha" >>"$log" 2>&1
+say "fresh clone of $(git log -1 --format='%h %s' "$sha" | cut -c1-80)"
+[ -z "$(git status --porcelain --untracked-files=no)" ] || say "note: this clone's uncommitted changes are not tested (the root has HEAD only)"
+
+if [ "$(id -u)" -ne 0 ]; then
+  no_root "not root (mmdebstrap's root mode and chroot need it)"
+fi
+if ! command -v mmdebstrap >/dev/null; then
+  apt-get install -y -qq --no-install-recommends mmdebstrap >>"$log" 2>&1 || true
+  command -v mmdebstrap >/dev/null || no_root "mmdebstrap is not installed and apt could not install it"
+fi
+
+mirror=${OMNILOC_CLEAN_ROOT_MIRROR:-http://deb.debian.org/debian}
+security=${OMNILOC_CLEAN_ROOT_SECURITY:-http://deb.debian.org/debian-security}
+sources=("deb $mirror bookworm main" "deb $mirror bookworm-updates main" "deb $security bookworm-security main")
+
+cache=${OMNILOC_CLEAN_ROOT_CACHE-/var/cache/omniloc/clean-root-debs}
+cache_in=() cache_out=()
+if [ -n "$cache" ] && mkdir -p "$cache" 2>/dev/null; then
+  [ "$(du -sm "$cache" | cut -f1)" -le 2048 ] || rm -f "$cache"/*.deb
+  say "download cache: $cache ($(find "$cache" -name '*.deb' | wc -l) .debs, $(du -sh "$cache" | cut -f1))"
+  cache_in=(--skip=essential/unlink --setup-hook='mkdir -p "$1"/var/cache/apt/archives/'
+            --setup-hook="sync-in '$cache' /var/cache/apt/archives/")
+  cache_out=(--customize-hook="sync-out /var/cache/apt/archives '$cache'")
+fi
+ccache_src=${OMNILOC_FRESH_ROOT_CCACHE-${CCACHE_DIR:-/var/cache/omniloc/ccache}}
+[ -d "$ccache_src" ] || ccache_src=""
+
+# Hooks run on this machine with the root as $1 (mmdebstrap mounts /proc, /dev and /sys for them).
+# The user: what a Debian 12 install with a sudo-enabled first user has; nothing of the project.
+cat >"$work/user_hook.sh" <<HOOK
+set -euo pipefail
+root=\$1
+touch "$work/root-ready"
+DEBIAN_FRONTEND=noninteractive chroot "\$root" apt-get install -y -qq --no-install-recommends sudo
+chroot "\$root" useradd --create-home --uid 1000 --shell /bin/bash $user
+echo "$user ALL=(ALL) NOPASSWD:ALL" >"\$root/etc/sudoers.d/$user"
+chmod 0440 "\$root/etc/sudoers.d/$user"
+cp -a "$work/omniloc" "\$root/home/$user/omniloc"
+chroot "\$root" chown -R $user:$user /home/$user/omniloc
+if [ -n "$ccache_src" ]; then
+  t=\$(date +%s)
+  mkdir -p "\$root/home/$user/.cache"
+  # Hard links where the root is on this cache's file system, else a copy; either way the folders are
+  # the user's (a new entry lands there) and a linked entry stays root's, read-only to the user.
+  cp -al "$ccache_src" "\$root/home/$user/.cache/ccache" 2>/dev/null || { rm -rf "\$root/home/$user/.cache/ccache"; cp -a "$ccache_src" "\$root/home/$user/.cache/ccache"; chroot "\$root" chown -R $user:$user /home/$user/.cache; }
+  chown 1000:1000 "\$root/home/$user/.cache"
+  find "\$root/home/$user/.cache/ccache" -type d -exec chown 1000:1000 {} +
+  rm -f "\$root/home/$user/.cache/ccache/ccache.conf"
+  echo "fresh-root: ~/.cache/ccache seeded from $ccache_src (\$(find "\$root/home/$user/.cache/ccache" -type f | wc -l) files, \$((\$(date +%s) - t)) s)"
+else
+  echo "fresh-root: no compile cache given: the build starts cold"
+fi
+echo "fresh-root: user $user (uid 1000, sudo), clone at /home/$user/omniloc; root ready \$((\$(date +%s) - $start)) s after the start"
+HOOK
+
+# The README's command as the user types it, from a login shell: runuser -l clears this machine's
+# environment and sets the login one (HOME, PATH, no LANG). Its exit status is kept so that the .deb
+# cache is saved also after a failure; the last hook hands it on.
+test_args=""
+[ $# -eq 0 ] || printf -v test_args ' %q' "$@"
+printf 'cd ~/omniloc && scripts/test.sh%s\n' "$test_args" >"$work/user_command.sh"
+cat >"$work/test_hook.sh" <<HOOK
+root=\$1
+t=\$(date +%s)
+echo "fresh-root: + scripts/test.sh$test_args   (as $user, in ~/omniloc)"
+install -m 0644 "$work/user_command.sh" "\$root/tmp/fresh_root_command.sh"
+rc=0
+chroot "\$root" runuser -l $user -c 'bash /tmp/fresh_root_command.sh' || rc=\$?
+echo "\$rc" >"$work/test-rc"
+echo "fresh-root: scripts/test.sh exit \$rc after \$((\$(date +%s) - t)) s"
+HOOK
+
+say "making a clean Debian 12 root with mmdebstrap --variant=apt (${sources[*]})"
+rc=0
+mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
+  --customize-hook="bash '$work/user_hook.sh' \"\$1\"" \
+  --customize-hook="bash '$work/test_hook.sh' \"\$1\"" \
+  "${cache_out[@]}" \
+  bookworm /dev/null "${sources[@]}" >>"$log" 2>&1 || rc=$?
+if [ ! -f "$work/root-ready" ]; then
+  no_root "mmdebstrap could not make a root (exit $rc): $(grep -E '^E: ' "$log" | head -n 3 | tr '\n' ' ')"
+fi
+test_rc=$(cat "$work/test-rc" 2>/dev/null || echo "none (the user or clone could not be set up; mmdebstrap exit $rc)")
+if [ "$test_rc" = 0 ] && [ $rc -eq 0 ]; then
+  say "passed: the README's test command on a fresh Debian 12 root ($((SECONDS - t0)) s in all)"
+  finish 0
+fi
+say "FAILED on a fresh Debian 12 root: scripts/test.sh exit $test_rc, mmdebstrap exit $rc ($((SECONDS - t0)) s in all)"
+finish 1
