@@ -85,6 +85,9 @@ cat >"$work/user_hook.sh" <<HOOK
 set -euo pipefail
 root=\$1
 touch "$work/root-ready"
+# The network names a Debian install writes (mmdebstrap writes none): without them "localhost" does
+# not resolve, and sudo complains about the host's name at every call.
+printf '127.0.0.1\tlocalhost\n127.0.1.1\t%s\n::1\tlocalhost ip6-localhost ip6-loopback\n' "\$(hostname)" >"\$root/etc/hosts"
 DEBIAN_FRONTEND=noninteractive chroot "\$root" apt-get install -y -qq --no-install-recommends sudo
 chroot "\$root" useradd --create-home --uid 1000 --shell /bin/bash $user
 echo "$user ALL=(ALL) NOPASSWD:ALL" >"\$root/etc/sudoers.d/$user"
