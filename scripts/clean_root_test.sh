@@ -88,6 +88,9 @@ touch "$work/root-ready"
 # The network names a Debian install writes (mmdebstrap writes none): without them "localhost" does
 # not resolve, and sudo complains about the host's name at every call.
 printf '127.0.0.1\tlocalhost\n127.0.1.1\t%s\n::1\tlocalhost ip6-localhost ip6-loopback\n' "\$(hostname)" >"\$root/etc/hosts"
+# dpkg without fsync (what mmdebstrap itself does while it installs): the root is thrown away, and
+# install-deps.sh's 400-odd packages install a minute or two sooner.
+echo force-unsafe-io >"\$root/etc/dpkg/dpkg.cfg.d/fresh-root-unsafe-io"
 DEBIAN_FRONTEND=noninteractive chroot "\$root" apt-get install -y -qq --no-install-recommends sudo
 chroot "\$root" useradd --create-home --uid 1000 --shell /bin/bash $user
 echo "$user ALL=(ALL) NOPASSWD:ALL" >"\$root/etc/sudoers.d/$user"
@@ -116,22 +119,35 @@ HOOK
 test_args=""
 [ $# -eq 0 ] || printf -v test_args ' %q' "$@"
 printf 'cd ~/omniloc && scripts/test.sh%s\n' "$test_args" >"$work/user_command.sh"
-cat >"$work/test_hook.sh" <<HOOK
-root=\$1
-t=\$(date +%s)
-echo "fresh-root: + scripts/test.sh$test_args   (as $user, in ~/omniloc)"
-install -m 0644 "$work/user_command.sh" "\$root/tmp/fresh_root_command.sh"
-rc=0
-chroot "\$root" runuser -l $user -c 'bash /tmp/fresh_root_command.sh' || rc=\$?
-echo "\$rc" >"$work/test-rc"
-echo "fresh-root: scripts/test.sh exit \$rc after \$((\$(date +%s) - t)) s"
+cat >"$work/test_hook.sh" <<'HOOK'
+root=$1 work=$2 user=$3
+t=$(date +%s)
+mark() { echo "fresh-root: $(($(date +%s) - t)) s into scripts/test.sh: $*"; }
+echo "fresh-root: + $(cut -d' ' -f4- "$work/user_command.sh")   (as $user, in ~/omniloc)"
+install -m 0644 "$work/user_command.sh" "$root/tmp/fresh_root_command.sh"
+# Each line is passed on as it is; where one phase ends (packages, build, ctest) a line with the time
+# is added, so the log shows where the stage's time went.
+chroot "$root" runuser -l "$user" -c 'bash /tmp/fresh_root_command.sh' 2>&1 | {
+  built=""
+  while IFS= read -r line; do
+    case $line in "["*) [ -n "$built" ] || { built=1; mark "the build starts"; } ;; esac
+    printf '%s\n' "$line"
+    case $line in
+      "install-deps: done" | "install-deps: all "*) mark "packages installed" ;;
+      "Test project "*) mark "the build is done, ctest starts" ;;
+    esac
+  done
+}
+rc=${PIPESTATUS[0]}
+echo "$rc" >"$work/test-rc"
+echo "fresh-root: scripts/test.sh exit $rc after $(($(date +%s) - t)) s"
 HOOK
 
 say "making a clean Debian 12 root with mmdebstrap --variant=apt (${sources[*]})"
 rc=0
 mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
   --customize-hook="bash '$work/user_hook.sh' \"\$1\"" \
-  --customize-hook="bash '$work/test_hook.sh' \"\$1\"" \
+  --customize-hook="bash '$work/test_hook.sh' \"\$1\" '$work' $user" \
   "${cache_out[@]}" \
   bookworm /dev/null "${sources[@]}" >>"$log" 2>&1 || rc=$?
 if [ ! -f "$work/root-ready" ]; then
