@@ -18,6 +18,8 @@
 # Whole log: build/fresh_root.log; its check lines and last lines are printed. Exit 0: every test
 # passed in the root; 1: something failed in it; 3: no root could be made here (not root, no
 # mmdebstrap, no mirror): the reason is printed, and .ci/run fails unless OMNILOC_CI_FRESH_ROOT=0.
+# OMNILOC_FRESH_ROOT_LIMIT: seconds scripts/test.sh may take in the root (default 1080, under .ci/run's
+# 1200 for the stage); at the limit every process in the root is ended and the check fails.
 # OMNILOC_CLEAN_ROOT_MIRROR: another Debian mirror (default http://deb.debian.org/debian);
 # OMNILOC_CLEAN_ROOT_SECURITY: another security mirror (default http://deb.debian.org/debian-security).
 set -euo pipefail
@@ -76,6 +78,7 @@ if [ -n "$cache" ] && mkdir -p "$cache" 2>/dev/null; then
             --setup-hook="sync-in '$cache' /var/cache/apt/archives/")
   cache_out=(--customize-hook="sync-out /var/cache/apt/archives '$cache'")
 fi
+limit=${OMNILOC_FRESH_ROOT_LIMIT:-1080}
 ccache_src=${OMNILOC_FRESH_ROOT_CCACHE-${CCACHE_DIR:-/var/cache/omniloc/ccache}}
 [ -d "$ccache_src" ] || ccache_src=""
 
@@ -120,14 +123,25 @@ test_args=""
 [ $# -eq 0 ] || printf -v test_args ' %q' "$@"
 printf 'cd ~/omniloc && scripts/test.sh%s\n' "$test_args" >"$work/user_command.sh"
 cat >"$work/test_hook.sh" <<'HOOK'
-root=$1 work=$2 user=$3
+root=$1 work=$2 user=$3 limit=$4
 t=$(date +%s)
 mark() { echo "fresh-root: $(($(date +%s) - t)) s into scripts/test.sh: $*"; }
-echo "fresh-root: + $(cut -d' ' -f4- "$work/user_command.sh")   (as $user, in ~/omniloc)"
+# runuser starts the user's command in a session of its own, which a signal to this process group
+# misses: whatever still runs inside the root (its /proc/PID/root is the root) is ended by its id, at
+# the time limit or when this hook is stopped, so that mmdebstrap can unmount and delete the root.
+end_root_processes() {
+  local p pids=()
+  for p in /proc/[0-9]*; do
+    [ "$(readlink "$p/root" 2>/dev/null)" = "$root" ] && pids+=("${p#/proc/}")
+  done
+  [ ${#pids[@]} -eq 0 ] || kill -KILL "${pids[@]}" 2>/dev/null || true
+}
+trap 'echo "fresh-root: stopped by a signal: ending the processes in the root"; end_root_processes; exit 143' TERM INT HUP
+echo "fresh-root: + $(cut -d' ' -f4- "$work/user_command.sh")   (as $user, in ~/omniloc; time limit $limit s)"
 install -m 0644 "$work/user_command.sh" "$root/tmp/fresh_root_command.sh"
 # Each line is passed on as it is; where one phase ends (packages, build, ctest) a line with the time
 # is added, so the log shows where the stage's time went.
-chroot "$root" runuser -l "$user" -c 'bash /tmp/fresh_root_command.sh' 2>&1 | {
+{ chroot "$root" runuser -l "$user" -c 'bash /tmp/fresh_root_command.sh'; echo $? >"$work/test-rc"; } 2>&1 | {
   built=""
   while IFS= read -r line; do
     case $line in "["*) [ -n "$built" ] || { built=1; mark "the build starts"; } ;; esac
@@ -137,9 +151,18 @@ chroot "$root" runuser -l "$user" -c 'bash /tmp/fresh_root_command.sh' 2>&1 | {
       "Test project "*) mark "the build is done, ctest starts" ;;
     esac
   done
-}
-rc=${PIPESTATUS[0]}
-echo "$rc" >"$work/test-rc"
+} &
+job=$!
+while kill -0 "$job" 2>/dev/null; do
+  if [ ! -f "$work/timed-out" ] && [ $(($(date +%s) - t)) -ge "$limit" ]; then
+    touch "$work/timed-out"
+    end_root_processes
+  fi
+  sleep 5
+done
+wait "$job"
+rc=$(cat "$work/test-rc" 2>/dev/null || echo none)
+[ ! -f "$work/timed-out" ] || echo "fresh-root: TIME LIMIT: scripts/test.sh ended after $limit s (OMNILOC_FRESH_ROOT_LIMIT)"
 echo "fresh-root: scripts/test.sh exit $rc after $(($(date +%s) - t)) s"
 HOOK
 
@@ -147,7 +170,7 @@ say "making a clean Debian 12 root with mmdebstrap --variant=apt (${sources[*]})
 rc=0
 mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
   --customize-hook="bash '$work/user_hook.sh' \"\$1\"" \
-  --customize-hook="bash '$work/test_hook.sh' \"\$1\" '$work' $user" \
+  --customize-hook="bash '$work/test_hook.sh' \"\$1\" '$work' $user $limit" \
   "${cache_out[@]}" \
   bookworm /dev/null "${sources[@]}" >>"$log" 2>&1 || rc=$?
 if [ ! -f "$work/root-ready" ]; then
