@@ -82,12 +82,26 @@ limit=${OMNILOC_FRESH_ROOT_LIMIT:-1080}
 ccache_src=${OMNILOC_FRESH_ROOT_CCACHE-${CCACHE_DIR:-/var/cache/omniloc/ccache}}
 [ -d "$ccache_src" ] || ccache_src=""
 
+# Ends, by its id, every process whose root is the given one (its /proc/PID/root): runuser starts the
+# user's command in a session of its own, which no signal to a process group reaches, and mmdebstrap
+# can unmount and delete the root only once nothing runs in it.
+cat >"$work/end_root.sh" <<'FUNC'
+end_root_processes() {
+  local p pids=()
+  [ -n "$1" ] || return 0
+  for p in /proc/[0-9]*; do
+    [ "$(readlink "$p/root" 2>/dev/null)" = "$1" ] && pids+=("${p#/proc/}")
+  done
+  [ ${#pids[@]} -eq 0 ] || kill -KILL "${pids[@]}" 2>/dev/null || true
+}
+FUNC
+
 # Hooks run on this machine with the root as $1 (mmdebstrap mounts /proc, /dev and /sys for them).
 # The user: what a Debian 12 install with a sudo-enabled first user has; nothing of the project.
 cat >"$work/user_hook.sh" <<HOOK
 set -euo pipefail
 root=\$1
-touch "$work/root-ready"
+echo "\$root" >"$work/root-ready"
 # The network names a Debian install writes (mmdebstrap writes none): without them "localhost" does
 # not resolve, and sudo complains about the host's name at every call.
 printf '127.0.0.1\tlocalhost\n127.0.1.1\t%s\n::1\tlocalhost ip6-localhost ip6-loopback\n' "\$(hostname)" >"\$root/etc/hosts"
@@ -126,17 +140,8 @@ cat >"$work/test_hook.sh" <<'HOOK'
 root=$1 work=$2 user=$3 limit=$4
 t=$(date +%s)
 mark() { echo "fresh-root: $(($(date +%s) - t)) s into scripts/test.sh: $*"; }
-# runuser starts the user's command in a session of its own, which a signal to this process group
-# misses: whatever still runs inside the root (its /proc/PID/root is the root) is ended by its id, at
-# the time limit or when this hook is stopped, so that mmdebstrap can unmount and delete the root.
-end_root_processes() {
-  local p pids=()
-  for p in /proc/[0-9]*; do
-    [ "$(readlink "$p/root" 2>/dev/null)" = "$root" ] && pids+=("${p#/proc/}")
-  done
-  [ ${#pids[@]} -eq 0 ] || kill -KILL "${pids[@]}" 2>/dev/null || true
-}
-trap 'echo "fresh-root: stopped by a signal: ending the processes in the root"; end_root_processes; exit 143' TERM INT HUP
+. "$work/end_root.sh"
+[ ! -f "$work/stopped" ] || exit 0
 echo "fresh-root: + $(cut -d' ' -f4- "$work/user_command.sh")   (as $user, in ~/omniloc; time limit $limit s)"
 install -m 0644 "$work/user_command.sh" "$root/tmp/fresh_root_command.sh"
 # Each line is passed on as it is; where one phase ends (packages, build, ctest) a line with the time
@@ -156,8 +161,9 @@ job=$!
 while kill -0 "$job" 2>/dev/null; do
   if [ ! -f "$work/timed-out" ] && [ $(($(date +%s) - t)) -ge "$limit" ]; then
     touch "$work/timed-out"
-    end_root_processes
+    end_root_processes "$root"
   fi
+  [ ! -f "$work/stopped" ] || end_root_processes "$root"
   sleep 5
 done
 wait "$job"
@@ -167,12 +173,36 @@ echo "fresh-root: scripts/test.sh exit $rc after $(($(date +%s) - t)) s"
 HOOK
 
 say "making a clean Debian 12 root with mmdebstrap --variant=apt (${sources[*]})"
-rc=0
-mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
+# mmdebstrap runs in a session of its own: a signal to this script's process group (.ci/run's
+# timeout, ^C) reaches this script alone, which ends what runs in the root and then waits while
+# mmdebstrap unmounts and deletes it as after any failure (signalled itself, it left the root's
+# mounts behind).
+. "$work/end_root.sh"
+stopped=""
+on_signal() {
+  stopped=1
+  touch "$work/stopped"  # the test hook checks it too: the signal may come before the root exists
+  say "stopped by a signal: ending what runs in the root; mmdebstrap then deletes it"
+  end_root_processes "$(cat "$work/root-ready" 2>/dev/null)"
+}
+trap on_signal TERM INT HUP
+setsid mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
   --customize-hook="bash '$work/user_hook.sh' \"\$1\"" \
   --customize-hook="bash '$work/test_hook.sh' \"\$1\" '$work' $user $limit" \
   "${cache_out[@]}" \
-  bookworm /dev/null "${sources[@]}" >>"$log" 2>&1 || rc=$?
+  bookworm /dev/null "${sources[@]}" >>"$log" 2>&1 </dev/null &
+mm=$!
+rc=0
+wait $mm || rc=$?
+while kill -0 $mm 2>/dev/null; do  # a signal ended the wait, not mmdebstrap
+  rc=0
+  wait $mm || rc=$?
+done
+trap - TERM INT HUP
+if [ -n "$stopped" ]; then
+  say "FAILED: stopped by a signal after $((SECONDS - t0)) s (mmdebstrap exit $rc)"
+  finish 1
+fi
 if [ ! -f "$work/root-ready" ]; then
   no_root "mmdebstrap could not make a root (exit $rc): $(grep -E '^E: ' "$log" | head -n 3 | tr '\n' ' ')"
 fi
