@@ -6,7 +6,7 @@
 # scripts/test.sh, which installs with sudo apt what install-deps.sh lists, builds and runs ctest.
 # A test that passes here (.ci/run's tests stage) but fails there depends on something the scripts do
 # not install: a package, a pip module, a tool on PATH, a warm cache, root, a locale. .ci/run's
-# fresh_root stage (docs/ci.md "A fresh machine").
+# fresh_root stage (docs/performance.md "A fresh machine").
 # Usage: scripts/clean_root_test.sh [ctest arguments]   (passed to scripts/test.sh; default: every test)
 # The clone is of the commit HEAD names, never the working tree, so untracked or uncommitted files
 # cannot leak in. Two caches make a repeated run cheaper without changing what it tests: the root's
