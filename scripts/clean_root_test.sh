@@ -20,6 +20,7 @@
 # mmdebstrap, no mirror): the reason is printed, and .ci/run fails unless OMNILOC_CI_FRESH_ROOT=0.
 # OMNILOC_FRESH_ROOT_LIMIT: seconds scripts/test.sh may take in the root (default 1080, under .ci/run's
 # 1200 for the stage); at the limit every process in the root is ended and the check fails.
+# OMNILOC_FRESH_ROOT_TMPFS=0: the root on disk even where a tmpfs could hold it.
 # OMNILOC_CLEAN_ROOT_MIRROR: another Debian mirror (default http://deb.debian.org/debian);
 # OMNILOC_CLEAN_ROOT_SECURITY: another security mirror (default http://deb.debian.org/debian-security).
 set -euo pipefail
@@ -175,6 +176,18 @@ rc=$(cat "$work/test-rc" 2>/dev/null || echo none)
 echo "fresh-root: scripts/test.sh exit $rc after $(($(date +%s) - t)) s"
 HOOK
 
+# The root in memory where the machine has room: a tmpfs makes dpkg's unpacking and the build's writes
+# cheaper, and deleting the root (86 s of a 796 s stage on disk) a matter of seconds. Its size is a
+# ceiling, not a reservation: about 3 GB is used (packages 1.6 GB, the build and the tests' caches).
+# Where no tmpfs can be mounted, or less than 8 GiB are free, the root stays on disk as before.
+mem_root=""
+avail_kb=$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo 2>/dev/null || echo 0)
+if [ "${OMNILOC_FRESH_ROOT_TMPFS:-1}" != 0 ] && [ "${avail_kb:-0}" -ge $((8 * 1024 * 1024)) ] && mkdir -p "$work/mem" &&
+   mount -t tmpfs -o "size=$((avail_kb / 2))k,mode=0755" omniloc-fresh-root "$work/mem" 2>>"$log"; then
+  mem_root=$work/mem
+  trap 'umount -l "$work/mem" 2>/dev/null; rm -rf "$work"' EXIT
+  say "the root is made in memory (tmpfs, at most $((avail_kb / 2 / 1024 / 1024)) GiB)"
+fi
 say "making a clean Debian 12 root with mmdebstrap --variant=apt (${sources[*]})"
 # mmdebstrap runs in a session of its own: a signal to this script's process group (.ci/run's
 # timeout, ^C) reaches this script alone, which ends what runs in the root and then waits while
@@ -189,7 +202,7 @@ on_signal() {
   end_root_processes "$(cat "$work/root-ready" 2>/dev/null)"
 }
 trap on_signal TERM INT HUP
-setsid mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
+TMPDIR=${mem_root:-${TMPDIR:-/tmp}} setsid mmdebstrap --variant=apt --mode=root --format=null "${cache_in[@]}" \
   --customize-hook="bash '$work/user_hook.sh' \"\$1\"" \
   --customize-hook="bash '$work/test_hook.sh' \"\$1\" '$work' $user $limit" \
   "${cache_out[@]}" \
