@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "core/error.hpp"
+#include "harness/image_file.hpp"
 
 namespace omniloc::harness {
 
@@ -26,10 +26,6 @@ cv::Point FieldPicture::px(const Eigen::Vector2d& w) const {
   return {static_cast<int>(std::lround((w.x() - x0_) * s_)), static_cast<int>(std::lround((y0_ - w.y()) * s_))};
 }
 
-std::string png_bytes(const cv::Mat& bgr) {
-  std::vector<uchar> buf;
-  if (!cv::imencode(".png", bgr, buf)) throw RuntimeFailure("cannot encode PNG");
-  return std::string(reinterpret_cast<const char*>(buf.data()), buf.size());
-}
+std::string png_bytes(const cv::Mat& bgr) { return encode_png(bgr); }
 
 }  // namespace omniloc::harness

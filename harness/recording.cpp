@@ -10,10 +10,6 @@
 #include <ostream>
 #include <sstream>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "core/version.hpp"
@@ -22,6 +18,7 @@
 #include "harness/external_session.hpp"
 #include "harness/frames_reader.hpp"
 #include "harness/gzip.hpp"
+#include "harness/image_file.hpp"
 #include "harness/recording_limits.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/render_frame.hpp"
@@ -190,16 +187,8 @@ RobotFrame robot_from_json(const Json& j, const std::string& at, double t, const
 }
 
 std::shared_ptr<const Image> read_png(const std::string& path) {
-  const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
   // The file was found readable before (why_not_readable_file): what fails here is its content.
-  if (bgr.empty()) throw ConfigError(path, "no image OpenCV can read", "a PNG image (recording.json says \"images\": true)");
-  cv::Mat rgb;
-  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-  auto img = std::make_shared<Image>();
-  img->width = rgb.cols;
-  img->height = rgb.rows;
-  img->rgb.assign(rgb.data, rgb.data + static_cast<std::size_t>(rgb.cols) * rgb.rows * 3);
-  return img;
+  return std::make_shared<Image>(read_png_rgb(path));
 }
 
 }  // namespace

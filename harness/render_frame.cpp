@@ -4,12 +4,12 @@
 #include <cmath>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "harness/camera_perception.hpp"
+#include "harness/image_file.hpp"
 #include "harness/simulation.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
@@ -49,14 +49,10 @@ void write_png(const Image& img, const std::string& path) {
   cv::Mat rgb(img.height, img.width, CV_8UC3, const_cast<std::uint8_t*>(img.rgb.data()));
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  std::vector<uchar> buf;
   // The encoder follows the extension (.png by default; .jpg for small pictures in docs).
   const auto dot = path.find_last_of('.');
-  std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
-  if (ext != ".jpg" && ext != ".jpeg") ext = ".png";
-  if (!cv::imencode(ext, bgr, buf, ext == ".png" ? std::vector<int>{} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 88}))
-    throw RuntimeFailure("cannot encode " + ext + " for " + path);
-  write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
+  const std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
+  write_file_atomic(path, ext == ".jpg" || ext == ".jpeg" ? encode_jpeg(bgr, 88) : encode_png(bgr));
 }
 
 void render_to_png(const Scenario& s, double t, int robot_id, std::uint64_t seed, bool labels, const std::string& png_path, bool points) {

@@ -3,6 +3,7 @@
 # Usage: scripts/install-deps.sh [--report-check]
 # OpenCV: we take the split -dev packages (core, imgproc, imgcodecs); they are ~10x smaller than
 # libopencv-dev but ship no CMake config, so CMakeLists.txt finds headers and libraries itself.
+# The program links core and imgproc; imgcodecs only the test that compares our PNG/JPEG files with it.
 set -euo pipefail
 case "${1:-}" in
   -h|--help)
@@ -19,7 +20,8 @@ esac
 PKGS=(
   build-essential cmake pkg-config git
   libbox2d-dev libeigen3-dev nlohmann-json3-dev
-  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev  # imgcodecs: tests only (harness/image_file.hpp)
+  libpng-dev libjpeg-dev  # PNG and JPEG files (harness/image_file.cpp)
   libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
   libbenchmark-dev libgtest-dev libgmock-dev
   libssl-dev zlib1g-dev libsimdjson-dev  # simdjson: the recording reader's fast path (harness/frames_reader.cpp)
