@@ -33,7 +33,7 @@ def encode(scene: Scene, compress: bool = True) -> tuple[bytes, str]:
     messages: list[mcap.Message] = []
     for topic, ns, payload in scene.messages:
         cid = channel(topic, *scene.topics[topic])
-        messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=_ENCODER.encode(payload).encode("utf-8")))
+        messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=payload if isinstance(payload, bytes) else _ENCODER.encode(payload).encode("utf-8")))
     for topic, ns, frame, png in scene.images:
         cid = channel(topic, "foxglove.CompressedImage", {})
         messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns,

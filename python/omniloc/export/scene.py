@@ -46,11 +46,11 @@ RAY_M = 3.0
 class Scene:
     """Messages by topic, each topic with its schema name and channel metadata, in the order added."""
     topics: dict[str, tuple[str, dict[str, str]]] = field(default_factory=dict)
-    messages: list[tuple[str, int, JSONObject]] = field(default_factory=list)
+    messages: list[tuple[str, int, JSONObject | bytes]] = field(default_factory=list)  # bytes: already JSON
     images: list[tuple[str, int, str, bytes]] = field(default_factory=list)  # topic, ns, frame, PNG (encoded last)
     notes: list[str] = field(default_factory=list)
 
-    def add(self, topic: str, schema: str, ns: int, message: JSONObject, latched: bool = False) -> None:
+    def add(self, topic: str, schema: str, ns: int, message: JSONObject | bytes, latched: bool = False) -> None:
         if topic not in self.topics:
             self.topics[topic] = (schema, {"latching": "1"} if latched else {})
         self.messages.append((topic, ns, message))
