@@ -82,6 +82,11 @@ class Export(unittest.TestCase):
             sc.write_text(json.dumps(scenario("paper/tracking.json", 4.0, f"mcap_{loc}", localizer={"type": loc})))
             cls.runs[loc] = cls.tmp / f"run_{loc}"
             omniloc("run", sc, "--debug-view", "-o", cls.runs[loc], "--quiet")
+        # 2 s of the landmark scenario (coloured landmarks: blobs).
+        sc = cls.tmp / "landmarks.json"
+        sc.write_text(json.dumps(scenario("paper/landmarks_003.json", 2.0, "mcap_landmarks")))
+        cls.run_lm = cls.tmp / "run_landmarks"
+        omniloc("run", sc, "--debug-view", "-o", cls.run_lm, "--quiet")
         # 1 s recorded with images, and a run replayed from it (line points and images from the recording).
         sc = cls.tmp / "images.json"
         sc.write_text(json.dumps(scenario("paper/tracking.json", 1.0, "mcap_images")))
@@ -171,6 +176,12 @@ class Export(unittest.TestCase):
         self.assertEqual(s["topics"]["/r0/line_points"], n)
         s = self.read(self.exported(self.run_img, "run_noimg.mcap", "--recording", self.rec_img, "--no-images"))
         self.assertNotIn("/r0/camera", s["topics"])
+
+    def test_blobs(self):
+        s = self.read(self.exported(self.run_lm, "landmarks.mcap"), "--run", self.run_lm)
+        blobs = sum(len(json.loads(line).get("blobs") or []) for line in (self.run_lm / "view.jsonl").read_text().splitlines())
+        self.assertGreater(blobs, 10)
+        self.assertEqual(s["blobs"], blobs)
 
     def test_handwritten_recording(self):
         """A log written from the format's documentation alone: no field markings, plain frames.jsonl."""
@@ -278,6 +289,31 @@ class Export(unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertEqual(out.read_bytes(), b"old")
         out.unlink()
+
+    def test_layout_names_what_an_export_writes(self):
+        """docs/foxglove_layout.json's panels show topics and fields the exports write (the bound
+        columns only where frames.csv has them)."""
+        layout = json.loads((ROOT / "docs" / "foxglove_layout.json").read_text())
+        wanted = set()
+        for pid, cfg in layout["configById"].items():
+            wanted.update(cfg.get("topics", {}))
+            wanted.update(p["value"] for p in cfg.get("paths", []))
+            for key in ("topicToRender",):
+                if key in cfg:
+                    wanted.add(cfg[key])
+            if cfg.get("imageMode", {}).get("imageTopic"):
+                wanted.add(cfg["imageMode"]["imageTopic"])
+        written = set()
+        for src, name, extra in ((self.runs["mcl"], "l_mcl.mcap", []), (self.run_lm, "l_lm.mcap", []),
+                                 (self.run_img, "l_img.mcap", ["--recording", self.rec_img])):
+            s = self.read(self.exported(src, name, *extra))
+            written.update(s["topics"])
+            for topic, keys in s["number_keys"].items():
+                written.update(f"{topic}.{k}" for k in keys)
+        missing = {w for w in wanted - written if not w.split(".")[-1].startswith("bound_")}
+        self.assertEqual(missing, set(), "the layout shows what no export writes")
+        self.assertIn("/r0/numbers.err_pos", wanted)
+        self.assertIn("/r0/camera", wanted)
 
     def test_help(self):
         r = export("--help")

@@ -98,6 +98,33 @@ function cloudPoints(msg) {
   return out;
 }
 
+// Blobs drawn as rays in the robot frame: one line per blob of view.jsonl, from the robot along its
+// bearing to its distance (3 m where it has none). Frames before the first blob may have no message.
+function compareBlobs(kind, msgs, frames) {
+  const withBlobs = frames.filter((f) => (f.blobs || []).length > 0);
+  if (withBlobs.length === 0) {
+    check(msgs.length === 0, `${kind}: ${msgs.length} messages, view.jsonl has no blobs`);
+    return 0;
+  }
+  const first = frames.findIndex((f) => (f.blobs || []).length > 0);
+  const expected = frames.slice(first);
+  if (!check(msgs.length === expected.length, `${kind}: ${msgs.length} messages for ${expected.length} frames from the first blob on`)) return 0;
+  let n = 0;
+  expected.forEach((f, i) => {
+    const lines = msgs[i].msg.entities[0].lines;
+    const blobs = f.blobs || [];
+    if (!check(lines.length === blobs.length, `${kind} frame ${f.k}: ${lines.length} rays for ${blobs.length} blobs`)) return;
+    blobs.forEach((b, j) => {
+      n += 1;
+      const d = b.distance == null ? 3.0 : b.distance;
+      const end = lines[j].points[1];
+      check(Math.abs(end.x - d * Math.cos(b.bearing)) < 1e-12 && Math.abs(end.y - d * Math.sin(b.bearing)) < 1e-12,
+        `${kind} frame ${f.k} blob ${j}: ray to (${end.x}, ${end.y}), bearing ${b.bearing} distance ${b.distance}`);
+    });
+  });
+  return n;
+}
+
 function readTum(file) {
   return fs.readFileSync(file, "utf8").split("\n").filter((l) => l.trim() && !l.startsWith("#")).map((l) => {
     const v = l.trim().split(/\s+/).map(Number);
@@ -298,6 +325,11 @@ async function main() {
   // 5. The round trip against the run folder or the recording.
   const summary = { file, messages: count, chunks: chunks.length, compression: chunks[0] ? chunks[0].compression : "", topics: {} };
   for (const [t, ms] of byTopic) summary.topics[t] = ms.length;
+  // What a Plot panel can plot: the keys of each robot's per-frame numbers.
+  summary.number_keys = {};
+  for (const [t, ms] of byTopic) {
+    if (t.endsWith("/numbers")) summary.number_keys[t] = [...new Set(ms.flatMap((m) => Object.keys(m.msg)))].sort();
+  }
   let points = 0;
   let poses = 0;
   const runView = runDir && fs.existsSync(path.join(runDir, "view.jsonl"));
@@ -318,6 +350,8 @@ async function main() {
       if (view) {
         const frames = view.filter((o) => o.robot === id).map((o) => ({ t: o.t, points: o.line_points }));
         points += compareLinePoints(`/r${id}/line_points`, byTopic.get(`/r${id}/line_points`) || [], frames);
+        summary.blobs = (summary.blobs || 0) + compareBlobs(`/r${id}/blobs`, byTopic.get(`/r${id}/blobs`) || [],
+          view.filter((o) => o.robot === id));
       }
     });
   }
