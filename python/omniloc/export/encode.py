@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from omniloc.export import foxglove as fx
+from omniloc.export import foxglove
 from omniloc.export import mcap
 from omniloc.export.scene import Scene
 
@@ -23,7 +23,7 @@ def encode(scene: Scene, compress: bool = True) -> tuple[bytes, str]:
             return channel_ids[topic]
         if schema_name not in schema_ids:
             schema_ids[schema_name] = len(schemas) + 1  # schema id 0 means "no schema"
-            data = json.dumps(fx.SCHEMAS[schema_name], sort_keys=True, separators=(",", ":")).encode("utf-8")
+            data = json.dumps(foxglove.SCHEMAS[schema_name], sort_keys=True, separators=(",", ":")).encode("utf-8")
             schemas.append(mcap.Schema(id=schema_ids[schema_name], name=schema_name, encoding="jsonschema", data=data))
         channel_ids[topic] = len(channels)
         channels.append(mcap.Channel(id=channel_ids[topic], schema_id=schema_ids[schema_name], topic=topic, message_encoding="json",
@@ -37,5 +37,5 @@ def encode(scene: Scene, compress: bool = True) -> tuple[bytes, str]:
     for topic, ns, frame, png in scene.images:
         cid = channel(topic, "foxglove.CompressedImage", {})
         messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns,
-                                     data=_ENCODER.encode(fx.compressed_image(ns, frame, png)).encode("utf-8")))
+                                     data=_ENCODER.encode(foxglove.compressed_image(ns, frame, png)).encode("utf-8")))
     return mcap.build("omniloc export", schemas, channels, messages, compress=compress)

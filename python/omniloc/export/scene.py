@@ -30,12 +30,12 @@ from omniloc.core.framedata import Blob, blobs, pairs
 from omniloc.core.jsonvalue import JSON, JSONObject, finite, lst, numbers, obj, text
 from omniloc.core.recording import RecordingHeader, read_frames
 from omniloc.core.viewlog import Debug
-from omniloc.export import foxglove as fx
+from omniloc.export import foxglove
 from omniloc.view.load import event_label
 from omniloc.view.model import RunData
 
 WORLD = "world"
-LINE_WHITE = fx.color(1.0, 1.0, 1.0, 1.0)
+LINE_WHITE = foxglove.color(1.0, 1.0, 1.0, 1.0)
 BLOB_COLOURS = {"yellow": (1.0, 0.84, 0.0), "blue": (0.16, 0.38, 1.0), "red": (0.9, 0.22, 0.21), "white": (1.0, 1.0, 1.0),
                 "orange": (1.0, 0.43, 0.0), "green": (0.0, 0.78, 0.33)}
 # A blob without a distance is drawn as a ray this long (m): its bearing is all the frame knows.
@@ -74,10 +74,10 @@ def field_update(ns: int, f: JSONObject) -> JSONObject:
     segments = [s for s in (numbers(v) for v in lst(f.get("segments"))) if s is not None and len(s) == 4]
     lines: list[JSON] = []
     if segments:
-        lines.append(fx.line(fx.LINE_LIST, [p for s in segments for p in ((s[0], s[1]), (s[2], s[3]))], LINE_WHITE, width))
+        lines.append(foxglove.line(foxglove.LINE_LIST, [p for s in segments for p in ((s[0], s[1]), (s[2], s[3]))], LINE_WHITE, width))
     for a in (numbers(v) for v in lst(f.get("arcs"))):
         if a is not None and len(a) == 5:
-            lines.append(fx.line(fx.LINE_STRIP, _arc_points(*a), LINE_WHITE, width))
+            lines.append(foxglove.line(foxglove.LINE_STRIP, _arc_points(*a), LINE_WHITE, width))
     colours = [text(c) or "white" for c in lst(f.get("goal_colours"))]
     for i, g in enumerate(numbers(v) for v in lst(f.get("goals"))):
         if g is None or len(g) != 3:
@@ -85,26 +85,26 @@ def field_update(ns: int, f: JSONObject) -> JSONObject:
         x, w, depth = g
         back = x + math.copysign(depth, x)
         rgb = BLOB_COLOURS.get(colours[i] if i < len(colours) else "white", (1.0, 1.0, 1.0))
-        lines.append(fx.line(fx.LINE_STRIP, [(x, -w / 2), (back, -w / 2), (back, w / 2), (x, w / 2)], fx.color(*rgb), 0.08, 0.01))
+        lines.append(foxglove.line(foxglove.LINE_STRIP, [(x, -w / 2), (back, -w / 2), (back, w / 2), (x, w / 2)], foxglove.color(*rgb), 0.08, 0.01))
     cylinders: list[JSON] = []
     for s in (numbers(v) for v in lst(f.get("spots"))):
         if s is not None and len(s) == 3:
-            cylinders.append(fx.cylinder(s[0], s[1], 0.0, 2 * s[2], 2 * s[2], 0.005, LINE_WHITE))
+            cylinders.append(foxglove.cylinder(s[0], s[1], 0.0, 2 * s[2], 2 * s[2], 0.005, LINE_WHITE))
     spheres: list[JSON] = []
     for lm in lst(f.get("landmarks")):
         pos = numbers(obj(lm).get("position"))
         if pos is not None and len(pos) >= 2:
             rgb = BLOB_COLOURS.get(text(obj(lm).get("colour")) or "", (1.0, 1.0, 1.0))
             size = obj(lm).get("size")
-            spheres.append(fx.sphere(pos[0], pos[1], 0.1, float(size) if finite(size) else 0.2, fx.color(*rgb)))
+            spheres.append(foxglove.sphere(pos[0], pos[1], 0.1, float(size) if finite(size) else 0.2, foxglove.color(*rgb)))
     length, wide = f.get("length"), f.get("width")
     cubes: list[JSON] = []
     if finite(length) and finite(wide):  # the carpet, just below the lines
         margin = _num(f.get("margin"), 0.0)
-        carpet = fx.cube(0.0, 0.0, 0.0, (float(length) + 2 * margin, float(wide) + 2 * margin, 0.002), fx.color(0.13, 0.45, 0.2, 1.0))
-        carpet["pose"] = fx.planar_pose(0.0, 0.0, 0.0, -0.002)
+        carpet = foxglove.cube(0.0, 0.0, 0.0, (float(length) + 2 * margin, float(wide) + 2 * margin, 0.002), foxglove.color(0.13, 0.45, 0.2, 1.0))
+        carpet["pose"] = foxglove.planar_pose(0.0, 0.0, 0.0, -0.002)
         cubes.append(carpet)
-    return fx.scene_update([fx.entity(ns, WORLD, "field", lines=lines, cylinders=cylinders, spheres=spheres, cubes=cubes)])
+    return foxglove.scene_update([foxglove.entity(ns, WORLD, "field", lines=lines, cylinders=cylinders, spheres=spheres, cubes=cubes)])
 
 
 # ------------------------------------------------------------------------------------------ per frame
@@ -129,27 +129,27 @@ def blob_update(ns: int, frame: str, found: Sequence[Blob]) -> JSONObject:
         rgb = BLOB_COLOURS.get(b.colour, (0.8, 0.8, 0.8))
         reach = b.distance if b.distance is not None else RAY_M
         end = (reach * math.cos(b.bearing), reach * math.sin(b.bearing))
-        lines.append(fx.line(fx.LINE_STRIP, [(0.0, 0.0), end], fx.color(*rgb, 0.8), 0.02, 0.05))
+        lines.append(foxglove.line(foxglove.LINE_STRIP, [(0.0, 0.0), end], foxglove.color(*rgb, 0.8), 0.02, 0.05))
         if b.kind == "ball" and b.distance is not None:
-            spheres.append(fx.sphere(end[0], end[1], 0.11, 0.22, fx.color(*rgb)))
-    return fx.scene_update([fx.entity(ns, frame, "blobs", lines=lines, spheres=spheres)])
+            spheres.append(foxglove.sphere(end[0], end[1], 0.11, 0.22, foxglove.color(*rgb)))
+    return foxglove.scene_update([foxglove.entity(ns, frame, "blobs", lines=lines, spheres=spheres)])
 
 
 def add_debug(scene: Scene, rid: int, ns: int, frame: str, d: Debug, estimate: tuple[float, float, float], particles: int) -> None:
     """One frame's view.jsonl (or recording) data of robot `rid`; `frame` is where its robot-frame data sits."""
-    scene.add(f"/r{rid}/line_points", "foxglove.PointCloud", ns, fx.point_cloud(ns, frame, d.line_points))
+    scene.add(f"/r{rid}/line_points", "foxglove.PointCloud", ns, foxglove.point_cloud(ns, frame, d.line_points))
     if d.blobs or f"/r{rid}/blobs" in scene.topics:
         scene.add(f"/r{rid}/blobs", "foxglove.SceneUpdate", ns, blob_update(ns, frame, d.blobs))
     if d.particles is not None and particles > 0:
         step = max(1, math.ceil(len(d.particles) / particles))
         scene.add(f"/r{rid}/particles", "foxglove.PosesInFrame", ns,
-                  fx.poses_in_frame(ns, WORLD, [(p[0], p[1], p[2]) for p in d.particles[::step]]))
+                  foxglove.poses_in_frame(ns, WORLD, [(p[0], p[1], p[2]) for p in d.particles[::step]]))
     if d.points is not None:
-        scene.add(f"/r{rid}/points", "foxglove.PointCloud", ns, fx.point_cloud(ns, WORLD, d.points))
+        scene.add(f"/r{rid}/points", "foxglove.PointCloud", ns, foxglove.point_cloud(ns, WORLD, d.points))
     if d.covariance is not None:
         e = ellipse_2sigma(d.covariance)
-        cyl: list[JSON] = [] if e is None else [fx.cylinder(estimate[0], estimate[1], e[2], e[0], e[1], 0.01, fx.color(1.0, 0.9, 0.0, 0.35))]
-        scene.add(f"/r{rid}/uncertainty", "foxglove.SceneUpdate", ns, fx.scene_update([fx.entity(ns, WORLD, "ellipse_2sigma", cylinders=cyl)]))
+        cyl: list[JSON] = [] if e is None else [foxglove.cylinder(estimate[0], estimate[1], e[2], e[0], e[1], 0.01, foxglove.color(1.0, 0.9, 0.0, 0.35))]
+        scene.add(f"/r{rid}/uncertainty", "foxglove.SceneUpdate", ns, foxglove.scene_update([foxglove.entity(ns, WORLD, "ellipse_2sigma", cylinders=cyl)]))
 
 
 def _number_value(v: Optional[float]) -> JSON:
@@ -163,7 +163,7 @@ def run_scene(run: RunData, images: dict[int, dict[int, bytes]], particles: int)
     """The run (omniloc.view.load.load_run) as messages; `images`: per robot, frame k -> PNG."""
     scene = Scene(notes=list(run["notes"]))
     robots = run["robots"]
-    first = fx.nanoseconds(robots[0]["t"][0]) if robots and robots[0]["t"] else 0
+    first = foxglove.nanoseconds(robots[0]["t"][0]) if robots and robots[0]["t"] else 0
     scene.add("/field", "foxglove.SceneUpdate", first, field_update(first, run["field"]), latched=True)
     for r in robots:
         rid = r["id"]
@@ -174,16 +174,16 @@ def run_scene(run: RunData, images: dict[int, dict[int, bytes]], particles: int)
                                                      **r["extra"]}
         flags = {"camera_ok": r["camera_ok"], "contact": r["contact"]}
         for k, t in enumerate(r["t"]):
-            ns = fx.nanoseconds(t)
+            ns = foxglove.nanoseconds(t)
             e = r["estimate"][k]
             if r["truth"] is not None:
                 g = r["truth"][k]
-                scene.add("/tf", "foxglove.FrameTransform", ns, fx.frame_transform(ns, WORLD, truth_frame, g.x, g.y, g.theta))
-                scene.add(f"/r{rid}/truth", "foxglove.PoseInFrame", ns, fx.pose_in_frame(ns, WORLD, g.x, g.y, g.theta))
-            scene.add("/tf", "foxglove.FrameTransform", ns, fx.frame_transform(ns, WORLD, est_frame, e.x, e.y, e.theta))
+                scene.add("/tf", "foxglove.FrameTransform", ns, foxglove.frame_transform(ns, WORLD, truth_frame, g.x, g.y, g.theta))
+                scene.add(f"/r{rid}/truth", "foxglove.PoseInFrame", ns, foxglove.pose_in_frame(ns, WORLD, g.x, g.y, g.theta))
+            scene.add("/tf", "foxglove.FrameTransform", ns, foxglove.frame_transform(ns, WORLD, est_frame, e.x, e.y, e.theta))
             if r["est_from_tum"][k]:
-                scene.add(f"/r{rid}/estimate", "foxglove.PoseInFrame", ns, fx.pose_in_frame(ns, WORLD, e.x, e.y, e.theta))
-            nums: JSONObject = {"timestamp": fx.stamp(ns), "t": t, "k": k, "valid": 1 if r["valid"][k] else 0, "mode": r["mode"][k]}
+                scene.add(f"/r{rid}/estimate", "foxglove.PoseInFrame", ns, foxglove.pose_in_frame(ns, WORLD, e.x, e.y, e.theta))
+            nums: JSONObject = {"timestamp": foxglove.stamp(ns), "t": t, "k": k, "valid": 1 if r["valid"][k] else 0, "mode": r["mode"][k]}
             for name, col in columns.items():
                 v = _number_value(col[k])
                 if v is not None:
@@ -191,21 +191,21 @@ def run_scene(run: RunData, images: dict[int, dict[int, bytes]], particles: int)
             for name, fl in flags.items():
                 if fl[k] is not None:
                     nums[name] = 1 if fl[k] else 0
-            scene.add(f"/r{rid}/numbers", fx.FRAME_NUMBERS, ns, nums)
+            scene.add(f"/r{rid}/numbers", foxglove.FRAME_NUMBERS, ns, nums)
             if debug is not None:
                 add_debug(scene, rid, ns, est_frame, debug[k], (e.x, e.y, e.theta), particles)
             png = images.get(rid, {}).get(k)
             if png is not None:
                 scene.images.append((f"/r{rid}/camera", ns, f"r{rid}/camera", png))
     for n, ev in enumerate(run["events"], 1):
-        ns = fx.nanoseconds(ev["t"])
-        scene.add("/events", "foxglove.Log", ns, fx.log(ns, _level(ev["type"]), ev["label"], "omniloc", "events.jsonl", n))
+        ns = foxglove.nanoseconds(ev["t"])
+        scene.add("/events", "foxglove.Log", ns, foxglove.log(ns, _level(ev["type"]), ev["label"], "omniloc", "events.jsonl", n))
     return scene
 
 
 def _level(kind: Optional[str]) -> int:
     """Events that move or blind a robot are warnings in a Log panel; the rest information."""
-    return fx.LOG_WARNING if kind in ("kidnap", "teleport", "cover") else fx.LOG_INFO
+    return foxglove.LOG_WARNING if kind in ("kidnap", "teleport", "cover") else foxglove.LOG_INFO
 
 
 # ------------------------------------------------------------------------------------------ a recording
@@ -230,7 +230,7 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
     frames = read_frames(head)
     fpath = head.frames_path
     scene = Scene()
-    first = fx.nanoseconds(frames[0].t) if frames else 0
+    first = foxglove.nanoseconds(frames[0].t) if frames else 0
     markings = head.field_markings
     raw_field = head.raw.get("field")
     field_obj = markings if markings is not None else (raw_field if isinstance(raw_field, dict) else None)
@@ -246,7 +246,7 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
             starts[rid] = (start[0], start[1], start[2])
     odo: dict[int, tuple[float, float, float]] = {}
     for f in frames:
-        ns = fx.nanoseconds(f.t)
+        ns = foxglove.nanoseconds(f.t)
         n = f.line
         for i, rid_json in enumerate(ids):
             r = f.robot(i)
@@ -257,7 +257,7 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
             if truth is not None and len(truth) == 3:
                 frame = f"r{rid}/truth"
                 pose = (truth[0], truth[1], truth[2])
-                scene.add(f"/r{rid}/truth", "foxglove.PoseInFrame", ns, fx.pose_in_frame(ns, WORLD, *pose))
+                scene.add(f"/r{rid}/truth", "foxglove.PoseInFrame", ns, foxglove.pose_in_frame(ns, WORLD, *pose))
             else:
                 frame = f"r{rid}/odometry"
                 step = numbers(r.get("odometry"))
@@ -267,11 +267,11 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
                 pose = (x + step[0] * math.cos(th) - step[1] * math.sin(th), y + step[0] * math.sin(th) + step[1] * math.cos(th),
                         th + step[2])
                 odo[rid] = pose
-            scene.add("/tf", "foxglove.FrameTransform", ns, fx.frame_transform(ns, WORLD, frame, *pose))
+            scene.add("/tf", "foxglove.FrameTransform", ns, foxglove.frame_transform(ns, WORLD, frame, *pose))
             lp = pairs(r.get("line_points"), fpath, n, "line_points")
             d = Debug(line_points=lp, blobs=blobs(r.get("blobs"), fpath, n), covariance=None, particles=None, points=None)
             add_debug(scene, rid, ns, frame, d, pose, 0)
-            nums: JSONObject = {"timestamp": fx.stamp(ns), "t": f.t, "k": f.k, "line_points": len(lp)}
+            nums: JSONObject = {"timestamp": foxglove.stamp(ns), "t": f.t, "k": f.k, "line_points": len(lp)}
             for key in ("camera_ok", "covered", "contact", "stop_robot"):
                 v = r.get(key)
                 if isinstance(v, bool):
@@ -286,7 +286,7 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
             for key in ("exposure_ms", "gain"):
                 if finite(cam.get(key)):
                     nums[key] = cam[key]
-            scene.add(f"/r{rid}/numbers", fx.FRAME_NUMBERS, ns, nums)
+            scene.add(f"/r{rid}/numbers", foxglove.FRAME_NUMBERS, ns, nums)
             if with_images and head.images and f.k % image_every == 0:
                 png = read_png(head.folder / "images" / f"r{rid}_{f.k:06d}.png")
                 scene.images.append((f"/r{rid}/camera", ns, f"r{rid}/camera", png))
@@ -298,6 +298,6 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
             robot = e.get("robot")
             label = event_label(events.Event(t=t, type=text(e.get("type")), robot=robot if isinstance(robot, int) else None,
                                              duration=None, raw=e))
-            ev_ns = fx.nanoseconds(t)
-            scene.add("/events", "foxglove.Log", ev_ns, fx.log(ev_ns, _level(text(e.get("type"))), label, "omniloc", fpath.name, n))
+            ev_ns = foxglove.nanoseconds(t)
+            scene.add("/events", "foxglove.Log", ev_ns, foxglove.log(ev_ns, _level(text(e.get("type"))), label, "omniloc", fpath.name, n))
     return scene
