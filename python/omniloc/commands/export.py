@@ -13,13 +13,13 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Callable, List, NoReturn, Optional
+from typing import BinaryIO, Callable, List, NoReturn, Optional
 
 from omniloc.core import pathcheck, rundir
 from omniloc.core.files import InputFileError
 from omniloc.core.recording import load_header
 from omniloc.export.encode import encode
-from omniloc.export.scene import Scene, read_png, recording_scene, run_scene
+from omniloc.export.scene import Scene, image_path, recording_scene, run_scene
 from omniloc.view.load import load_run
 
 DESCRIPTION = """\
@@ -77,16 +77,19 @@ def parser(prog: str) -> argparse.ArgumentParser:
     return p
 
 
-def write_atomically(path: Path, data: bytes) -> None:
-    """`data` at `path`, written under a temporary name in the same folder and renamed into place."""
+def write_atomically(path: Path, fill: Callable[[BinaryIO], str]) -> tuple[int, str]:
+    """What `fill` writes, at `path`: written under a temporary name in the same folder and renamed
+    into place; removed on any error. Returns the size and what `fill` returned."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as f:
-            f.write(data)
+            result = fill(f)
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, 0o644)
+        size = os.path.getsize(tmp)
         os.replace(tmp, path)
+        return size, result
     except BaseException:
         try:
             os.unlink(tmp)
@@ -113,13 +116,13 @@ def kind_of(folder: Path) -> str:
 def scene_of(folder: Path, kind: str, args: argparse.Namespace) -> Scene:
     images = not args.no_images
     if kind == "recording":
-        return recording_scene(load_header(folder), args.particles, args.image_every, images)
+        return recording_scene(load_header(folder), args.image_every, images)
     recording = Path(args.recording) if args.recording else None
     run = load_run(folder, recording, image_every=args.image_every, images=False)
-    pngs: dict[int, dict[int, bytes]] = {}
+    pngs: dict[int, dict[int, Path]] = {}
     if recording is not None and images and run["recording_images"]:
         for r in run["robots"]:
-            pngs[r["id"]] = {k: read_png(recording / "images" / f"r{r['id']}_{k:06d}.png") for k in range(0, run["frames"], args.image_every)}
+            pngs[r["id"]] = {k: image_path(recording, r["id"], k) for k in range(0, run["frames"], args.image_every)}
     scene = run_scene(run, pngs, args.particles)
     if run["debug_source"] is None:
         scene.notes.append("no view.jsonl (omniloc run --debug-view) and no --recording: no line points, particles or ellipse")
@@ -129,12 +132,11 @@ def scene_of(folder: Path, kind: str, args: argparse.Namespace) -> Scene:
 def export_one(folder: Path, kind: str, out: Path, args: argparse.Namespace, prog: str) -> None:
     began = time.perf_counter()
     scene = scene_of(folder, kind, args)
-    data, compression = encode(scene)
-    write_atomically(out, data)
+    size, compression = write_atomically(out, lambda f: encode(scene, f))
     if not args.quiet:
         seconds = time.perf_counter() - began
         images = len(scene.images)
-        print(f"wrote {out} ({len(data) / 1e6:.2f} MB, {len(scene.messages) + images} messages on {len(scene.topics) + (1 if images else 0)} "
+        print(f"wrote {out} ({size / 1e6:.2f} MB, {len(scene.messages) + images} messages on {len(scene.topics) + (1 if images else 0)} "
               f"topics, {images} image(s), chunks {compression or 'uncompressed'}, {seconds:.2f} s)")
         for note in scene.notes:
             print(f"{prog}: note: {note}")

@@ -3,16 +3,18 @@ topic, JSON-encoded messages (compact, finite numbers only) in time order."""
 from __future__ import annotations
 
 import json
+import pathlib
+from typing import BinaryIO, Callable
 
 from omniloc.export import foxglove
 from omniloc.export import mcap
-from omniloc.export.scene import Scene
+from omniloc.export.scene import Scene, read_png
 
 _ENCODER = json.JSONEncoder(separators=(",", ":"), allow_nan=False, check_circular=False)
 
 
-def encode(scene: Scene, compress: bool = True) -> tuple[bytes, str]:
-    """The MCAP file of the scene and its chunk compression ("lz4" or "")."""
+def encode(scene: Scene, out: BinaryIO, compress: bool = True) -> str:
+    """Writes the MCAP file of the scene to `out`; returns its chunk compression ("lz4" or "")."""
     schema_ids: dict[str, int] = {}
     schemas: list[mcap.Schema] = []
     channels: list[mcap.Channel] = []
@@ -34,8 +36,14 @@ def encode(scene: Scene, compress: bool = True) -> tuple[bytes, str]:
     for topic, ns, payload in scene.messages:
         cid = channel(topic, *scene.topics[topic])
         messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=payload if isinstance(payload, bytes) else _ENCODER.encode(payload).encode("utf-8")))
-    for topic, ns, frame, png in scene.images:
+    for topic, ns, frame, path in scene.images:
         cid = channel(topic, "foxglove.CompressedImage", {})
-        messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns,
-                                     data=_ENCODER.encode(foxglove.compressed_image(ns, frame, png)).encode("utf-8")))
-    return mcap.build("omniloc export", schemas, channels, messages, compress=compress)
+        messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=_image_message(ns, frame, path)))
+    return mcap.write(out, "omniloc export", schemas, channels, messages, compress=compress)
+
+
+def _image_message(ns: int, frame: str, path: pathlib.Path) -> Callable[[], bytes]:
+    """The image's message, made when its chunk is written (InputFileError if it is no PNG)."""
+    def make() -> bytes:
+        return _ENCODER.encode(foxglove.compressed_image(ns, frame, read_png(path))).encode("utf-8")
+    return make

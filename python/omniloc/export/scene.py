@@ -47,7 +47,9 @@ class Scene:
     """Messages by topic, each topic with its schema name and channel metadata, in the order added."""
     topics: dict[str, tuple[str, dict[str, str]]] = field(default_factory=dict)
     messages: list[tuple[str, int, JSONObject | bytes]] = field(default_factory=list)  # bytes: already JSON
-    images: list[tuple[str, int, str, bytes]] = field(default_factory=list)  # topic, ns, frame, PNG (encoded last)
+    # Camera images: topic, ns, frame id, the PNG's path (checked to be a readable file; read while
+    # the file is written, one chunk at a time).
+    images: list[tuple[str, int, str, pathlib.Path]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
     def add(self, topic: str, schema: str, ns: int, message: JSONObject | bytes, latched: bool = False) -> None:
@@ -159,8 +161,8 @@ def _number_value(v: Optional[float]) -> JSON:
     return int(v) if v.is_integer() and abs(v) < 2**53 else v
 
 
-def run_scene(run: RunData, images: dict[int, dict[int, bytes]], particles: int) -> Scene:
-    """The run (omniloc.view.load.load_run) as messages; `images`: per robot, frame k -> PNG."""
+def run_scene(run: RunData, images: dict[int, dict[int, pathlib.Path]], particles: int) -> Scene:
+    """The run (omniloc.view.load.load_run) as messages; `images`: per robot, frame k -> its PNG."""
     scene = Scene(notes=list(run["notes"]))
     robots = run["robots"]
     first = foxglove.nanoseconds(robots[0]["t"][0]) if robots and robots[0]["t"] else 0
@@ -210,6 +212,13 @@ def _level(kind: Optional[str]) -> int:
 
 # ------------------------------------------------------------------------------------------ a recording
 
+def image_path(folder: pathlib.Path, rid: int, k: int) -> pathlib.Path:
+    """A recording's image of robot `rid` in frame k, checked to be a readable file."""
+    path = folder / "images" / f"r{rid}_{k:06d}.png"
+    check_file(path, "the frame's image (the recording says it holds every image)")
+    return path
+
+
 def read_png(path: pathlib.Path) -> bytes:
     """A recorded camera image's bytes; InputFileError unless it is a readable PNG."""
     check_file(path, "the frame's image (the recording says it holds every image)")
@@ -222,11 +231,10 @@ def read_png(path: pathlib.Path) -> bytes:
     return data
 
 
-def recording_scene(head: RecordingHeader, particles: int, image_every: int, with_images: bool) -> Scene:
+def recording_scene(head: RecordingHeader, image_every: int, with_images: bool) -> Scene:
     """A recording (omniloc record, or a real robot's log) as messages: truth (where recorded), else
     the odometry integrated from each robot's start (or the origin), with line points and blobs in
     that robot frame; the frames' numbers; events; images."""
-    del particles  # a recording holds no localizer state
     frames = read_frames(head)
     fpath = head.frames_path
     scene = Scene()
@@ -288,8 +296,7 @@ def recording_scene(head: RecordingHeader, particles: int, image_every: int, wit
                     nums[key] = cam[key]
             scene.add(f"/r{rid}/numbers", foxglove.FRAME_NUMBERS, ns, nums)
             if with_images and head.images and f.k % image_every == 0:
-                png = read_png(head.folder / "images" / f"r{rid}_{f.k:06d}.png")
-                scene.images.append((f"/r{rid}/camera", ns, f"r{rid}/camera", png))
+                scene.images.append((f"/r{rid}/camera", ns, f"r{rid}/camera", image_path(head.folder, rid, f.k)))
         for ev in f.events + [e for i in range(len(ids)) for e in lst(f.robot(i).get("events"))]:
             e = obj(ev)
             t = e.get("t")
