@@ -28,7 +28,8 @@ their transforms (world -> r0/truth, world -> r0/estimate), the frame's line poi
 frame, particles, the 2-sigma ellipse and blobs (from RUN_DIR/view.jsonl, `omniloc run
 --debug-view`, else from --recording), camera images (a recording made with --images), frames.csv's
 numbers for plots and the events as a log. Messages use the Foxglove schemas in JSON encoding and
-are stamped with their frame's t. docs/foxglove_layout.json is a layout for them.
+are stamped with their frame's t. docs/foxglove_layout.json (installed: /usr/share/doc/omniloc/) is
+a Foxglove layout for them.
 
 INPUT is a run folder (omniloc run / replay -o DIR), a recording (omniloc record -o DIR) or a sweep
 folder (omniloc sweep): for a sweep, -o names a folder and each run becomes OUT/<run>.mcap."""
