@@ -280,6 +280,14 @@ class Export(unittest.TestCase):
         shutil.copytree(self.rec_img, rec)
         (rec / "images" / "r0_000003.png").write_bytes(b"not a png")
         self.assert_bad([rec], ["r0_000003.png", "PNG"], out)
+        hw = self.tmp / "nan_truth"
+        shutil.copytree(ROOT / "tests" / "data" / "handwritten_recording", hw)
+        lines = (hw / "frames.jsonl").read_text().splitlines(True)
+        frame = json.loads(lines[2])
+        frame["robots"][0]["truth"] = [1.0, "x", 0.2]
+        lines[2] = json.dumps(frame) + "\n"
+        (hw / "frames.jsonl").write_text("".join(lines))
+        self.assert_bad([hw], ["frames.jsonl line 3", "`truth`", "finite numbers"], out)
         self.assert_bad([self.run_k, "--recording", self.rec_img], ["recording.json", "frames"], out)
         self.assert_bad([self.runs["matching"], "--recording", self.tmp / "no_rec"], ["no_rec", "--recording"], out)
         self.assert_bad([self.runs["matching"]], ["missing_folder: missing", "existing folder"], out_dir / "missing_folder" / "x.mcap")

@@ -181,6 +181,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     except InputFileError as e:
         print(f"{prog}: {e}", file=sys.stderr)
         return 2
+    except ValueError as e:  # the JSON encoder refuses a number that is not finite: a reader let one through
+        print(f"{prog}: {folder}: a value that is not a finite number ({e}); expected finite numbers everywhere", file=sys.stderr)
+        return 2
     except OSError as e:
         print(f"{prog}: {out}: cannot write ({e.strerror or e})", file=sys.stderr)
         return 2

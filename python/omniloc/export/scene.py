@@ -19,6 +19,7 @@ Every message's log and publish time is its frame's t (nanoseconds from the run'
 """
 from __future__ import annotations
 
+import json
 import math
 import pathlib
 from dataclasses import dataclass, field
@@ -231,6 +232,18 @@ def read_png(path: pathlib.Path) -> bytes:
     return data
 
 
+def _triple(robot: JSONObject, key: str, path: pathlib.Path, line: int) -> Optional[list[float]]:
+    """`key`'s [x, y, theta] of a recording's robot; None where absent or null; InputFileError where
+    it is something else (docs/recording.md section 4)."""
+    v = robot.get(key)
+    if v is None:
+        return None
+    xs = numbers(v)
+    if xs is None or len(xs) != 3 or not all(math.isfinite(x) for x in xs):
+        raise InputFileError(path, f"`{key}`: expected [x, y, theta], three finite numbers, got {json.dumps(v)[:60]}", line)
+    return xs
+
+
 def recording_scene(head: RecordingHeader, image_every: int, with_images: bool) -> Scene:
     """A recording (omniloc record, or a real robot's log) as messages: truth (where recorded), else
     the odometry integrated from each robot's start (or the origin), with line points and blobs in
@@ -250,7 +263,7 @@ def recording_scene(head: RecordingHeader, image_every: int, with_images: bool) 
     starts: dict[int, tuple[float, float, float]] = {}
     for r in lst(head.raw.get("robots")):
         rid, start = obj(r).get("id"), numbers(obj(r).get("start"))
-        if isinstance(rid, int) and start is not None and len(start) == 3:
+        if isinstance(rid, int) and start is not None and len(start) == 3 and all(math.isfinite(x) for x in start):
             starts[rid] = (start[0], start[1], start[2])
     odo: dict[int, tuple[float, float, float]] = {}
     for f in frames:
@@ -261,15 +274,15 @@ def recording_scene(head: RecordingHeader, image_every: int, with_images: bool) 
             rid = r.get("robot")
             if not isinstance(rid, int) or rid != rid_json:
                 raise InputFileError(fpath, f"expected robot {rid_json} in place {i}", n)
-            truth = numbers(r.get("truth"))
+            truth = _triple(r, "truth", fpath, n)
             if truth is not None and len(truth) == 3:
                 frame = f"r{rid}/truth"
                 pose = (truth[0], truth[1], truth[2])
                 scene.add(f"/r{rid}/truth", "foxglove.PoseInFrame", ns, foxglove.pose_in_frame(ns, WORLD, *pose))
             else:
                 frame = f"r{rid}/odometry"
-                step = numbers(r.get("odometry"))
-                if step is None or len(step) != 3:
+                step = _triple(r, "odometry", fpath, n)
+                if step is None:
                     raise InputFileError(fpath, "`odometry`: expected [dx, dy, dtheta]", n)
                 x, y, th = odo.get(rid, starts.get(rid, (0.0, 0.0, 0.0)))
                 pose = (x + step[0] * math.cos(th) - step[1] * math.sin(th), y + step[0] * math.sin(th) + step[1] * math.cos(th),
@@ -287,7 +300,7 @@ def recording_scene(head: RecordingHeader, image_every: int, with_images: bool) 
             heading = r.get("heading")
             if finite(heading):
                 nums["heading"] = heading
-            step_o = numbers(r.get("odometry"))
+            step_o = _triple(r, "odometry", fpath, n)
             if step_o is not None and len(step_o) == 3:
                 nums["odometry_dx"], nums["odometry_dy"], nums["odometry_dtheta"] = step_o
             cam = obj(r.get("camera"))
