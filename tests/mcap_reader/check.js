@@ -143,6 +143,28 @@ function robotIds(runDir) {
   return ids;
 }
 
+// Each /r<id>/numbers message against frames.csv's row: every non-empty cell (but robot) as the
+// same number (mode as its text), no key for an empty cell.
+function compareNumbers(kind, msgs, runDir, id) {
+  const lines = fs.readFileSync(path.join(runDir, "frames.csv"), "utf8").split("\n").filter((l) => l);
+  const header = lines[0].split(",");
+  const rows = lines.slice(1).map((l) => l.split(",")).filter((r) => Number(r[header.indexOf("robot")]) === id);
+  if (!check(msgs.length === rows.length, `${kind}: ${msgs.length} messages, frames.csv has ${rows.length} rows of r${id}`)) return 0;
+  let n = 0;
+  rows.forEach((row, k) => {
+    const m = msgs[k].msg;
+    check(m.k === k && msgs[k].logTime === ns(Number(row[header.indexOf("t")])), `${kind} ${k}: frame or time`);
+    header.forEach((col, j) => {
+      if (col === "robot") return;
+      n += 1;
+      if (col === "mode") check(m.mode === row[j], `${kind} ${k}: mode ${m.mode}, frames.csv ${row[j]}`);
+      else if (row[j] === "") check(!(col in m), `${kind} ${k}: ${col} given, frames.csv's cell is empty`);
+      else check(m[col] === Number(row[j]), `${kind} ${k}: ${col} ${m[col]}, frames.csv ${row[j]}`);
+    });
+  });
+  return n;
+}
+
 function comparePoses(kind, msgs, rows, file) {
   if (!check(msgs.length === rows.length, `${kind}: ${msgs.length} messages, ${file} has ${rows.length} rows`)) return;
   rows.forEach((row, i) => {
@@ -339,6 +361,7 @@ async function main() {
       ? fs.readFileSync(path.join(runDir, "view.jsonl"), "utf8").split("\n").filter((l) => l.trim()).map((l) => JSON.parse(l)) : null;
     ids.forEach((id, i) => {
       const suffix = i === 0 ? "" : `_r${id}`;
+      summary.numbers = (summary.numbers || 0) + compareNumbers(`/r${id}/numbers`, byTopic.get(`/r${id}/numbers`) || [], runDir, id);
       const est = readTum(path.join(runDir, `est${suffix}.tum`));
       comparePoses(`/r${id}/estimate`, byTopic.get(`/r${id}/estimate`) || [], est, `est${suffix}.tum`);
       poses += est.length;

@@ -18,6 +18,7 @@ from typing import BinaryIO, Callable, List, NoReturn, Optional
 from omniloc.core import pathcheck, rundir
 from omniloc.core.files import InputFileError
 from omniloc.core.recording import load_header
+from omniloc.core.runfiles import read_frame_table
 from omniloc.export.encode import encode
 from omniloc.export.scene import Scene, image_path, recording_scene, run_scene
 from omniloc.view.load import load_run
@@ -124,7 +125,7 @@ def scene_of(folder: Path, kind: str, args: argparse.Namespace) -> Scene:
     if recording is not None and images and run["recording_images"]:
         for r in run["robots"]:
             pngs[r["id"]] = {k: image_path(recording, r["id"], k) for k in range(0, run["frames"], args.image_every)}
-    scene = run_scene(run, pngs, args.particles)
+    scene = run_scene(run, read_frame_table(folder / "frames.csv"), pngs, args.particles)
     if run["debug_source"] is None:
         scene.notes.append("no view.jsonl (omniloc run --debug-view) and no --recording: no line points, particles or ellipse")
     return scene

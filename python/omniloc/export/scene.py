@@ -30,6 +30,7 @@ from omniloc.core.files import InputFileError, check_file
 from omniloc.core.framedata import Blob, blobs, pairs
 from omniloc.core.jsonvalue import JSON, JSONObject, finite, lst, numbers, obj, text
 from omniloc.core.recording import RecordingHeader, read_frames
+from omniloc.core.runfiles import FrameTable
 from omniloc.core.viewlog import Debug
 from omniloc.export import foxglove
 from omniloc.view.load import event_label
@@ -162,8 +163,9 @@ def _number_value(v: Optional[float]) -> JSON:
     return int(v) if v.is_integer() and abs(v) < 2**53 else v
 
 
-def run_scene(run: RunData, images: dict[int, dict[int, pathlib.Path]], particles: int) -> Scene:
-    """The run (omniloc.view.load.load_run) as messages; `images`: per robot, frame k -> its PNG."""
+def run_scene(run: RunData, table: FrameTable, images: dict[int, dict[int, pathlib.Path]], particles: int) -> Scene:
+    """The run (omniloc.view.load.load_run) as messages; `table`: its frames.csv (each frame's
+    numbers); `images`: per robot, frame k -> its PNG."""
     scene = Scene(notes=list(run["notes"]))
     robots = run["robots"]
     first = foxglove.nanoseconds(robots[0]["t"][0]) if robots and robots[0]["t"] else 0
@@ -172,10 +174,9 @@ def run_scene(run: RunData, images: dict[int, dict[int, pathlib.Path]], particle
         rid = r["id"]
         debug = r["debug"]
         est_frame, truth_frame = f"r{rid}/estimate", f"r{rid}/truth"
-        columns: dict[str, list[Optional[float]]] = {"err_pos": r["err_pos"], "err_theta": r["err_theta"],
-                                                     "match_error": r["match_error"], "line_points": r["line_points"],
-                                                     **r["extra"]}
-        flags = {"camera_ok": r["camera_ok"], "contact": r["contact"]}
+        # Every column of frames.csv, whatever the build wrote (the localizer's own, the accuracy
+        # bounds): a Plot panel can then plot any of them.
+        columns = {name: col for name, col in table.columns[rid].items() if name != "t"}
         for k, t in enumerate(r["t"]):
             ns = foxglove.nanoseconds(t)
             e = r["estimate"][k]
@@ -186,14 +187,11 @@ def run_scene(run: RunData, images: dict[int, dict[int, pathlib.Path]], particle
             scene.add("/tf", "foxglove.FrameTransform", ns, foxglove.frame_transform(ns, WORLD, est_frame, e.x, e.y, e.theta))
             if r["est_from_tum"][k]:
                 scene.add(f"/r{rid}/estimate", "foxglove.PoseInFrame", ns, foxglove.pose_in_frame(ns, WORLD, e.x, e.y, e.theta))
-            nums: JSONObject = {"timestamp": foxglove.stamp(ns), "t": t, "k": k, "valid": 1 if r["valid"][k] else 0, "mode": r["mode"][k]}
+            nums: JSONObject = {"timestamp": foxglove.stamp(ns), "t": t, "k": k, "mode": table.modes[rid][k]}
             for name, col in columns.items():
                 v = _number_value(col[k])
                 if v is not None:
                     nums[name] = v
-            for name, fl in flags.items():
-                if fl[k] is not None:
-                    nums[name] = 1 if fl[k] else 0
             scene.add(f"/r{rid}/numbers", foxglove.FRAME_NUMBERS, ns, nums)
             if debug is not None:
                 add_debug(scene, rid, ns, est_frame, debug[k], (e.x, e.y, e.theta), particles)
