@@ -44,7 +44,8 @@ def prepare_reader():
     if not (stamp.exists() and stamp.read_bytes() == lock and (READER / "node_modules").is_dir()):
         r = subprocess.run([npm, "ci", "--no-audit", "--no-fund", "--loglevel=error"], cwd=READER, capture_output=True, text=True, timeout=600)
         if r.returncode != 0:
-            return None, f"npm ci could not install the pinned @mcap/core and @foxglove/schemas (no network?): {r.stderr.strip()[-400:]}"
+            first = " / ".join(line.strip() for line in r.stderr.strip().splitlines()[:2])
+            return None, f"npm ci could not install the pinned @mcap/core and @foxglove/schemas (no network?): {first[:300]}"
         stamp.write_bytes(lock)
     return node, None
 
