@@ -35,7 +35,8 @@ def encode(scene: Scene, out: BinaryIO, compress: bool = True) -> str:
     messages: list[mcap.Message] = []
     for topic, ns, payload in scene.messages:
         cid = channel(topic, *scene.topics[topic])
-        messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=payload if isinstance(payload, bytes) else _ENCODER.encode(payload).encode("utf-8")))
+        data = payload if isinstance(payload, bytes) else _ENCODER.encode(payload).encode("utf-8")
+        messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=data))
     for topic, ns, frame, path in scene.images:
         cid = channel(topic, "foxglove.CompressedImage", {})
         messages.append(mcap.Message(channel_id=cid, log_time=ns, publish_time=ns, data=_image_message(ns, frame, path)))

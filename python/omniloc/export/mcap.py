@@ -5,8 +5,9 @@ offsets and the footer with the summary's CRC, so a reader seeks by time without
 
 Messages are given whole (write() takes them all): an export knows every message before it writes,
 and writing the data section in one pass from a sorted list keeps chunk boundaries and therefore the
-bytes the same for the same input. The file is written as it is made, a chunk at a time. Chunks are compressed with LZ4 frames (Debian's python3-lz4, a
-dependency of python3-matplotlib) where the module is importable, else stored uncompressed ("").
+bytes the same for the same input. The file is written as it is made, a chunk at a time. Chunks are
+compressed with LZ4 frames (Debian's python3-lz4, a dependency of python3-matplotlib) where the
+module is importable, else stored uncompressed ("").
 """
 from __future__ import annotations
 

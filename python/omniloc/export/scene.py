@@ -152,8 +152,10 @@ def add_debug(scene: Scene, rid: int, ns: int, frame: str, d: Debug, estimate: t
         scene.add(f"/r{rid}/points", "foxglove.PointCloud", ns, foxglove.point_cloud(ns, WORLD, d.points))
     if d.covariance is not None:
         e = ellipse_2sigma(d.covariance)
-        cyl: list[JSON] = [] if e is None else [foxglove.cylinder(estimate[0], estimate[1], e[2], e[0], e[1], 0.01, foxglove.color(1.0, 0.9, 0.0, 0.35))]
-        scene.add(f"/r{rid}/uncertainty", "foxglove.SceneUpdate", ns, foxglove.scene_update([foxglove.entity(ns, WORLD, "ellipse_2sigma", cylinders=cyl)]))
+        cyl: list[JSON] = [] if e is None else [
+            foxglove.cylinder(estimate[0], estimate[1], e[2], e[0], e[1], 0.01, foxglove.color(1.0, 0.9, 0.0, 0.35))]
+        update = foxglove.scene_update([foxglove.entity(ns, WORLD, "ellipse_2sigma", cylinders=cyl)])
+        scene.add(f"/r{rid}/uncertainty", "foxglove.SceneUpdate", ns, update)
 
 
 def _number_value(v: Optional[float]) -> JSON:
