@@ -673,7 +673,7 @@ int main(int argc, char** argv) {
     std::cout << version_line() << "\n";
     return 0;
   }
-  for (const char* py_cmd : {"compare", "gate", "report", "paper-table", "global-start", "view"})
+  for (const char* py_cmd : {"compare", "gate", "report", "paper-table", "global-start", "view", "export"})
     if (cmd == py_cmd) {
       std::string module = cmd;
       std::replace(module.begin(), module.end(), '-', '_');

@@ -27,7 +27,8 @@ install(PROGRAMS scripts/ci_recipe.py DESTINATION ${OMNILOC_SHARE}/scripts)
 # (source only; the clients' own tests stay in the tree).
 install(DIRECTORY clients/python clients/cpp DESTINATION ${OMNILOC_SHARE}/clients
         PATTERN __pycache__ EXCLUDE PATTERN *.pyc EXCLUDE)
-install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} FILES_MATCHING PATTERN *.md PATTERN *.png PATTERN *.svg PATTERN *.jpg)
+install(DIRECTORY docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} FILES_MATCHING PATTERN *.md PATTERN *.png PATTERN *.svg PATTERN *.jpg
+        PATTERN foxglove_layout.json)  # the layout for omniloc export's MCAP files (docs/viewer.md section 8)
 install(FILES README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
 
 # --- Debian package (CPack DEB) -----------------------------------------------------------------

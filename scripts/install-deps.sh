@@ -31,6 +31,14 @@ PKGS=(
   dpkg-dev file  # scripts/package.sh: dpkg-shlibdeps computes the .deb's Depends; cpack tests ELF files with file
   libxml2-utils python3-yaml  # tests: xmllint validates omniloc gate's JUnit XML; the CI recipe test reads docs/ci.md's YAML
   python3-pytest mypy  # the results package's tests (python/tests, ctest results_pytest) and type check (results_mypy)
+  # omniloc export's MCAP chunk compression (LZ4 frames). Already there with python3-matplotlib (its
+  # python3-fonttools depends on it), named because the export imports it: not a new download, and
+  # chunks stay readable by every MCAP reader (lz4 is one of the two compressions the format names).
+  python3-lz4
+  # tests: ctest mcap_export_py reads the exported MCAP files with the MCAP project's reader
+  # (@mcap/core, `npm ci` from tests/mcap_reader/package-lock.json). A nodejs that carries npm itself
+  # (NodeSource's, which provides and conflicts with Debian's npm) counts as having npm.
+  nodejs npm
 )
 # --report-check: also Debian's chromium, for the headless check of report.html
 # (scripts/check_report_html.py; .ci/run). Not needed to build, test or run the suite.
@@ -39,7 +47,9 @@ if [ "${1:-}" = "--report-check" ]; then
 fi
 missing=()
 for p in "${PKGS[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" && continue
+  [ "$p" = npm ] && command -v npm >/dev/null && continue
+  missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#PKGS[@]} packages present"

@@ -2,6 +2,7 @@
 every import of every module, as scripts/check_layers.py checks the C++ includes (ctest layering):
 
     core  <-  tools  <-  compare, gate, global_start, data  <-  paper  <-  view  <-  report  <-  commands
+                                                                          view  <-  export  <-  commands
 
 A module may import its own layer and those its layer lists in ALLOWED, nothing else of the package;
 imports inside functions and those for the type checker alone count as well. The third-party
@@ -25,11 +26,13 @@ ALLOWED = {
     "paper": {"core", "tools", "judges"},  # the papers' tables and claims (a claim may read a global-start row)
     "view": {"core", "tools"},  # the run viewer
     "report": {"core", "tools", "judges", "data", "paper", "view"},  # the report, and the terminal's paper tables
-    "commands": {"core", "tools", "judges", "data", "paper", "view", "report"},
+    "export": {"core", "view"},  # MCAP for Foxglove: the run as the viewer loads it
+    "commands": {"core", "tools", "judges", "data", "paper", "view", "report", "export"},
 }
 # Third-party modules and the only modules that may import them.
 THIRD_PARTY = {"matplotlib": {"omniloc.tools.plot"}, "PIL": {"omniloc.tools.images"},
-               "numpy": {"omniloc.data.nubot", "omniloc.data.nubot_frames", "omniloc.report.real_robots"}}
+               "numpy": {"omniloc.data.nubot", "omniloc.data.nubot_frames", "omniloc.report.real_robots"},
+               "lz4": {"omniloc.export.mcap"}}
 
 
 def layer_of(module):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import gzip
 import json
 import pathlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional
 
 from omniloc.core.files import InputFileError, check_file, json_lines, read_text
@@ -117,12 +117,13 @@ def load_header(folder: pathlib.Path) -> RecordingHeader:
 
 @dataclass(frozen=True)
 class RecordingFrame:
-    """One frame of a recording: its line in the frames file, index k, time t, and each robot's raw
-    object (in the header's robot order)."""
+    """One frame of a recording: its line in the frames file, index k, time t, each robot's raw
+    object (in the header's robot order) and the scenario's events applied on the way to it."""
     line: int
     k: int
     t: float
     robots: list[JSON]
+    events: list[JSON] = field(default_factory=list)
 
     def robot(self, index: int) -> JSONObject:
         """The `index`-th robot's object ({} where there is none or it is not an object)."""
@@ -149,5 +150,8 @@ def read_frames(header: RecordingHeader) -> list[RecordingFrame]:
         robots = f.get("robots") if isinstance(f, dict) else None
         if not isinstance(f, dict) or f.get("k") != n - 1 or not finite(t) or not isinstance(robots, list):
             raise InputFileError(fpath, f"expected a frame {{\"k\": {n - 1}, \"t\", \"robots\": [...]}}", n)
-        out.append(RecordingFrame(line=n, k=n - 1, t=t, robots=lst(robots)))
+        events = f.get("events", [])
+        if not isinstance(events, list):
+            raise InputFileError(fpath, "`events`: expected a list of event objects (docs/recording.md section 4)", n)
+        out.append(RecordingFrame(line=n, k=n - 1, t=t, robots=lst(robots), events=events))
     return out
