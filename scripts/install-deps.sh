@@ -1,22 +1,28 @@
 #!/usr/bin/env bash
 # Installs every Debian package omniloc needs, only when something is missing.
-# Usage: scripts/install-deps.sh [--report-check]
+# Usage: scripts/install-deps.sh [--report-check] [--mcap-check]
 # OpenCV: we take the split -dev packages (core, imgproc, imgcodecs); they are ~10x smaller than
 # libopencv-dev but ship no CMake config, so CMakeLists.txt finds headers and libraries itself.
 # The program links core and imgproc; imgcodecs only the test that compares our PNG/JPEG files with it.
 set -euo pipefail
-case "${1:-}" in
-  -h|--help)
-    cat <<'USAGE'
-usage: scripts/install-deps.sh [--report-check]
+report_check="" mcap_check=""
+for arg in "$@"; do
+  case "$arg" in
+    -h|--help)
+      cat <<'USAGE'
+usage: scripts/install-deps.sh [--report-check] [--mcap-check]
 Installs, with apt (sudo when not root), the Debian 12 packages omniloc needs to build, test and run,
 and only those that are missing; does nothing when all are present.
   --report-check  also Debian's chromium, for the headless check of report.html (scripts/check_report_html.py)
+  --mcap-check    also Debian's nodejs and npm, for the check of omniloc export's MCAP files by the
+                  MCAP project's own reader (ctest mcap_export_py; skipped, saying why, without them)
 USAGE
-    exit 0 ;;
-  ""|--report-check) ;;
-  *) echo "install-deps: unknown option $1 (try --help)" >&2; exit 2 ;;
-esac
+      exit 0 ;;
+    --report-check) report_check=1 ;;
+    --mcap-check) mcap_check=1 ;;
+    *) echo "install-deps: unknown option $arg (try --help)" >&2; exit 2 ;;
+  esac
+done
 PKGS=(
   build-essential cmake pkg-config git
   libbox2d-dev libeigen3-dev nlohmann-json3-dev
@@ -35,16 +41,16 @@ PKGS=(
   # python3-fonttools depends on it), named because the export imports it: not a new download, and
   # chunks stay readable by every MCAP reader (lz4 is one of the two compressions the format names).
   python3-lz4
-  # tests: ctest mcap_export_py reads the exported MCAP files with the MCAP project's reader
-  # (@mcap/core, `npm ci` from tests/mcap_reader/package-lock.json). A nodejs that carries npm itself
-  # (NodeSource's, which provides and conflicts with Debian's npm) counts as having npm.
-  nodejs npm
 )
 # --report-check: also Debian's chromium, for the headless check of report.html
 # (scripts/check_report_html.py; .ci/run). Not needed to build, test or run the suite.
-if [ "${1:-}" = "--report-check" ]; then
-  PKGS+=(chromium)
-fi
+[ -z "$report_check" ] || PKGS+=(chromium)
+# --mcap-check: ctest mcap_export_py reads the exported MCAP files with the MCAP project's reader
+# (@mcap/core, `npm ci` from tests/mcap_reader/package-lock.json). Not in the default list: Debian's
+# npm brings about 420 packages, which a user who never checks MCAP files should not download; .ci/run
+# asks for them. A nodejs that carries npm itself (NodeSource's, which provides and conflicts with
+# Debian's npm) counts as having npm.
+[ -z "$mcap_check" ] || PKGS+=(nodejs npm)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" && continue

@@ -11,7 +11,8 @@ same input giving the same bytes, and bad input (exit 2 naming the file, nothing
 
 The Node packages are installed with `npm ci` from the lockfile into $OMNILOC_MCAP_READER_DIR
 (default build/mcap_reader). Without node or npm, or when npm cannot install (no network), the file
-says why and exits 77 (ctest: skipped).
+says why and exits 77 (ctest: skipped), unless OMNILOC_MCAP_CHECK=required (.ci/run sets it after
+installing them with `scripts/install-deps.sh --mcap-check`): then a missing reader fails the test.
 """
 import json
 import os
@@ -347,7 +348,8 @@ class Export(unittest.TestCase):
 
 if __name__ == "__main__":
     if NODE is None:
-        print(f"mcap_export_test: skipped: {WHY_NOT}", file=sys.stderr)
-        sys.exit(SKIP)
+        required = os.environ.get("OMNILOC_MCAP_CHECK") == "required"
+        print(f"mcap_export_test: {'FAILED (OMNILOC_MCAP_CHECK=required)' if required else 'skipped'}: {WHY_NOT}", file=sys.stderr)
+        sys.exit(1 if required else SKIP)
     result = unittest.main(exit=False, verbosity=2).result
     sys.exit(0 if result.wasSuccessful() else 1)
