@@ -23,6 +23,11 @@ estimate counting as outside) and the share of frames answered (valid_fraction);
 (position RMSE, mean x / y / heading, ...) follow and are over the answered frames only. A
 statistic that is null in some run (no estimate: no frame answered) is never averaged away: its
 row says "no estimate in k of n runs" for that side instead of a t-test on the remaining seeds.
+
+The accuracy limit (docs/results.md), where the runs carry it: after the errors, the efficiency (RMSE
+/ Cramer-Rao bound of the same frames: 1 is the limit), the share of frames it covers, the bound and
+the relative pose error over a frame and a second; a run without a bound reads "no bound in k of n
+runs", never 0. Runs made before the bound have none of these rows.
 Exit code 0; 2 on bad arguments or folders without results.
 """
 from __future__ import annotations
