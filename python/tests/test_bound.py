@@ -228,3 +228,25 @@ def test_viewer_draws_the_posterior_bound_and_leaves_old_pages_alone(tmp_path):
     assert "raw.boundPos" in page_new and "<bound>" in page_new
     assert "boundPos" not in page_data(page_old)["robots"][0]
     assert "bound" not in page_old.split('id="omniloc-data"')[1].split("</script>", 1)[1], "the bound's drawing is left out of an old page"
+
+
+def test_seed_table_and_run_table_in_a_written_report(tmp_path):
+    from omniloc.report import runs as RRUNS, seeds as RSEED
+    from omniloc.tools import markup
+    sel = write_side(tmp_path / "r", [1.3, 1.5, None])
+    rep = markup.Report(tmp_path / "out", "t")
+    RSEED.seed_table(rep, [("tracking", sorted(sel, key=lambda r: r.seed))])
+    RRUNS.report_run(rep, sel[0], plots=False)
+    rep.write()
+    md = (tmp_path / "out" / "report.md").read_text()
+    nb = "\u00a0"
+    assert f"seeds: s1{nb}1.30, s2{nb}1.50, s3{nb}no bound (no bound in 1 of 3 runs: the mean is over the others) (bound in 64 % of frames" in md
+    assert "| RMSE against the limit |" in md and "3.9 cm, 1.30x the limit (bound in 97 % of frames)" in md
+    old = tmp_path / "old"
+    write_run(old / "s1", "tracking", "matching", 1, {}, scored(robot(3.9)), start_pose_given=True, scoring=SCORING)
+    rep = markup.Report(tmp_path / "out_old", "t")
+    RSEED.seed_table(rep, [("tracking", discover([old])[0])])
+    RRUNS.report_run(rep, discover([old])[0][0], plots=False)
+    rep.write()
+    md = (tmp_path / "out_old" / "report.md").read_text()
+    assert "limit" not in md and "bound" not in md
