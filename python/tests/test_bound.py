@@ -250,3 +250,14 @@ def test_seed_table_and_run_table_in_a_written_report(tmp_path):
     rep.write()
     md = (tmp_path / "out_old" / "report.md").read_text()
     assert "limit" not in md and "bound" not in md
+
+
+def test_localizer_rows_for_the_efficiency_table(tmp_path):
+    runs = (write_side(tmp_path / "t", [1.2, 1.4], scenario="tracking") + write_side(tmp_path / "o", [None], scenario="occlusion_002")
+            + write_side(tmp_path / "m", [3.0], scenario="tracking", localizer="mcl"))
+    assert limit.localizer_rows(runs) == [["matching", "occlusion", "1", "no bound", "no bound", "-", "1"],
+                                          ["matching", "tracking", "2", "1.30x", "1.10x", "97 %", "0"],
+                                          ["mcl", "tracking", "1", "3.00x", "1.10x", "97 %", "0"]]
+    p = subprocess.run([PY, str(pathlib.Path(__file__).resolve().parents[2] / "scripts" / "limit_table.py"), str(tmp_path)],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and "| matching | tracking | 2 | 1.30x | 1.10x | 97 % | 0 |" in p.stdout, p.stdout + p.stderr

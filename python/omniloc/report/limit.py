@@ -7,6 +7,7 @@ what it was. A bound that is null reads "no bound" with its reason, never 0.
 """
 from __future__ import annotations
 
+import math
 import statistics
 from dataclasses import dataclass
 from typing import Optional
@@ -202,3 +203,26 @@ def aggregate_share_cell(g: AggregateGroup, phase: bool) -> str:
 def sweep_has_limit(groups: list[AggregateGroup]) -> bool:
     return any(g.limit_metric("efficiency_position") is not None or g.limit_metric("bound_position_rms_m") is not None for g in groups)
 
+
+
+LOCALIZER_HEADER = ["localizer", "scenario family", "runs", "position RMSE / bound", "heading RMSE / bound", "frames with a bound", "runs without a bound"]
+
+
+def localizer_rows(runs: list[Run]) -> list[list[str]]:
+    """Per localizer and scenario family: the mean over runs of the position and heading efficiency,
+    the mean share of frames they cover, and the runs without a bound (docs/localizers.md's table of
+    the built-in localizers on the paper suite is made of these rows; scripts/limit_table.py)."""
+    by: dict[tuple[str, str], list[RobotBound]] = {}
+    for r in runs:
+        rb = r.bound()
+        if rb is not None:
+            by.setdefault((str(r.localizer), bound.family(r.scenario)), []).append(rb)
+    rows = []
+    for (loc, fam), rbs in sorted(by.items()):
+        effs = [rb.efficiency for rb in rbs if rb.efficiency is not None and rb.efficiency.position is not None]
+        pos = mean([e.position for e in effs if e.position is not None])
+        head = mean([e.heading for e in effs if e.heading is not None])
+        share = mean([e.share for e in effs if e.share is not None])
+        rows.append([loc, fam, str(len(rbs)), "no bound" if pos is None else f"{pos:.2f}x", "no bound" if head is None else f"{head:.2f}x",
+                     "-" if share is None else f"{math.floor(100.0 * share + 1e-9):d} %", str(len(rbs) - len(effs))])
+    return rows
