@@ -261,3 +261,10 @@ def test_localizer_rows_for_the_efficiency_table(tmp_path):
     p = subprocess.run([PY, str(pathlib.Path(__file__).resolve().parents[2] / "scripts" / "limit_table.py"), str(tmp_path)],
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 0 and "| matching | tracking | 2 | 1.30x | 1.10x | 97 % | 0 |" in p.stdout, p.stdout + p.stderr
+
+
+def test_viewer_says_no_bound_where_the_columns_are_empty(tmp_path):
+    run = write_viewable_run(tmp_path / "no_truth")
+    with_bound_columns(run, every_without=1)  # every frame without a bound
+    r = page_data(render(load_run(run, images=False)))["robots"][0]
+    assert r["boundKind"] == "none" and set(r["boundPos"]) == {None}, "no bound is null, never 0"

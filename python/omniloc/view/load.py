@@ -136,6 +136,8 @@ def load_run(run_dir: Path, recording: Optional[Path] = None, image_every: int =
             if any(v is not None for v in c.get(f"{prefix}_pos_m", [])):
                 kind = label
                 break
+        if kind is None and "bound_pos_m" in c:
+            kind = "none"  # the run scores the bound, and no frame has one (no truth): said, never drawn as 0
         prefix = "pbound" if kind == "posterior" else "bound"
         robots.append(RobotRun(id=rid, radius=radius.get(rid, 0.26), t=times[rid], truth=truth, estimate=estimate, est_from_tum=from_tum, valid=valid,
                                mode=modes[rid], camera_ok=flag("camera_ok"), line_points=col("line_points"),

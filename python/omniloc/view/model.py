@@ -28,7 +28,7 @@ class RobotRun(TypedDict):
     # bound_*; None where the frame has none); None for a run made before the bound.
     bound_pos: Optional[List[Optional[float]]]
     bound_theta: Optional[List[Optional[float]]]
-    bound_kind: Optional[str]  # "posterior" or "single frame"
+    bound_kind: Optional[str]  # "posterior", "single frame", or "none" where no frame has a bound
     contact: List[Optional[bool]]
     extra: Dict[str, List[Optional[float]]]  # the localizer's own frames.csv columns
     debug: Optional[List[Debug]]  # per frame

@@ -334,7 +334,8 @@
         }
         c.fillStyle = '#2e7d32';
         c.textAlign = 'right';
-        c.fillText('shaded: ' + raw.boundKind + ' bound, in ' + Math.floor(100 * covered / Math.max(1, n)) + ' % of frames', g.x1 - 4, s.y0 + 10);
+        c.fillText(covered ? 'shaded: ' + raw.boundKind + ' bound, in ' + Math.floor(100 * covered / Math.max(1, n)) + ' % of frames' : 'no bound in any frame',
+                   g.x1 - 4, s.y0 + 10);
         c.textAlign = 'left';
       }
       // </bound>

@@ -26,7 +26,8 @@
     // <bound> this frame's accuracy limit (standard deviation no unbiased estimator can beat), or why there is none
     if (raw.boundPos) {
       var bp = raw.boundPos[k], bt = raw.boundTh[k];
-      h += row(raw.boundKind + ' bound', bp === null ? 'no bound in this frame' : fmt(bp * 100, 1) + ' cm, ' + fmt(bt * 180 / Math.PI, 2) + '°');
+      h += row(raw.boundKind === 'none' ? 'bound' : raw.boundKind + ' bound',
+               bp === null ? 'no bound in this frame' : fmt(bp * 100, 1) + ' cm, ' + fmt(bt * 180 / Math.PI, 2) + '°');
     }
     // </bound>
     var e = raw.cov && raw.cov[k];
