@@ -268,3 +268,14 @@ def test_viewer_says_no_bound_where_the_columns_are_empty(tmp_path):
     with_bound_columns(run, every_without=1)  # every frame without a bound
     r = page_data(render(load_run(run, images=False)))["robots"][0]
     assert r["boundKind"] == "none" and set(r["boundPos"]) == {None}, "no bound is null, never 0"
+
+
+def test_the_texts_take_the_rmse_over_the_frames_the_efficiency_covers():
+    r = bounded(1.3)
+    r["efficiency"] = dict(r["efficiency"], rmse_m=0.052, bound_rms_m=0.04)  # over the frames with a bound, not all answered ones
+    rb = bound.read_robot_bound(r)
+    assert rb.error_m == 0.052 and rb.limit_m == 0.04
+    assert bound.robot_limit_text(rb) == "5.2 cm, 1.30x the limit (bound in 97 % of frames)"
+    del r["efficiency"]["rmse_m"], r["efficiency"]["bound_rms_m"]
+    rb = bound.read_robot_bound(r)
+    assert rb.error_m == RMSE and rb.limit_m == pytest.approx(RMSE / 1.3)

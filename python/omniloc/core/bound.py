@@ -117,13 +117,16 @@ class Efficiency:
     """RMSE / bound (summary.json "efficiency" against the posterior bound where the run tracks,
     "efficiency_single_frame" against the single-frame one): 1 is the limit, 1.3 is 30 % above it.
     None with why_null where undefined (no bound, no estimate). frames / share: the frames both the
-    error and the bound cover."""
+    error and the bound cover; rmse_m and bound_rms_m: the position RMSE and the bound's RMS over
+    those frames (None in a block that does not give them)."""
     position: Optional[float]
     heading: Optional[float]
     against: Optional[str]
     frames: int
     share: Optional[float]
     why_null: Optional[str]
+    rmse_m: Optional[float] = None
+    bound_rms_m: Optional[float] = None
 
     @staticmethod
     def from_json(raw: JSON) -> Optional[Efficiency]:
@@ -131,7 +134,8 @@ class Efficiency:
         if not e:
             return None
         return Efficiency(position=number(e.get("position")), heading=number(e.get("heading")), against=text(e.get("against")),
-                          frames=integer(e.get("frames")) or 0, share=number(e.get("share")), why_null=text(e.get("why_null")))
+                          frames=integer(e.get("frames")) or 0, share=number(e.get("share")), why_null=text(e.get("why_null")),
+                          rmse_m=number(e.get("rmse_m")), bound_rms_m=number(e.get("bound_rms_m")))
 
 
 @dataclass(frozen=True)
@@ -176,8 +180,19 @@ class RobotBound:
     rmse_m: Optional[float]
 
     @property
+    def error_m(self) -> Optional[float]:
+        """The position RMSE the efficiency is of: over the frames with both an estimate and a bound
+        where the efficiency block gives it, else the run's RMSE over its answered frames."""
+        if self.efficiency is not None and self.efficiency.rmse_m is not None:
+            return self.efficiency.rmse_m
+        return self.rmse_m
+
+    @property
     def limit_m(self) -> Optional[float]:
-        """The position bound the efficiency is taken against (posterior or single frame)."""
+        """The position bound the efficiency is taken against (posterior or single frame), over the
+        efficiency's frames where its block gives it."""
+        if self.efficiency is not None and self.efficiency.bound_rms_m is not None:
+            return self.efficiency.bound_rms_m
         if self.bound is None:
             return None
         against = self.efficiency.against if self.efficiency else None
@@ -286,7 +301,7 @@ def robot_limit_text(rb: Optional[RobotBound]) -> str:
     e = rb.efficiency
     if e is None:
         return limit_text(rb.rmse_m, None, None, NO_BOUND)
-    return limit_text(rb.rmse_m, e.position, e.share, e.why_null)
+    return limit_text(rb.error_m, e.position, e.share, e.why_null)
 
 
 _FAMILY = re.compile(r"^(.*?)(?:_\d.*)?$")

@@ -64,7 +64,7 @@ def family_limits(runs: list[Run]) -> list[FamilyLimit]:
         for r, rb in items:
             e = rb.efficiency.position if rb.efficiency else None
             if e is not None:
-                gap = rb.rmse_m - rb.limit_m if rb.rmse_m is not None and rb.limit_m is not None else None
+                gap = rb.error_m - rb.limit_m if rb.error_m is not None and rb.limit_m is not None else None
                 per_scenario.setdefault(str(r.scenario), []).append((e, gap))
         worst: Optional[tuple[str, float, Optional[float]]] = None
         for sc, vals in sorted(per_scenario.items()):
