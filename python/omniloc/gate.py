@@ -346,6 +346,10 @@ def judge(rules: Sequence[Rule], runs: list[Run], base_runs: Optional[list[Run]]
         paired_any = False
         for k in keys:
             vals, no_value, of = seed_counts(groups[k], metric)
+            if not of and limit_path(metric) is not None:
+                # Runs of a recording without truth score nothing, so they have no bound: "no bound", not bad input.
+                unscored = [r for r in groups[k] if r.summary.robots and all(rob.get("scored") is False for rob in r.summary.robots)]
+                no_value, of = len(unscored), len(unscored)
             if not of:
                 raise BadInput(f"rule {rule.index}: no run of {names[k]} has the metric {metric}")
             c = Check(rule=rule, metric=metric, key=k, label=names[k], values=vals, no_value=no_value, of=of,

@@ -279,3 +279,12 @@ def test_the_texts_take_the_rmse_over_the_frames_the_efficiency_covers():
     del r["efficiency"]["rmse_m"], r["efficiency"]["bound_rms_m"]
     rb = bound.read_robot_bound(r)
     assert rb.error_m == RMSE and rb.limit_m == pytest.approx(RMSE / 1.3)
+
+
+def test_gate_a_recording_without_truth_has_no_bound(tmp_path):
+    write_side(tmp_path / "r" / "a", [1.3], scenario="tracking")
+    unscored = {"robot": 0, "frames": 30, "valid_frames": 30, "scored": False, "why": "the recording has no ground truth: nothing was scored"}
+    write_run(tmp_path / "r" / "real", "nubot_robot1", "matching", 1, {}, unscored, start_pose_given=False)
+    p = run_gate(tmp_path, tmp_path / "r", [{"metric": "efficiency/position", "max": 1.5}])
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert "FAIL  nubot_robot1 / matching  r0/efficiency/position  no bound (n=0 of 1)" in p.stdout and "[no bound in 1 of 1 runs]" in p.stdout, p.stdout
