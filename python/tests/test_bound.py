@@ -148,7 +148,7 @@ def test_gate_fails_a_group_without_a_bound(tmp_path):
 
 @pytest.mark.parametrize("rule, fragment", [
     ({"metric": "efficiency/pos", "max": 1.5}, "/rules/0/metric: got \"efficiency/pos\", expected a number of the accuracy limit"),
-    ({"metric": "bound/prior/position_rms_m", "max": 0.1}, "/rules/0/metric: got \"bound/prior/position_rms_m\""),
+    ({"metric": "bound/posterior/position_rms", "max": 0.1}, "/rules/0/metric: got \"bound/posterior/position_rms\""),
     ({"metric": "efficiency/position", "max": 0}, "/rules/0/max: got 0, expected a positive ratio"),
     ({"metric": "r0/efficiency_single_frame/heading", "min": -1}, "/rules/0/min: got -1, expected a positive ratio"),
 ])
