@@ -20,6 +20,8 @@ sweep-level metric means robot 0's.
 No estimate: a statistic over zero answered frames is null in summary.json (never 0). A rule whose
 metric is null in any run of a group FAILS that group, "no estimate in N of M runs", whatever its
 limits, and so does a regression check: a run without estimates never passes an accuracy limit.
+recall/..., valid_fraction and recovered_fraction are higher-is-better: a rule on them regresses
+when they fall (unless the rule says "better").
 
 The accuracy limit (docs/results.md): "r0/efficiency/position" is the position RMSE over the
 Cramer-Rao bound of the same frames (1 is the limit; {"metric": "efficiency/position", "max": 1.5}
@@ -28,8 +30,6 @@ fails a localizer more than 50 % above it), "efficiency/heading" the same for th
 bound itself; "efficiency.position" may be written for "efficiency/position". Where a run has no
 bound (no truth, no frame with a finite bound) the efficiency is null and the rule fails the group,
 "no bound in N of M runs".
-recall/..., valid_fraction and recovered_fraction are higher-is-better: a rule on them regresses
-when they fall (unless the rule says "better").
 
 Exit 0 when every rule holds, 1 when any limit or regression fails, 2 on bad input (a missing or
 incomplete result folder, bad rules, an unknown metric, a rule that selects nothing) before any
