@@ -23,6 +23,11 @@ estimate counting as outside) and the share of frames answered (valid_fraction);
 (position RMSE, mean x / y / heading, ...) follow and are over the answered frames only. A
 statistic that is null in some run (no estimate: no frame answered) is never averaged away: its
 row says "no estimate in k of n runs" for that side instead of a t-test on the remaining seeds.
+
+The accuracy limit (docs/results.md), where the runs carry it: after the errors, the efficiency (RMSE
+/ Cramer-Rao bound of the same frames: 1 is the limit), the share of frames it covers, the bound and
+the relative pose error over a frame and a second; a run without a bound reads "no bound in k of n
+runs", never 0. Runs made before the bound have none of these rows.
 Exit code 0; 2 on bad arguments or folders without results.
 """
 from __future__ import annotations
@@ -31,7 +36,7 @@ import json
 import textwrap
 from typing import Callable, Iterator, NamedTuple, Optional, Sequence, Union
 
-from omniloc.core import metrics, pairing, stats
+from omniloc.core import bound, metrics, pairing, stats
 from omniloc.core.jsonvalue import JSON
 from omniloc.core.rundir import Run
 from omniloc.core.stats import SeedStats, Welch
@@ -54,9 +59,17 @@ class GroupKey(NamedTuple):
 Pair = tuple[GroupKey, GroupKey, list[str]]
 
 
+# The accuracy limit (core.bound), after the errors: how far the RMSE is from the Cramer-Rao bound
+# (efficiency, posterior bound where the run tracks), the bound itself, the share of frames both
+# cover, and the relative pose error over a frame and a second. Runs made before the bound lack them
+# and their rows are left out.
+LIMIT_METRICS = ["efficiency/position", "efficiency/heading", "efficiency/share", "bound/posterior/position_rms_m",
+                 "rpe/frame/translation_rms_m", "rpe/1s/translation_rms_m"]
+
+
 # After the coverage metrics (recall at the headline threshold, valid_fraction: metrics_for), in this order.
 METRICS = ["position_m/rmse", "x_cm/mean", "y_cm/mean", "theta_rad/mean", "position_m/mean", "position_m/p95", "line_points/mean", "wrong_frames",
-           "coasting_frames", "recovery/recovered", "recovery/recovery_time_s/median"]
+           "coasting_frames", "recovery/recovered", "recovery/recovery_time_s/median"] + LIMIT_METRICS
 
 
 COVERAGE = "valid_fraction"
@@ -70,6 +83,17 @@ EXPLANATION = ("Runs pair by scenario, localizer and effective configuration (no
                "counts as outside); valid_fraction: share of frames answered; the errors after them are over answered frames only. "
                "'no estimate in k of n runs': the statistic is null there (no frame answered), so no t-test is made. "
                "'exceeds spread': Welch's t-test over seeds, p < alpha; n < 2: no spread to compare with.")
+
+
+LIMIT_EXPLANATION = ("efficiency/position: the position RMSE over the Cramer-Rao bound of the same frames (1 is the limit, 1.3 is 30 % above "
+                     "it; against the posterior bound where the run tracks), efficiency/share: the share of scored frames with both an "
+                     "estimate and a finite bound; 'no bound in k of n runs': the bound is null there (no truth, or no frame with a "
+                     "finite bound), never 0. rpe: relative pose error over one frame and one second (no alignment).")
+
+
+def explanation(runs: Sequence[Run]) -> str:
+    """EXPLANATION, and what the accuracy limit's rows mean where any of the runs carries the bound."""
+    return EXPLANATION + (" " + LIMIT_EXPLANATION if any(r.bound() is not None for r in runs) else "")
 
 
 def metrics_for(runs: list[Run], wanted: Optional[Sequence[str]] = None) -> list[str]:
@@ -150,13 +174,15 @@ def groups(runs: list[Run]) -> dict[GroupKey, list[Run]]:
     return g
 
 
-def verdict(w: Welch, a: Sequence[float], b: Sequence[float], alpha: float, none_a: int = 0, none_b: int = 0, of_a: int = 0, of_b: int = 0) -> str:
+def verdict(w: Welch, a: Sequence[float], b: Sequence[float], alpha: float, none_a: int = 0, none_b: int = 0, of_a: int = 0, of_b: int = 0,
+            metric: str = "") -> str:
     """'yes' / 'no' (Welch, p < alpha), 'n < 2', 'same', '-'; where a side has runs without a value
-    (no estimate), no test is made and the verdict names them: 'no estimate in 1 of 3 runs (B)'."""
+    (no estimate; no bound for a metric of the accuracy limit), no test is made and the verdict names
+    them: 'no estimate in 1 of 3 runs (B)'."""
     if none_a or none_b:
         if (none_a, of_a) == (none_b, of_b):
-            return f"{metrics.no_estimate_text(none_a, of_a)} (A and B)"
-        return "; ".join(f"{metrics.no_estimate_text(k, n)} ({side})" for side, k, n in (("A", none_a, of_a), ("B", none_b, of_b)) if k)
+            return f"{metrics.no_estimate_text(none_a, of_a, metric)} (A and B)"
+        return "; ".join(f"{metrics.no_estimate_text(k, n, metric)} ({side})" for side, k, n in (("A", none_a, of_a), ("B", none_b, of_b)) if k)
     if len(a) == len(b) and a and all(x == y for x, y in zip(sorted(a), sorted(b))):
         return "same"
     if w.diff is None:
@@ -238,7 +264,7 @@ def compare_rows(runs_a: list[Run], runs_b: list[Run], alpha: float = ALPHA, wan
     for ka, kb, diffs in pairs:
         label = names[ka] + (f" (A vs B: {'; '.join(diffs)})" if diffs else "")
         for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha, wanted):
-            rows.append([label, m, mean_text(sa), sa.n, mean_text(sb), sb.n,
+            rows.append([label, m, mean_text(sa, metric=m), sa.n, mean_text(sb, metric=m), sb.n,
                          stats.fnum(w.diff, 4), stats.fnum(w.p, 3) if w.p is not None else "-", v])
     for k in only_a:
         why = unpaired_reason(k, gb)
@@ -257,9 +283,10 @@ def side_labels(ga: dict[GroupKey, list[Run]], gb: dict[GroupKey, list[Run]]) ->
     return names
 
 
-def mean_text(st: SeedStats, digits: int = 4) -> str:
-    """A side's mean over seeds; 'no estimate' where every run has the statistic null."""
-    return metrics.NO_ESTIMATE if not st.n and st.no_value else stats.fnum(st.mean, digits)
+def mean_text(st: SeedStats, digits: int = 4, metric: str = "") -> str:
+    """A side's mean over seeds; 'no estimate' ('no bound' for a metric of the accuracy limit) where
+    every run has the statistic null."""
+    return bound.null_text(metric) if not st.n and st.no_value else stats.fnum(st.mean, digits)
 
 
 def metric_rows(ra: list[Run], rb: list[Run], alpha: float, wanted: Optional[Sequence[str]] = None) -> Iterator[tuple[str, SeedStats, SeedStats, Welch, str]]:
@@ -274,7 +301,7 @@ def metric_rows(ra: list[Run], rb: list[Run], alpha: float, wanted: Optional[Seq
         w = stats.welch(a, b)
         if sa.no_value or sb.no_value:
             w = Welch(diff=None, t=None, df=None, p=None)
-        yield m, sa, sb, w, verdict(w, a, b, alpha, sa.no_value, sb.no_value, sa.of, sb.of)
+        yield m, sa, sb, w, verdict(w, a, b, alpha, sa.no_value, sb.no_value, sa.of, sb.of, m)
 
 
 def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: int = 100) -> None:
@@ -296,7 +323,7 @@ def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: int = 
         print(line(head))
         for m, sa, sb, w, v in metric_rows(ga[ka], gb[kb], alpha):
             short = v if len(v) <= widths[-1] else "no test"  # the runs without a value: on a line of their own
-            print(line([m, mean_text(sa), str(sa.n), mean_text(sb), str(sb.n), stats.fnum(w.diff, 4),
+            print(line([m, mean_text(sa, metric=m), str(sa.n), mean_text(sb, metric=m), str(sb.n), stats.fnum(w.diff, 4),
                         stats.fnum(w.p, 3) if w.p is not None else "-", short]))
             if short != v:
                 print(wrap(v, "    "))
@@ -307,6 +334,8 @@ def print_text(runs_a: list[Run], runs_b: list[Run], alpha: float, width: int = 
             print(wrap(f"only in {side} ({len(g[k])} runs): {names[k]}" + (f"; {why}" if why else ""), ""))
     print()
     print(textwrap.fill(EXPLANATION + " p: Welch's t-test over seeds.", width))
+    if any(r.bound() is not None for r in list(runs_a) + list(runs_b)):
+        print(textwrap.fill(LIMIT_EXPLANATION, width))
 
 
 def versions(runs: list[Run]) -> str:

@@ -23,6 +23,14 @@ limits, and so does a regression check: a run without estimates never passes an 
 recall/..., valid_fraction and recovered_fraction are higher-is-better: a rule on them regresses
 when they fall (unless the rule says "better").
 
+The accuracy limit (docs/results.md): "r0/efficiency/position" is the position RMSE over the
+Cramer-Rao bound of the same frames (1 is the limit; {"metric": "efficiency/position", "max": 1.5}
+fails a localizer more than 50 % above it), "efficiency/heading" the same for the heading,
+"efficiency_single_frame/..." against the single-frame bound, "bound/posterior/position_rms_m" the
+bound itself; "efficiency.position" may be written for "efficiency/position". Where a run has no
+bound (no truth, no frame with a finite bound) the efficiency is null and the rule fails the group,
+"no bound in N of M runs".
+
 Exit 0 when every rule holds, 1 when any limit or regression fails, 2 on bad input (a missing or
 incomplete result folder, bad rules, an unknown metric, a rule that selects nothing) before any
 verdict is printed.
@@ -38,7 +46,7 @@ from dataclasses import dataclass, field
 from typing import Optional, Sequence, Union
 
 from omniloc import compare
-from omniloc.core import metrics, pathcheck, rundir, stats
+from omniloc.core import bound, metrics, pathcheck, rundir, stats
 from omniloc.core.jsonvalue import JSON, JSONObject, parse
 from omniloc.core.rundir import Run
 
@@ -54,6 +62,65 @@ HIGHER_IS_BETTER = ("recall", "valid_fraction", "recovered_fraction")
 
 
 RULE_KEYS = {"metric", "max", "min", "scenario", "localizer", "stat", "better", "tolerance", "tolerance_fraction", "name", "comment"}
+
+
+# The accuracy limit's figures a rule names (summary.json's blocks, core.bound), each block with the
+# numbers it holds: a misspelt one is bad input naming the rule's JSON path, before any results are
+# read. The bound's other blocks (the noise it measured, the compass, the odometry) are checked
+# against the results' metrics like any other name.
+LIMIT_BLOCKS: dict[str, tuple[str, ...]] = {
+    "efficiency": ("position", "heading", "share", "frames"),
+    "efficiency_single_frame": ("position", "heading", "share", "frames"),
+    "bound/single_frame": ("position_rms_m", "heading_rms_rad", "frames", "share"),
+    "bound/posterior": ("position_rms_m", "heading_rms_rad", "frames", "share"),
+    "bound/no_bound": ("frames",),
+    "rpe/frame": ("translation_rms_m", "rotation_rms_rad", "pairs"),
+    "rpe/1s": ("translation_rms_m", "rotation_rms_rad", "pairs"),
+}
+
+
+def limit_path(metric: str) -> Optional[tuple[str, str]]:
+    """(block, rest) of a metric of the accuracy limit ("r0/efficiency/position" -> ("efficiency",
+    "position")); None for any other metric."""
+    parts = metric.strip("/").split("/")
+    if parts and parts[0][:1] == "r" and parts[0][1:].isdigit():
+        parts = parts[1:]
+    if parts and parts[0] == "tracking_phase":
+        parts = parts[1:]
+    if not parts or parts[0] not in ("efficiency", "efficiency_single_frame", "bound", "rpe"):
+        return None
+    depth = 1 if parts[0].startswith("efficiency") else 2
+    return "/".join(parts[:depth]), "/".join(parts[depth:])
+
+
+def check_limit_metric(metric: str, where: str) -> None:
+    """BadInput naming the rule's metric where it names a block of the accuracy limit that does not
+    exist, or a number the block does not hold."""
+    found = limit_path(metric)
+    if found is None:
+        return
+    block, rest = found
+    if block.startswith("bound/") and block not in LIMIT_BLOCKS:
+        return  # the bound's other blocks (its noise, compass, odometry): checked against the results' metrics
+    expected = [f"{b}/{k}" for b, ks in LIMIT_BLOCKS.items() for k in ks]
+    if block not in LIMIT_BLOCKS or rest not in LIMIT_BLOCKS[block]:
+        raise BadInput(f"{where}/metric: got {json.dumps(metric)}, expected a number of the accuracy limit (docs/results.md): "
+                       + ", ".join(expected))
+
+
+def is_ratio(metric: str) -> bool:
+    """Whether a metric is an efficiency ratio (RMSE / bound) rather than a share or a count."""
+    found = limit_path(metric)
+    return found is not None and found[0].startswith("efficiency") and found[1] in ("position", "heading")
+
+
+def spelt(metric: str) -> str:
+    """A metric as aggregate.csv spells it: "efficiency.position" (the accuracy limit's blocks
+    written with dots, as docs and papers name them) is read as "efficiency/position"."""
+    m = metric.strip("/")
+    if "/" not in m and "." in m and m.split(".", 1)[0] in ("efficiency", "efficiency_single_frame", "bound", "rpe"):
+        return m.replace(".", "/")
+    return m
 
 
 class BadInput(Exception):
@@ -157,9 +224,14 @@ def load_rules(path: Union[str, pathlib.Path], have_baseline: bool) -> list[Rule
             if k in rule and (not isinstance(v, str) or not v):
                 raise BadInput(f"{where}/{k}: got {json.dumps(rule[k])}, expected a non-empty string")
             names[k] = v if isinstance(v, str) else None
-        metric = m.strip("/")
+        metric = spelt(m)
+        check_limit_metric(metric, where)
         high = _number(rule, "max", where) if "max" in rule else None
         low = _number(rule, "min", where) if "min" in rule else None
+        if is_ratio(metric):
+            for k, v in (("max", high), ("min", low)):
+                if v is not None and v <= 0:
+                    raise BadInput(f"{where}/{k}: got {v:g}, expected a positive ratio of the RMSE to the bound (1 is the limit, 1.5 is 50 % above it)")
         if high is not None and low is not None and low > high:
             raise BadInput(f"{where}/min: got {low:g}, expected at most max ({high:g})")
         stat = rule.get("stat", "mean")
@@ -182,9 +254,10 @@ def load_rules(path: Union[str, pathlib.Path], have_baseline: bool) -> list[Rule
 
 def higher_is_better(metric: str) -> bool:
     """Whether a larger value of `metric` is better: recall at a threshold ("r0/recall/25cm_10deg"),
-    the share of frames answered (valid_fraction) and of kidnaps recovered (recovered_fraction)."""
+    the share of frames answered (valid_fraction) and of kidnaps recovered (recovered_fraction), and
+    the share of frames the accuracy limit covers ("r0/efficiency/share")."""
     parts = metric.strip("/").split("/")
-    return "recall" in parts[:-1] or parts[-1] in HIGHER_IS_BETTER
+    return "recall" in parts[:-1] or parts[-1] in HIGHER_IS_BETTER or (limit_path(metric) is not None and parts[-1] == "share")
 
 
 def resolve_metric(name: str, known: set[str]) -> Optional[str]:
@@ -260,6 +333,9 @@ def judge(rules: Sequence[Rule], runs: list[Run], base_runs: Optional[list[Run]]
     checks = []
     for rule in rules:
         metric = resolve_metric(rule.metric, known)
+        if metric is None and limit_path(rule.metric) is not None and not any(limit_path(k) for k in known):
+            raise BadInput(f"rule {rule.index}: metric \"{rule.metric}\" is not among the results' metrics: none of their runs carries the "
+                           "accuracy limit (runs made by an omniloc before the bound was scored; docs/results.md)")
         if metric is None:
             near = sorted(k for k in known if k.split("/")[-1] == rule.metric.split("/")[-1])[:4]
             raise BadInput(f"rule {rule.index}: metric \"{rule.metric}\" is not among the results' metrics"
@@ -273,12 +349,16 @@ def judge(rules: Sequence[Rule], runs: list[Run], base_runs: Optional[list[Run]]
         paired_any = False
         for k in keys:
             vals, no_value, of = seed_counts(groups[k], metric)
+            if not of and limit_path(metric) is not None:
+                # Runs of a recording without truth score nothing, so they have no bound: "no bound", not bad input.
+                unscored = [r for r in groups[k] if r.summary.robots and all(rob.get("scored") is False for rob in r.summary.robots)]
+                no_value, of = len(unscored), len(unscored)
             if not of:
                 raise BadInput(f"rule {rule.index}: no run of {names[k]} has the metric {metric}")
             c = Check(rule=rule, metric=metric, key=k, label=names[k], values=vals, no_value=no_value, of=of,
                       value=statistic(vals, rule.stat), interval=stats.interval(vals))
-            if no_value:  # a run without estimates never passes: whatever the limits and the baseline
-                c.failures.append((NO_ESTIMATE, metrics.no_estimate_text(no_value, of)))
+            if no_value:  # a run without estimates (or without a bound) never passes: whatever the limits and the baseline
+                c.failures.append((bound.null_text(metric), metrics.no_estimate_text(no_value, of, metric)))
             check_limits(c)
             if base_runs is not None:
                 if k in pair_of:
@@ -294,6 +374,9 @@ def judge(rules: Sequence[Rule], runs: list[Run], base_runs: Optional[list[Run]]
 
 
 NO_ESTIMATE = "no estimate"  # the kind of failure of a metric that is null in some run
+
+
+NULL_KINDS = (NO_ESTIMATE, bound.NO_BOUND)  # ... and of a metric of the accuracy limit
 
 
 def check_limits(c: Check) -> None:
@@ -313,7 +396,7 @@ def check_regression(c: Check, base: tuple[list[float], int, int], diffs: list[s
     r = c.rule
     base_vals, base_none, base_of = base
     if base_none:
-        c.notes.append(f"baseline: {metrics.no_estimate_text(base_none, base_of)}")
+        c.notes.append(f"baseline: {metrics.no_estimate_text(base_none, base_of, c.metric)}")
     b = statistic(base_vals, r.stat)
     if b is None or c.value is None:
         if not base_vals:
@@ -349,12 +432,12 @@ def rule_text(r: Rule) -> str:
 def value_text(c: Check) -> str:
     """'mean 0.0453 (n=5)', or 'no estimate (n=0 of 1)' where no run has a value."""
     if c.value is None:
-        return f"no estimate (n=0 of {c.of})"
+        return f"{bound.null_text(c.metric)} (n=0 of {c.of})"
     return f"{c.rule.stat} {c.value:.6g} (n={len(c.values)}" + (f" of {c.of}" if c.no_value else "") + ")"
 
 
 def failure_text(kind: str, msg: str) -> str:
-    return msg if kind == NO_ESTIMATE else f"{kind}: {msg}"
+    return msg if kind in NULL_KINDS else f"{kind}: {msg}"
 
 
 def line(c: Check) -> str:
@@ -403,10 +486,10 @@ def junit_xml(checks: Sequence[Check], results: str, baseline: Optional[str]) ->
             case = ElementTree.SubElement(suite, "testcase", name=f"{c.label}: {title}",
                                  classname=f"omniloc.{scenario}.{c.key.localizer}", time="0")
             if c.failures:
-                msg = "; ".join(f"{c.metric}: {m}" if kind == NO_ESTIMATE else f"{kind}: {c.metric} {m}" for kind, m in c.failures)
+                msg = "; ".join(f"{c.metric}: {m}" if kind in NULL_KINDS else f"{kind}: {c.metric} {m}" for kind, m in c.failures)
                 fail = ElementTree.SubElement(case, "failure", message=msg, type=" and ".join(sorted({k for k, _ in c.failures})))
                 fail.text = line(c) + "\nseed values: " + (", ".join(f"{v:.6g}" for v in c.values) or "none") + (
-                    f"; {metrics.no_estimate_text(c.no_value, c.of)}" if c.no_value else "")
+                    f"; {metrics.no_estimate_text(c.no_value, c.of, c.metric)}" if c.no_value else "")
             else:
                 out = ElementTree.SubElement(case, "system-out")
                 out.text = line(c)
@@ -418,6 +501,8 @@ UNITS = [("_cm/", "cm"), ("_m/", "m"), ("_rad/", "rad"), ("_rad", "rad"), ("_s/"
 
 
 def unit_of(metric: str) -> str:
+    if is_ratio(metric):
+        return "x bound"
     m = metric + "/"
     for tag, unit in UNITS:
         if tag in m:
@@ -446,6 +531,6 @@ def benchmark_json(checks: Sequence[Check]) -> tuple[list[dict[str, JSON]], list
         e: dict[str, JSON] = {"name": name, "unit": unit_of(c.metric), "value": c.value}
         if iv.kind in (stats.T95, stats.RANGE):
             e["range"] = f"{iv.lo:.6g} to {iv.hi:.6g} ({'95 % t interval' if iv.kind == stats.T95 else 'seeds range'})"
-        e["extra"] = f"n={len(c.values)} seeds; " + (f"{metrics.no_estimate_text(c.no_value, c.of)}; " if c.no_value else "") + verdict
+        e["extra"] = f"n={len(c.values)} seeds; " + (f"{metrics.no_estimate_text(c.no_value, c.of, c.metric)}; " if c.no_value else "") + verdict
         entries[name] = e
     return list(entries.values()), left

@@ -203,3 +203,38 @@ def write_viewable_run(folder, scenario="quickstart", localizer="odometry_only",
     (folder / "est.tum").write_text("\n".join(est) + "\n")
     (folder / "events.jsonl").write_text(json.dumps({"mode": "tracking", "robot": 0, "t": 0.0, "type": "mode"}) + "\n")
     return folder
+
+
+def limit_blocks(rmse_m, efficiency=1.3, share=0.97, scored_frames=100, heading_efficiency=1.1, against="posterior"):
+    """summary.json's blocks of the accuracy limit for one robot (docs/results.md), as omniloc writes
+    them: a bound `efficiency` times below the RMSE over `share` of the scored frames, the frames
+    without one said with their reasons, the noise it assumed, and the relative pose error."""
+    frames = round(share * scored_frames)
+    bound_m = rmse_m / efficiency
+    figure = {"position_rms_m": bound_m, "heading_rms_rad": 0.004, "frames": frames, "share": share}
+    single = dict(figure, position_rms_m=bound_m * 1.4, heading_rms_rad=0.006)
+    missing = scored_frames - frames
+    return {"bound": {"single_frame": single, "posterior": figure,
+                      "no_bound": {"frames": missing, "why": {"points on one line": missing} if missing else {}},
+                      "noise": {"bands_m": [0, 1.5, 3, 5, 7.5], "measured_sigma_m": [0.032, 0.042, 0.087, 0.2],
+                                "declared_sigma_m": [0.03, 0.04, 0.08, None], "points": 9000, "false_points": 12,
+                                "common_mode": {"sigma_rad": 0.002}},
+                      "assumptions": "known association, the measured noise, unbiased estimators"},
+            "efficiency": {"position": efficiency, "heading": heading_efficiency, "against": against, "frames": frames, "share": share,
+                           "rmse_m": rmse_m, "bound_rms_m": bound_m, "heading_rmse_rad": 0.004 * heading_efficiency, "heading_bound_rms_rad": 0.004},
+            "efficiency_single_frame": {"position": efficiency / 1.4, "heading": heading_efficiency / 1.5, "against": "single_frame",
+                                        "frames": frames, "share": share},
+            "rpe": {"frame": {"translation_rms_m": 0.004, "rotation_rms_rad": 0.001, "pairs": scored_frames - 1},
+                    "1s": {"translation_rms_m": 0.03, "rotation_rms_rad": 0.008, "pairs": scored_frames - 30}}}
+
+
+def no_limit_blocks(scored_frames=100, why="no truth to place the line points at"):
+    """The accuracy limit's blocks of a run where no frame has a bound (a recording without truth):
+    every figure null with the reason, never 0."""
+    null_fig = {"position_rms_m": None, "heading_rms_rad": None, "frames": 0, "share": 0.0}
+    eff = {"position": None, "heading": None, "against": "posterior", "frames": 0, "share": 0.0, "why_null": why}
+    return {"bound": {"single_frame": null_fig, "posterior": null_fig,
+                      "no_bound": {"frames": scored_frames, "why": {why: scored_frames}}, "noise": None, "assumptions": None},
+            "efficiency": eff, "efficiency_single_frame": dict(eff, against="single_frame"),
+            "rpe": {"frame": {"translation_rms_m": 0.004, "rotation_rms_rad": 0.001, "pairs": scored_frames - 1},
+                    "1s": {"translation_rms_m": 0.03, "rotation_rms_rad": 0.008, "pairs": scored_frames - 30}}}

@@ -41,7 +41,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print("|" + "---|" * len(header))
         for r in rows:
             print("| " + " | ".join(str(c) for c in r) + " |")
-        print("\n" + compare.EXPLANATION)
+        print("\n" + compare.explanation(ra + rb))
     else:
         print()
         compare.print_text(ra, rb, a.alpha)

@@ -8,6 +8,7 @@ import pathlib
 from dataclasses import dataclass
 from typing import Optional, Union
 
+from omniloc.core.bound import AGGREGATE_KEYS
 from omniloc.core.files import read_csv
 from omniloc.core.jsonvalue import JSON, JSONObject, integer, load_file, lst, number, obj, text
 from omniloc.core.stats import NO_INTERVAL
@@ -58,10 +59,27 @@ class AggregateGroup:
     def from_json(raw: JSON) -> AggregateGroup:
         g = obj(raw)
         given = g.get("start_pose_given")
+        metrics = {k: AggregateMetric.from_json(v) for k, v in obj(g.get("metrics")).items()}
+        # The bound's per-group figures, where an aggregate keeps them beside "metrics" rather than in it.
+        for k in AGGREGATE_KEYS:
+            if isinstance(g.get(k), dict) and k not in metrics:
+                metrics[k] = AggregateMetric.from_json(g.get(k))
         return AggregateGroup(scenario=text(g.get("scenario")), localizer=text(g.get("localizer")), params=text(g.get("params")),
                               start_pose_given=given if isinstance(given, (bool, str)) else None,
-                              finished=g.get("finished", "-"), failed=g.get("failed", 0),
-                              metrics={k: AggregateMetric.from_json(v) for k, v in obj(g.get("metrics")).items()})
+                              finished=g.get("finished", "-"), failed=g.get("failed", 0), metrics=metrics)
+
+    def limit_metric(self, which: str, phase: bool = False) -> Optional[AggregateMetric]:
+        """The group's figure of the accuracy limit over seeds: which "efficiency_position" (RMSE /
+        bound) or "bound_position_rms_m" (the bound, m), under the name the aggregate gives it
+        (batch/aggregate.cpp's key, or robot 0's summary.json path, posterior bound first); None
+        for an aggregate of runs made before the bound (never 0)."""
+        base = "r0/tracking_phase/" if phase else "r0/"
+        paths = {"efficiency_position": ["efficiency/position"],
+                 "bound_position_rms_m": ["bound/posterior/position_rms_m", "bound/single_frame/position_rms_m"]}[which]
+        for name in [which, "r0/" + which] + [base + p for p in paths] + ["r0/" + p for p in paths]:
+            if name in self.metrics:
+                return self.metrics[name]
+        return None
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ import math
 import re
 from typing import Iterable, Optional
 
+from omniloc.core.bound import null_text
 from omniloc.core.jsonvalue import JSON
 from omniloc.core.rundir import Run
 from omniloc.core.stats import SeedStats, fnum, is_number, stats
@@ -27,9 +28,10 @@ TABLE_KEYS: list[tuple[str, str]] = [("x_cm", "mean"), ("y_cm", "mean"), ("theta
 TABLE_COLS = ["mean x cm", "mean y cm", "mean th rad", "std x cm", "std y cm", "std th rad", "max x cm", "max y cm", "max th rad"]
 
 
-def no_estimate_text(k: int, n: int) -> str:
-    """'no estimate in 1 of 3 runs': how every tool names runs whose statistic is null."""
-    return f"no estimate in {k} of {n} runs"
+def no_estimate_text(k: int, n: int, path: str = "") -> str:
+    """'no estimate in 1 of 3 runs': how every tool names runs whose statistic is null ('no bound in
+    1 of 3 runs' for a metric of the accuracy limit, core.bound)."""
+    return f"{null_text(path)} in {k} of {n} runs"
 
 
 def run_values(runs: list[Run], path: str, phase: str = "tracking") -> tuple[list[float], int, int]:
@@ -61,7 +63,7 @@ def run_stats(runs: list[Run], path: str, phase: str = "tracking") -> SeedStats:
     if no_value:
         whys = {r.why_null(path, phase) for r in runs if r.lookup(path, phase) == (True, None)}
         one = whys.pop() if len(whys) == 1 else None
-        st.why = one if one and not one.startswith("no estimate") else NO_ESTIMATE
+        st.why = one if one and not one.startswith("no estimate") else null_text(path, one)
     return st
 
 

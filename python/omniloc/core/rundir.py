@@ -16,6 +16,7 @@ from typing import Iterable, Optional, Sequence, Union
 
 from omniloc.core import pathcheck
 from omniloc.core.aggregate import read_aggregate, read_run_ids, summary_metrics
+from omniloc.core.bound import RobotBound, robot_bound
 from omniloc.core.files import read_csv
 from omniloc.core.jsonvalue import JSON, JSONObject, flag, integer, load_file, lst, number, obj, parse, text
 
@@ -233,6 +234,12 @@ class Run:
                 break
             why = block.get("why_null", why)
         return why if isinstance(why, str) else None
+
+    def bound(self, robot: int = 0, phase: str = "tracking") -> Optional[RobotBound]:
+        """Robot `robot`'s accuracy limit (core.bound: the Cramer-Rao bound, efficiency, relative
+        pose error), from its tracking-phase block where that has one; None for a run made before
+        omniloc scored the bound."""
+        return robot_bound(self.robot(robot), phase)
 
     def aggregate_metrics(self) -> dict[str, Optional[float]]:
         """Every number of summary.json under its aggregate.csv name (core.aggregate.summary_metrics),

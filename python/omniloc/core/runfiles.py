@@ -11,12 +11,13 @@ import pathlib
 from dataclasses import dataclass
 from typing import Optional
 
+from omniloc.core.bound import FRAME_COLUMNS as BOUND_COLUMNS
 from omniloc.core.files import InputFileError, read_text
 from omniloc.core.jsonvalue import JSONObject, finite
 
 # frames.csv's own columns (docs/results.md); the others are the localizer's and are shown as given.
 FRAMES_COLUMNS = ["t", "robot", "gt_x", "gt_y", "gt_theta", "est_x", "est_y", "est_theta", "err_x", "err_y", "err_theta",
-                  "err_pos", "valid", "mode", "camera_ok", "line_points", "match_error", "contact"]
+                  "err_pos", "valid", "mode", "camera_ok", "line_points", "match_error", "contact"] + BOUND_COLUMNS
 REQUIRED_COLUMNS = ["t", "robot", "est_x", "est_y", "est_theta", "valid", "mode"]
 
 

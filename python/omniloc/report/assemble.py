@@ -75,7 +75,7 @@ def build(a: argparse.Namespace) -> None:
             if not str(cells[1]).startswith("("):
                 row[1] = f"`{cells[1]}`"
             rows.append(row)
-        explanation = compare.EXPLANATION.replace("recall/T", "`recall/T`").replace("valid_fraction", "`valid_fraction`")
+        explanation = compare.explanation(base_runs + runs).replace("recall/T", "`recall/T`").replace("valid_fraction", "`valid_fraction`")
         rep.table(header, rows, f"baseline: {' '.join(a.baseline)}; this report's results as 'new'. "
                   + explanation)
     in_sweeps = set()

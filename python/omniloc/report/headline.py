@@ -14,6 +14,7 @@ from omniloc.paper import causes, labels, tables
 from omniloc.paper.causes import Cause
 from omniloc.paper.claims import Claim
 from omniloc.paper.tables import Context
+from omniloc.report import limit
 from omniloc.report.scorecard import field_robot_runs, ratio_text
 from omniloc.tools.markup import Writer
 
@@ -123,4 +124,7 @@ def headline(rep: Writer, ctx: Context, claims: Sequence[Claim], field_claims: O
         parts.append(s)
     elif judged:
         parts.append("Every claim these results judge holds.")
+    near = limit.headline_sentence(ctx.runs)  # results made before the bound: nothing
+    if near:
+        parts.append(near)
     rep.para("**In short.** " + " ".join(parts), "headline", "headline")

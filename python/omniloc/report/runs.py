@@ -11,7 +11,7 @@ from omniloc.core.jsonvalue import JSON, JSONObject, number, obj
 from omniloc.core.pairing import profile_of
 from omniloc.core.rundir import Run
 from omniloc.core.stats import fnum
-from omniloc.report import viewers
+from omniloc.report import limit, viewers
 from omniloc.tools import plot
 from omniloc.tools.markup import Cell, Writer
 
@@ -105,19 +105,26 @@ def report_run(rep: Writer, run: Run, plots: bool, params: Optional[str] = None,
     rows: list[list[Cell]] = []
     key = run.headline
     answered = any("valid_fraction" in r for r in s.robots)
+    # Beside the RMSE, how far it is from the accuracy limit (runs made before the bound: no column).
+    bounded = limit.any_bound([run])
     for r in s.robots:
         rows.append([f"r{r['robot']}" + (" all frames" if "tracking_phase" in r else ""), *coverage_cells(r, key, answered),
-                     *[block_cell(r, f"{a}/{st}", 3) for a, st in metrics.TABLE_KEYS], *position_cells(r), str(r.get("frames", "-"))])
+                     *[block_cell(r, f"{a}/{st}", 3) for a, st in metrics.TABLE_KEYS], *position_cells(r),
+                     *(limit.run_cells(r) if bounded else []), str(r.get("frames", "-"))])
         if "tracking_phase" in r:
             tp = obj(r["tracking_phase"])
             rows.append([f"r{r['robot']} tracking phase", *coverage_cells(tp, key, answered), *[block_cell(tp, f"{a}/{st}", 3) for a, st in metrics.TABLE_KEYS],
-                         *position_cells(tp), str(tp.get("frames", "-"))])
+                         *position_cells(tp), *(limit.run_cells(tp) if bounded else []), str(tp.get("frames", "-"))])
     task = pairing.start_pose_text(run.start_pose_given)
     first = first_fix_text(s, key)
-    rep.table(["robot"] + ([f"within {metrics.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + metrics.TABLE_COLS + POSITION_COLS + ["frames"], rows,
+    rep.table(["robot"] + ([f"within {metrics.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + metrics.TABLE_COLS + POSITION_COLS
+              + (["RMSE against the limit"] if bounded else []) + ["frames"], rows,
               f"noise profile {s.raw.get('noise_profile')}, {s.raw.get('duration_s')} s at {s.raw.get('camera_rate_hz')} Hz" + (f"; {task}" if task else "") +
               f"; omniloc {s.version}"
-              + ("; errors over the frames answered" if answered else "") + (f"; {first}" if first else ""))
+              + ("; errors over the frames answered" if answered else "") + (f"; {first}" if first else "")
+              + ("; 'against the limit': the RMSE over the Cramer-Rao bound of the same frames (1x is the limit), with the share of frames "
+                 "the bound covers" if bounded else ""))
+    limit.run_table(rep, run)
     for r in s.robots:
         rec = r.get("recovery")
         if isinstance(rec, dict) and rec:

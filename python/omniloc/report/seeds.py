@@ -8,6 +8,7 @@ import statistics
 from typing import Collection, Optional, Sequence
 
 from omniloc.core import metrics, stats
+from omniloc.core.bound import null_text, share_text
 from omniloc.core.events import read_events
 from omniloc.core.rundir import Run
 from omniloc.core.stats import SeedStats, fnum
@@ -34,10 +35,12 @@ def coverage_cols(runs: list[Run]) -> list[tuple[str, str]]:
     return cols
 
 
-def seed_values_text(sel: list[Run], values: Sequence[Optional[float]], flagged: Collection[int], digits: int, nulls: Collection[int] = ()) -> str:
-    """'s1 3.10, s2 806.00 (outlier), s3 no estimate': every seed's value beside the mean."""
+def seed_values_text(sel: list[Run], values: Sequence[Optional[float]], flagged: Collection[int], digits: int, nulls: Collection[int] = (),
+                     metric: str = "") -> str:
+    """'s1 3.10, s2 806.00 (outlier), s3 no estimate': every seed's value beside the mean ('no bound'
+    for a null of the accuracy limit)."""
     null_set = set(nulls)
-    return ", ".join(f"s{r.seed}\u00a0" + ("no estimate" if i in null_set else fnum(v, digits)) + ("\u00a0(outlier)" if i in flagged else "")
+    return ", ".join(f"s{r.seed}\u00a0" + (null_text(metric) if i in null_set else fnum(v, digits)) + ("\u00a0(outlier)" if i in flagged else "")
                      for i, (r, v) in enumerate(zip(sel, values)))
 
 
@@ -129,6 +132,11 @@ def seed_table(rep: Writer, rows_runs: Sequence[RowRuns], phase: str = "tracking
     # Coverage first (percent of all frames), then the errors over the answered frames.
     columns = [(m, f"{h}, % of frames", 1, 100.0) for m, h in coverage_cols([r for _, sel in rows_runs for r in sel])] + \
         [(m, name, digits, 1.0) for m, name, digits in SEED_METRICS]
+    # Each seed's distance from the accuracy limit, where the runs carry it (runs made before the bound: no column).
+    coverage = len(columns) > len(SEED_METRICS)
+    bounded = any(r.bound(phase=phase) is not None for _, sel in rows_runs for r in sel)
+    if bounded:
+        columns.append(("efficiency/position", "position RMSE / bound (x the limit)", 2, 1.0))
     pages = viewers.viewers_of(rep)
     linked = pages is not None and pages.all  # a report of many runs links only those shown on their own
     for label, sel in rows_runs:
@@ -148,10 +156,11 @@ def seed_table(rep: Writer, rows_runs: Sequence[RowRuns], phase: str = "tracking
             # One cell per metric (the mean with its interval, the median, every seed): a table a
             # reader takes in without scrolling sideways.
             if not st.n and nulls:
-                row.append(metrics.no_estimate_text(len(nulls), len(sel)))
+                row.append(metrics.no_estimate_text(len(nulls), len(sel), metric))
                 continue
-            row.append(f"mean {interval_text(st, digits)}; median {fnum(st.median, digits)}; seeds: {seed_values_text(sel, vals, flagged, digits, nulls)}"
-                       + (f" ({metrics.no_estimate_text(len(nulls), len(sel))}: the mean is over the others)" if nulls else ""))
+            row.append(f"mean {interval_text(st, digits)}; median {fnum(st.median, digits)}; seeds: {seed_values_text(sel, vals, flagged, digits, nulls, metric)}"
+                       + (f" ({metrics.no_estimate_text(len(nulls), len(sel), metric)}: the mean is over the others)" if nulls else "")
+                       + (f" ({share_text(metrics.run_stats(sel, 'efficiency/share', phase).mean)}, mean over seeds)" if metric == "efficiency/position" else ""))
         row.append("; ".join(f"s{r.seed}: {outlier_cause(r)}" for r in out) or "-")
         if linked:
             row.append(seed_links(rep, sel))
@@ -166,7 +175,9 @@ def seed_table(rep: Writer, rows_runs: Sequence[RowRuns], phase: str = "tracking
               "Every seed beside the mean: mean with its interval; median; each seed's value. "
               + ("The share of frames within the headline threshold (a frame without an estimate counts as outside) and the share answered come "
                  "first; the errors after them are over the answered frames, and a seed without any says 'no estimate'. "
-                 if len(columns) > len(SEED_METRICS) else "")
+                 if coverage else "")
+              + ("'x the limit': the seed's position RMSE over the Cramer-Rao bound of the same frames (1x is the limit), 'no bound' where "
+                 "it has none. " if bounded else "")
               + "The " + stats.INTERVAL_RULE_TEXT + ". A seed is flagged as an outlier when its mean x error lies above 3x "
               "the median of the other seeds and further from it than 3x their range; its cause is read from its frames.csv and events.jsonl."
               + caption_extra + (" 'viewers': each seed's run in the run viewer (frame by frame)." if linked else ""), classes)

@@ -11,7 +11,7 @@ from omniloc.core import metrics, rundir
 from omniloc.core.aggregate import Aggregate, AggregateMetric, read_aggregate, read_runs_csv
 from omniloc.core.rundir import Run
 from omniloc.core.stats import fnum
-from omniloc.report import viewers
+from omniloc.report import limit, viewers
 from omniloc.report.runs import params_text, report_run, run_title
 from omniloc.report.seeds import RowRuns, flag_outliers, outlier_cause, seed_table
 from omniloc.tools.markup import Cell, Writer
@@ -69,6 +69,7 @@ def report_sweep(rep: Writer, sweep: pathlib.Path, all_runs: list[Run], max_runs
     runs = sweep_runs(sweep, all_runs)
     key = metrics.headline_key([r for r, _, _ in runs]) or middle_recall_key(agg)
     answered = any("r0/valid_fraction" in g.metrics for g in agg.groups)
+    bounded = limit.sweep_has_limit(agg.groups)  # aggregates of runs made before the bound: no columns
     for g in agg.groups:
         m = g.metrics
         phase = "r0/tracking_phase/x_cm/mean" in m
@@ -90,13 +91,17 @@ def report_sweep(rep: Writer, sweep: pathlib.Path, all_runs: list[Run], max_runs
                      *([metrics.percent(mean_of(f"recall/{key}"))] if key else []),
                      *([metrics.percent(mean_of("valid_fraction"))] if answered else []),
                      *[cell(f"{a}/{s}", 3) for a, s in metrics.TABLE_KEYS], cell("position_m/mean", 3), cell("position_m/rmse", 3),
+                     *([limit.aggregate_limit_cell(g, phase), limit.aggregate_share_cell(g, phase)] if bounded else []),
                      f"{g.finished}/{g.failed}", f"{n}; {metrics.no_estimate_text(without, n + without)}" if without else n])
     rep.table(["group"] + ([f"within {metrics.recall_label(key)}"] if key else []) + (["answered"] if answered else []) + metrics.TABLE_COLS +
-              ["position mean m", "position RMSE m", "runs ok/failed", "n"], rows,
+              ["position mean m", "position RMSE m"] + (["RMSE against the limit", "frames with a bound"] if bounded else []) + ["runs ok/failed", "n"], rows,
               "mean over seeds of each run's statistics (robot 0); runs with kidnaps or covers: tracking phase. Published rows: see 'Published tables beside ours'."
               + (f" 'within {metrics.recall_label(key)}': the share of all frames within that threshold (a frame without an estimate counts as outside); "
                  "'answered': the share of frames with an estimate; the errors are over the answered frames, 'no estimate' where no run of the "
-                 "group answered any, and n counts the runs with a value (aggregate.csv also counts those without one)." if key or answered else ""))
+                 "group answered any, and n counts the runs with a value (aggregate.csv also counts those without one)." if key or answered else "")
+              + (" 'RMSE against the limit': the mean over seeds of the RMSE over the Cramer-Rao bound of the same frames (1x is the limit; "
+                 "posterior bound where the runs track), 'no bound' where no run has one; 'frames with a bound': the mean share of scored "
+                 "frames it covers." if bounded else ""))
     groups: dict[tuple[Optional[str], Optional[str], str], list[Run]] = {}
     for run, params, row_name in runs:
         groups.setdefault((run.scenario, row_name, params), []).append(run)

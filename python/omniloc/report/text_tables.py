@@ -7,11 +7,12 @@ import pathlib
 import sys
 from typing import Optional, Sequence
 
-from omniloc.core import metrics, pairing
+from omniloc.core import bound, metrics, pairing
 from omniloc.core.jsonvalue import JSONObject, lst, obj
 from omniloc.core.pairing import profile_of
 from omniloc.core.rundir import Run
 from omniloc.paper import tables
+from omniloc.report import limit
 from omniloc.report.published import command, published_tables
 from omniloc.tools.markup import TextReport
 
@@ -64,24 +65,29 @@ def print_error_table(papers: JSONObject, key: str, runs: list[Run], labels: Opt
         print(f"error: {e.args[0]}", file=sys.stderr)
         return 2
     cov, cov_head = tables.table_coverage(rows)
-    head = ["row", "source"] + cov_head + SHORT + ["line points / frame", "seeds"]
+    # How far our rows are from the accuracy limit, where their runs carry it (older runs: no column).
+    bounded = limit.any_bound([r for p in rows for r in p.runs] + [r for p in rows for q in p.peers for r in q.runs])
+    head = ["row", "source"] + cov_head + SHORT + ["line points / frame", "seeds"] + (["x the limit"] if bounded else [])
+
+    def near(runs: list[Run]) -> list[str]:
+        return [limit_cell(runs)] if bounded else []
     lines: list[list[str]] = []
     notes: list[str] = []
     for p in rows:
         st = p.stats
         if p.runs:
-            lines.append([p.shown + (" (tracking phase)" if p.phased else ""), "omniloc"] + tables.row_cells(st, cov, p.runs))
+            lines.append([p.shown + (" (tracking phase)" if p.phased else ""), "omniloc"] + tables.row_cells(st, cov, p.runs) + near(p.runs))
         else:
-            lines.append([p.label, "not run"] + ["-"] * (len(cov) + 9) + ["-", "0"])
+            lines.append([p.label, "not run"] + ["-"] * (len(cov) + 9) + ["-", "0"] + (["-"] if bounded else []))
             notes.append(f"not run: {p.label} ({pairing.describe_key(p.key)}); run: {report_command(p.command)}")
         for peer in p.peers:  # external localizers (docs/protocol.md) on the same scenario, configuration and start pose
-            lines.append([peer.row, f"external: {peer.name}"] + tables.row_cells(peer.stats, cov, peer.runs))
+            lines.append([peer.row, f"external: {peer.name}"] + tables.row_cells(peer.stats, cov, peer.runs) + near(peer.runs))
         if p.published:
-            lines.append([p.label, "paper"] + ["-"] * len(cov) + [f"{v:.3f}" for v in p.published] + ["-", "-"])
+            lines.append([p.label, "paper"] + ["-"] * len(cov) + [f"{v:.3f}" for v in p.published] + ["-", "-"] + (["-"] if bounded else []))
             if p.runs:
                 means = [st[f"{c}/{s}"].mean for c, s in metrics.TABLE_KEYS]
                 lines.append([p.label, "ours/paper"] + [""] * len(cov) + [f"{m / v:.2f}" if v and m is not None else "-"
-                                                                          for m, v in zip(means, p.published)] + ["", ""])
+                                                                          for m, v in zip(means, p.published)] + ["", ""] + ([""] if bounded else []))
     if markdown:
         print("| " + " | ".join(head) + " |")
         print("|" + "---|" * len(head))
@@ -96,5 +102,20 @@ def print_error_table(papers: JSONObject, key: str, runs: list[Run], labels: Opt
     print(f"\nunits: x, y in cm, th in rad; paper: {obj(papers[key])['source']}"
           + ("; ours: errors over the frames answered, " + ", ".join(
               f"'{h}': share of all frames " + ("within that threshold (a frame without an estimate counts as outside)" if h != "answered" else "with an estimate")
-              for h in cov_head) + ", means over seeds" if cov_head else "") + "\n")
+              for h in cov_head) + ", means over seeds" if cov_head else "")
+          + ("; 'x the limit': our position RMSE over the Cramer-Rao bound of the same frames (1x is the limit; posterior bound where "
+             "the runs track), mean over seeds, with the mean share of frames the bound covers; 'no bound' where no run has one" if bounded else "")
+          + "\n")
     return 0
+
+
+def limit_cell(runs: list[Run]) -> str:
+    """'1.32x (bound in 96 % of frames)' over a row's seeds; 'no bound' (in k of n runs) where runs have none."""
+    eff = metrics.run_stats(runs, "efficiency/position")
+    share = metrics.run_stats(runs, "efficiency/share")
+    if not eff.of:
+        return "-"
+    if eff.mean is None:
+        return bound.NO_BOUND
+    note = f"; {metrics.no_estimate_text(eff.no_value, eff.of, 'efficiency/position')}" if eff.no_value else ""
+    return f"{eff.mean:.2f}x ({bound.share_text(share.mean)}{note})"

@@ -130,9 +130,20 @@ def load_run(run_dir: Path, recording: Optional[Path] = None, image_every: int =
         def flag(name: str) -> List[Optional[bool]]:
             return [None if v is None else bool(v) for v in col(name)]
 
+        # The bound under the error curve: the posterior one where the run has it (tracking), else the single-frame one.
+        kind: Optional[str] = None
+        for prefix, label in (("pbound", "posterior"), ("bound", "single frame")):
+            if any(v is not None for v in c.get(f"{prefix}_pos_m", [])):
+                kind = label
+                break
+        if kind is None and "bound_pos_m" in c:
+            kind = "none"  # the run scores the bound, and no frame has one (no truth): said, never drawn as 0
+        prefix = "pbound" if kind == "posterior" else "bound"
         robots.append(RobotRun(id=rid, radius=radius.get(rid, 0.26), t=times[rid], truth=truth, estimate=estimate, est_from_tum=from_tum, valid=valid,
                                mode=modes[rid], camera_ok=flag("camera_ok"), line_points=col("line_points"),
                                match_error=col("match_error"), err_pos=col("err_pos"), err_theta=col("err_theta"),
+                               bound_pos=col(f"{prefix}_pos_m") if kind else None, bound_theta=col(f"{prefix}_heading_rad") if kind else None,
+                               bound_kind=kind,
                                contact=flag("contact"), extra={name: col(name) for name in extra}, debug=None, images={}))
 
     debug_source: Optional[str] = None

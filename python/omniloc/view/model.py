@@ -24,6 +24,11 @@ class RobotRun(TypedDict):
     match_error: List[Optional[float]]
     err_pos: List[Optional[float]]
     err_theta: List[Optional[float]]
+    # The accuracy limit per frame (frames.csv pbound_* where the run has the posterior bound, else
+    # bound_*; None where the frame has none); None for a run made before the bound.
+    bound_pos: Optional[List[Optional[float]]]
+    bound_theta: Optional[List[Optional[float]]]
+    bound_kind: Optional[str]  # "posterior", "single frame", or "none" where no frame has a bound
     contact: List[Optional[bool]]
     extra: Dict[str, List[Optional[float]]]  # the localizer's own frames.csv columns
     debug: Optional[List[Debug]]  # per frame

@@ -17,6 +17,7 @@ import array
 import base64
 import html
 import json
+import re
 import math
 import sys
 from pathlib import Path
@@ -126,6 +127,10 @@ def robot_json(r: RobotRun, max_particles: int, particles_every: int) -> PageJSO
         "extra": {k: [_num(v, 9) for v in vs] for k, vs in r["extra"].items()},
         "lp": None, "particles": None, "points": None, "blobs": {}, "cov": None, "images": {str(k): v for k, v in r["images"].items()},
     }
+    if r["bound_pos"] is not None:  # a run made before the bound: the page's data as it was
+        out["boundPos"] = [_num(v, 5) for v in r["bound_pos"]]
+        out["boundTh"] = [_num(v, 5) for v in (r["bound_theta"] or [])]
+        out["boundKind"] = r["bound_kind"]
     debug = r["debug"]
     if debug is not None:
         out["lp"] = _packed_points([d.line_points for d in debug], (1000.0, 1000.0))
@@ -160,6 +165,10 @@ def page_json(run: RunData, max_particles: int, particles_every: int) -> PageJSO
     }
 
 
+# The lines of viewer.js that draw the accuracy limit, between "// <bound>" and "// </bound>".
+BOUND_JS = re.compile(r"^[ \t]*// <bound>.*?// </bound>\n", re.S | re.M)
+
+
 def _script_safe(text: str) -> str:
     """JSON or JS that cannot end its <script> element early."""
     return text.replace("<!--", "\\u003c!--").replace("</", "<\\/")
@@ -171,6 +180,9 @@ def render(run: RunData, max_particles: int = 100, particles_every: int = 1) -> 
     css = (HERE / "viewer.css").read_text(encoding="utf-8")
     # One script in two files (each under 500 lines): viewer.js opens it, viewer_controls.js closes it.
     js = (HERE / "viewer.js").read_text(encoding="utf-8") + (HERE / "viewer_controls.js").read_text(encoding="utf-8")
+    if not any(r["bound_pos"] is not None for r in run["robots"]):
+        # The bound's drawing only where a robot has one: a run made before the bound gets the page it got before.
+        js = BOUND_JS.sub("", js)
     head, rest = template.split("{{DATA}}", 1)
     head = head.replace("{{TITLE}}", html.escape(run["title"])).replace("{{CSS}}", css)
     rest = rest.replace("{{JS}}", _script_safe(js))

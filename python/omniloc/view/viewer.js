@@ -293,6 +293,9 @@
       { v: raw.errPos, scale: 1, unit: 'm', name: 'position error', colour: COL.err, y0: g.y0a },
       { v: raw.errTh, scale: 180 / Math.PI, unit: 'deg', name: 'heading error', colour: COL.errTh, y0: g.y0b, abs: true }
     ];
+    // <bound> the accuracy limit (the Cramer-Rao bound of each frame) under the error curves; page.py leaves these lines out for runs without it
+    if (raw.boundPos) { series[0].bound = raw.boundPos; series[1].bound = raw.boundTh; }
+    // </bound>
     series.forEach(function (s) {
       var vmax = 0, n = raw.t.length;
       for (var k = 0; k < n; k++) if (s.v[k] !== null && raw.valid[k]) vmax = Math.max(vmax, Math.abs(s.v[k]) * s.scale);
@@ -318,6 +321,24 @@
       c.fillText(S.show.log ? fmtAxis(lo) : '0', g.x0 - 4, s.y0 + g.ph);
       c.textAlign = 'left';
       c.fillText(s.name + (s.abs ? ' (absolute)' : '') + (S.show.log ? ', log scale' : ''), g.x0 + 4, s.y0 + 10);
+      // <bound> shaded from 0 to the bound, frames without one left blank; the label says which bound and the share of frames it covers
+      if (s.bound) {
+        var covered = 0;
+        c.fillStyle = 'rgba(46,160,67,0.28)';
+        for (var k5 = 0; k5 < n; k5++) {
+          var bv = s.bound[k5];
+          if (bv === null || bv === undefined) continue;
+          covered++;
+          var xa5 = plotX(g, raw.t[k5]), xb5 = plotX(g, k5 + 1 < n ? raw.t[k5 + 1] : raw.t[k5]), yb = yOf(bv * s.scale);
+          c.fillRect(xa5, yb, Math.max(1, xb5 - xa5), s.y0 + g.ph - yb);
+        }
+        c.fillStyle = '#2e7d32';
+        c.textAlign = 'right';
+        c.fillText(covered ? 'shaded: ' + raw.boundKind + ' bound, in ' + Math.floor(100 * covered / Math.max(1, n)) + ' % of frames' : 'no bound in any frame',
+                   g.x1 - 4, s.y0 + 10);
+        c.textAlign = 'left';
+      }
+      // </bound>
       c.strokeStyle = s.colour; c.lineWidth = 1.2;
       c.beginPath();
       var pen = false;

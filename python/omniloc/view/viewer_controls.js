@@ -23,6 +23,13 @@
       var ep = raw.errPos[k], eth = raw.errTh[k] * 180 / Math.PI;
       h += row('error', fmt(ep * 100, 1) + ' cm, ' + fmt(eth, 2) + '°', ep > 0.5 || Math.abs(eth) > 20 ? 'bad' : '');
     }
+    // <bound> this frame's accuracy limit (standard deviation no unbiased estimator can beat), or why there is none
+    if (raw.boundPos) {
+      var bp = raw.boundPos[k], bt = raw.boundTh[k];
+      h += row(raw.boundKind === 'none' ? 'bound' : raw.boundKind + ' bound',
+               bp === null ? 'no bound in this frame' : fmt(bp * 100, 1) + ' cm, ' + fmt(bt * 180 / Math.PI, 2) + '°');
+    }
+    // </bound>
     var e = raw.cov && raw.cov[k];
     if (e) h += row('covariance', '2σ ellipse ' + fmt(e[0] * 100, 1) + ' × ' + fmt(e[1] * 100, 1) + ' cm, σθ ' + fmt(e[3] * 180 / Math.PI, 2) + '°');
     if (D.debugSource) {
