@@ -36,9 +36,11 @@ void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twin
 
 void prune(std::vector<Hypothesis>& set, const HypothesisSetParams& p) {
   if (set.size() <= 1) return;
+  double top = 0.0;
+  for (const auto& h : set) top = std::max(top, h.validity);
   std::vector<Hypothesis> kept;
   for (const auto& h : set)
-    if (h.age < p.prune_age || h.validity >= p.prune_validity) kept.push_back(h);
+    if (h.age < p.prune_age || (h.validity >= p.prune_validity && h.validity >= top - p.prune_gap)) kept.push_back(h);
   if (kept.empty()) kept.push_back(set[static_cast<std::size_t>(best(set, -1, 0.0))]);
   set.swap(kept);
 }

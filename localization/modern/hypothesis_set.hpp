@@ -26,6 +26,10 @@ struct HypothesisSetParams {
   double merge_xy = 0.25;     ///< m: closer hypotheses are one (within one association corridor)
   double merge_theta = 0.2;   ///< rad
   double prune_validity = 0.1;
+  /// Hypotheses this much less valid than the most valid one are pruned: a validity is a filtered
+  /// share of points that fit, whose frame-to-frame noise with ~100 points is a few hundredths, so
+  /// 0.3 less after prune_age (two validity time constants) has lost on the evidence.
+  double prune_gap = 0.3;
   double prune_age = 1.0;     ///< s: younger hypotheses are not pruned (they have not been judged)
 };
 
@@ -40,7 +44,8 @@ Eigen::Vector3d twin(const Eigen::Vector3d& q);
 /// a compass or goal colours nothing can tell them apart, and two of them would make the output jump).
 void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twins_equal);
 
-/// Removes hypotheses older than prune_age with validity below prune_validity, never the last one.
+/// Removes hypotheses older than prune_age with validity below prune_validity or more than
+/// prune_gap below the most valid one; never the last one.
 void prune(std::vector<Hypothesis>& set, const HypothesisSetParams& p);
 
 /// Adds `h`; when the set is full it replaces the least valid one. Returns false (and adds nothing)

@@ -32,6 +32,7 @@ const ParamList<HypothesisSetParams>& set_params() {
       positive_param("merge_xy", &P::merge_xy, 10.0, "m", "hypotheses closer than this (and merge_theta) are merged"),
       positive_param("merge_theta", &P::merge_theta, 3.2, "rad", "hypotheses closer than this in heading (and merge_xy) are merged"),
       number_param("prune_validity", &P::prune_validity, 0.0, 1.0, "", "hypotheses below this validity are pruned"),
+      number_param("prune_gap", &P::prune_gap, 0.0, 1.0, "", "hypotheses this much less valid than the most valid one are pruned"),
       number_param("prune_age", &P::prune_age, 0.0, 100.0, "s", "younger hypotheses are not pruned"),
   };
   return list;
