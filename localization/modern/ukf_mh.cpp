@@ -171,14 +171,31 @@ bool UkfMhLocalizer::contradicted(const Eigen::Vector3d& q, std::optional<double
   return false;
 }
 
+double UkfMhLocalizer::point_variance(const Eigen::Vector2d& o) const {
+  const double d2 = p_.weight_d * p_.weight_d;
+  return p_.point_sigma * p_.point_sigma * (d2 + o.squaredNorm()) / (d2 + p_.weight_ref * p_.weight_ref);
+}
+
+double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const {
+  if (pts.empty()) return 0.0;
+  const double common_var = p_.common_sd_xy * p_.common_sd_xy;
+  const double c = std::cos(q.z()), s = std::sin(q.z());
+  int fit = 0;
+  for (const auto& o : pts) {
+    const Eigen::Vector2d w(q.x() + c * o.x() - s * o.y(), q.y() + s * o.x() + c * o.y());
+    const LocalMarking m = assoc_.associate(w);
+    if (m.marking >= 0 && m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (point_variance(o) + common_var)) ++fit;
+  }
+  return static_cast<double>(fit) / static_cast<double>(pts.size());
+}
+
 void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs,
                                    double dt) {
   // Per point: its noise variance (grows with range, NuBot's weights read as variances).
-  const double d2 = p_.weight_d * p_.weight_d, ref = (d2 + p_.weight_ref * p_.weight_ref);
   const double common_var = p_.common_sd_xy * p_.common_sd_xy;
   thread_local std::vector<double> var;
   var.resize(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) var[i] = p_.point_sigma * p_.point_sigma * (d2 + pts[i].squaredNorm()) / ref;
+  for (std::size_t i = 0; i < pts.size(); ++i) var[i] = point_variance(pts[i]);
   const auto linearise = [&](const Eigen::Vector3d& at, const SigmaPoints& sp, InformationSum& sum) {
     const double c = std::cos(at.z()), s = std::sin(at.z());
     std::array<double, 6> cs{}, sn{};
@@ -204,16 +221,8 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   common(0, 0) = common(1, 1) = common_var;
   common(2, 2) = p_.common_sd_theta * p_.common_sd_theta;
   h.ukf.update(linearise, p_.iterations, common);
-  // The frame's fit at the new mean: the share of points within inlier_sigmas of their marking.
+  h.inliers = inlier_share(h.ukf.mean(), pts);
   const Eigen::Vector3d& q = h.ukf.mean();
-  const double c = std::cos(q.z()), s = std::sin(q.z());
-  int fit = 0;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const Eigen::Vector2d w(q.x() + c * pts[i].x() - s * pts[i].y(), q.y() + s * pts[i].x() + c * pts[i].y());
-    const LocalMarking m = assoc_.associate(w);
-    if (m.marking >= 0 && m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (var[i] + common_var)) ++fit;
-  }
-  h.inliers = pts.empty() ? 0.0 : static_cast<double>(fit) / static_cast<double>(pts.size());
   const double evidence = contradicted(q, heading, obs) ? 0.0 : h.inliers;
   const double alpha = 1.0 - std::exp(-std::max(dt, 0.0) / p_.validity_time);
   h.validity += alpha * (evidence - h.validity);
@@ -240,7 +249,10 @@ void UkfMhLocalizer::search(const std::vector<Eigen::Vector2d>& pts, std::option
     Hypothesis h;
     h.ukf.reset(Pose2(cand.pose.x(), cand.pose.y(), cand.pose.z()),
                 Eigen::Vector3d(p_.new_sd_xy * p_.new_sd_xy, p_.new_sd_xy * p_.new_sd_xy, p_.new_sd_theta * p_.new_sd_theta).asDiagonal());
-    h.validity = 0.0;
+    // Half credit for the frame it was fitted to: one frame alone does not make a pose valid, and a
+    // pose that explains fewer points than valid_min / 0.5 of them starts below what it can reach.
+    h.validity = 0.5 * inlier_share(cand.pose, pts);
+    h.inliers = 2.0 * h.validity;
     h.id = next_id_++;
     // Replacement: when full, the least valid hypothesis that is not the current estimate goes.
     if (static_cast<int>(set_.size()) >= p_.set.max_hypotheses) {

@@ -50,7 +50,7 @@ struct UkfMhParams {
   // Hypotheses.
   HypothesisSetParams set;
   double validity_time = 0.5;    ///< s: time constant of the validity's low-pass filter
-  double valid_min = 0.5;        ///< validity at which a hypothesis is reported valid
+  double valid_min = 0.75;       ///< validity at which a hypothesis is reported valid
   double hysteresis = 0.05;      ///< another hypothesis must be this much more valid to take the lead
   double compass_gate = 0.5;     ///< rad: a hypothesis this far from the compass heading fits nothing
   double new_sd_xy = 0.1;        ///< m: a proposal's initial standard deviation
@@ -81,6 +81,9 @@ class UkfMhLocalizer : public Localizer {
   /// The points moved into the robot frame of now (latency: the image shows the robot as it was).
   std::vector<Eigen::Vector2d> to_now(const std::vector<Eigen::Vector2d>& pts, double t) const;
   void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
+  double point_variance(const Eigen::Vector2d& o) const;
+  /// The share of the points within inlier_sigmas standard deviations of their marking at q.
+  double inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const;
   bool contradicted(const Eigen::Vector3d& q, std::optional<double> heading, const Observations& obs) const;
   void search(const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, bool twins_equal, bool searching);
 
