@@ -106,13 +106,17 @@ InformationSum UkfPose::update(Linearise&& linearise, int iterations, const Eige
   Eigen::Vector3d at = x_;
   Eigen::Matrix3d post = p_;
   InformationSum sum;
+  int done = 0;
   for (int it = 0; it < iterations; ++it) {
     const SigmaPoints sp(at, p_);
-    sum = InformationSum{};
-    linearise(at, sp, sum);
-    if (sum.used == 0) return sum;
+    InformationSum next;
+    linearise(at, sp, next);
+    if (next.used == 0) break;  // nothing associated from here: keep the last step's result
+    sum = next;
     at = step(at, sum, common, &post);
+    ++done;
   }
+  if (done == 0) return sum;
   x_ = at;
   x_.z() = wrap_angle(x_.z());
   p_ = 0.5 * (post + post.transpose());
