@@ -253,3 +253,34 @@ TEST(UkfMh, RecoversFromAKidnap) {
   EXPECT_GE(found_at, 0.0);
   EXPECT_LE(found_at, 2.0);
 }
+
+// Twins on the legacy field (coloured goals), no compass: a yellow blob decides between a pose and
+// its point mirror. Seen where the yellow goal is from the truth, it ends on the truth; seen where
+// the twin would see it (pi further round), on the twin.
+TEST(UkfMh, GoalColourDecidesTheTwin) {
+  const Field f = Field::preset("msl2007");
+  const FieldMap prefilter(f, 0.05);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed)
+    for (bool mirrored : {false, true}) {
+      const Pose2 truth(-1.5 + seed, 1.0 - 0.5 * seed, 2.5 - 1.7 * seed);
+      const Pose2 want = mirrored ? Pose2(-truth.x, -truth.y, truth.theta + kPi) : truth;
+      UkfMhLocalizer loc(f, UkfMhParams{}, seed, "");
+      loc.reset(std::nullopt);
+      Rng rng(seed);
+      Estimate e;
+      for (int k = 0; k < 60; ++k) {
+        Observations obs;
+        obs.t = k / 30.0;
+        obs.line_points = scenes::line_points(f, truth, 80, rng, {.noise = 0.02, .prefilter = &prefilter});
+        Blob yellow;
+        yellow.colour = kYellow;  // the goal at +x, seen from `want`
+        yellow.bearing = wrap_angle(std::atan2(0.0 - want.y, 6.0 - want.x) - want.theta);
+        obs.blobs.push_back(yellow);
+        e = loc.update(obs, Odometry{obs.t, Pose2()}, std::nullopt);
+      }
+      ASSERT_TRUE(e.valid) << seed << " " << mirrored;
+      EXPECT_EQ(e.extra.at("twin_ambiguous"), 0.0);
+      EXPECT_LT(std::hypot(e.pose.x - want.x, e.pose.y - want.y), 0.05) << seed << " " << mirrored << ": " << e.pose.x << ", " << e.pose.y;
+      EXPECT_LT(std::fabs(angle_diff(e.pose.theta, want.theta)), 0.05) << seed << " " << mirrored;
+    }
+}
