@@ -31,6 +31,7 @@
 #include "localization/landmarks/landmark_solvers.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
+#include "localization/modern/ukf_mh.hpp"
 #include "localization/vision/blobs.hpp"
 #include "localization/vision/scan_lines.hpp"
 #include "sim/render/panoramic_camera.hpp"
@@ -102,6 +103,23 @@ std::map<std::string, Workload> workloads() {
                        return loc->update(*obs, Odometry{}, std::nullopt).pose.x;
                      });
                    }};
+  w["ukf_mh"] = {200, "ukf_mh tracking frame (predict, 100 of 200 line points associated and updated twice), alternative-pose rounds off", [] {
+                   auto f = std::make_shared<Field>(Field::preset("msl2012"));
+                   modern::UkfMhParams p;
+                   p.alt_period = 1e9;
+                   auto loc = std::make_shared<modern::UkfMhLocalizer>(*f, p, 1, "");
+                   Rng rng(1);
+                   const Pose2 truth(-3.0, 1.0, 0.4);
+                   auto obs = std::make_shared<Observations>();
+                   obs->line_points = scenes::line_points(*f, truth, 200, rng, scenes::kBenchmarkLinePoints);
+                   loc->reset(truth);
+                   auto k = std::make_shared<int>(0);
+                   return std::function<double()>([f, loc, obs, k] {
+                     obs->t += 1.0 / 30.0;
+                     const Odometry odo{obs->t, Pose2(((*k)++ & 1) ? 0.03 : -0.03, 0.0, 0.0)};
+                     return loc->update(*obs, odo, std::nullopt).pose.x;
+                   });
+                 }};
   w["fieldmap_lookup"] = {100000, "field distance map lookup with gradient (5 cm cells)", [] {
                             auto m = std::make_shared<FieldMap>(Field::preset("msl2012"), 0.05);
                             auto q = std::make_shared<std::vector<Eigen::Vector2d>>();

@@ -5,6 +5,7 @@
 #include "localization/landmarks/landmark_localizer.hpp"
 #include "localization/matching.hpp"
 #include "localization/mcl.hpp"
+#include "localization/modern/ukf_mh.hpp"
 #include "localization/odometry_only.hpp"
 
 namespace omniloc::harness {
@@ -45,6 +46,9 @@ const std::vector<LocalizerInfo>& localizers() {
          return std::make_unique<GridGlobalLocalizer>(*ctx.field, GridGlobalParams::from_json(r), ctx.cache_dir);
        },
        &GridGlobalParams::schema},
+      {"ukf_mh", "modern reference: a few unscented Kalman filter hypotheses on line points associated with the markings, validity-filtered, with Falcons-style simplex field fits as alternative poses (after B-Human's SelfLocator / UKFPose2D and the Falcons' localization; docs/modern_localizer.md)", false, true,
+       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, modern::UkfMhParams::from_json(r), ctx.seed, ctx.cache_dir); },
+       &modern::UkfMhParams::schema},
       {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },
        [] { return params_schema(LandmarkLocalizerParams::params()); }},

@@ -120,7 +120,7 @@ class WrongTypes(unittest.TestCase):
             elif kind == "scenario" and not is_sweep and isinstance(j, dict) and "robots" in j and "experiment" not in j:
                 shipped.append(j)
         if kind == "scenario":
-            for t in ["odometry_only", "matching", "mcl", "hybrid", "grid_global", "landmarks"]:
+            for t in ["odometry_only", "matching", "mcl", "hybrid", "grid_global", "landmarks", "ukf_mh"]:
                 docs.append(dict(BASE, localizer=LOCALIZERS.get(t, {"type": t})))
             docs.append(dict(BASE, localizer=dict(EXTERNAL)))
             docs.append(dict(BASE, lighting={"lamp_grid": {}}))

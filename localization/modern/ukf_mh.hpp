@@ -1,0 +1,109 @@
+#pragma once
+// Localizer "ukf_mh": a modern reference beside the papers' localizers, designed after the
+// strongest documented self-locators of today (our own code; the methods from their published
+// descriptions and sources):
+// - B-Human's SelfLocator and UKFPose2D (bhuman/BHumanCodeRelease: Src/Modules/Modeling/SelfLocator,
+//   Src/Tools/Modeling/UKFPose2D): a small set of hypotheses, each an unscented Kalman filter over
+//   (x, y, theta) (ukf_pose.hpp); odometry prediction with noise growing with distance and rotation;
+//   line-point updates with association to the field's markings inside a corridor
+//   (marking_association.hpp); a validity per hypothesis, filtered over frames; merging, pruning and
+//   replacement of hypotheses (hypothesis_set.hpp); twin handling by compass or goal colours.
+// - The Falcons' field fit (Falcons-Robocup code, packages/multiCam determinePosition; MRA-components
+//   localization_vision): a per-frame simplex fit over a field table from the previous candidates
+//   plus restarts (alternative_poses.hpp), which proposes poses; a proposal replaces the weakest
+//   hypothesis when the evidence disagrees with the current estimate.
+// It reads what every localizer reads: line points, odometry, the heading when there is one, blobs
+// of goal colours where the field has them. No start pose: it localizes globally.
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "core/json_reader.hpp"
+#include "core/params.hpp"
+#include "localization/field_map.hpp"
+#include "localization/localizer.hpp"
+#include "localization/modern/alternative_poses.hpp"
+#include "localization/modern/hypothesis_set.hpp"
+#include "localization/modern/marking_association.hpp"
+#include "localization/modern/ukf_pose.hpp"
+
+namespace omniloc::modern {
+
+/// Every default argued in docs/localizers.md ("ukf_mh: defaults and their arguments").
+struct UkfMhParams {
+  // Measurements.
+  int max_points = 100;          ///< line points evenly subsampled beyond this (cost; the common error dominates beyond)
+  int min_points = 10;           ///< fewer: no sensor update (matching's default; NuBot > 15, CAMBADA > 5)
+  double point_sigma = 0.05;     ///< m: a line point's own noise at range weight_ref (matching's point_sigma)
+  double weight_d = 2.5;         ///< m: point noise grows as (weight_d^2 + r^2) (NuBot's range weights)
+  double weight_ref = 1.5;       ///< m: the range at which the noise is point_sigma (NuBot)
+  double common_sd_xy = 0.03;    ///< m: frame-common error of the points' pose (camera vibration)
+  double common_sd_theta = 0.01; ///< rad
+  double corridor = 0.5;         ///< m: points farther from their marking are not associated
+  double gate_sigmas = 3.0;      ///< innovation gate in standard deviations
+  double inlier_sigmas = 3.0;    ///< a point fits when within this many standard deviations of its marking
+  int iterations = 2;            ///< iterated update: association and linearisation again at the new mean
+  double latency = 0.0;          ///< s: the image is this much older than the odometry (0: unknown)
+  // Odometry.
+  MotionNoise motion;
+  // Hypotheses.
+  HypothesisSetParams set;
+  double validity_time = 0.5;    ///< s: time constant of the validity's low-pass filter
+  double valid_min = 0.75;       ///< validity at which a hypothesis is reported valid
+  double hysteresis = 0.05;      ///< another hypothesis must be this much more valid to take the lead
+  double compass_gate = 0.5;     ///< rad: a hypothesis this far from the compass heading fits nothing
+  double new_sd_xy = 0.1;        ///< m: a proposal's initial standard deviation
+  double new_sd_theta = 0.05;    ///< rad
+  // Alternative poses.
+  AlternativePoseParams alt;
+  int alt_points = 40;           ///< line points of the fit (evenly subsampled)
+  double alt_period = 0.5;       ///< s: while tracking, a search round this often
+  int alt_tracking_restarts = 20;  ///< fresh restarts per round while tracking (searching: alt.screened)
+  double alt_margin = 0.05;      ///< a proposal must beat the best hypothesis's score by this to enter
+  double cell = 0.05;            ///< m: distance-map cell of the fit (Tribots: 50 mm)
+
+  static UkfMhParams from_json(JsonReader& r);
+  static const ParamList<UkfMhParams>& params();
+  static Json schema();
+};
+
+class UkfMhLocalizer : public Localizer {
+ public:
+  UkfMhLocalizer(const Field& field, const UkfMhParams& p, std::uint64_t seed, const std::string& cache_dir);
+  std::string type() const override { return "ukf_mh"; }
+  void reset(const std::optional<Pose2>& start) override;
+  Estimate update(const Observations& obs, const Odometry& odometry, std::optional<double> heading) override;
+  DebugView debug_view(std::size_t max_particles) const override;
+  const std::vector<Hypothesis>& hypotheses() const { return set_; }
+
+ private:
+  /// The points moved into the robot frame of now (latency: the image shows the robot as it was).
+  std::vector<Eigen::Vector2d> to_now(const std::vector<Eigen::Vector2d>& pts, double t) const;
+  void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
+  double point_variance(const Eigen::Vector2d& o) const;
+  /// The share of the points within inlier_sigmas standard deviations of their marking at q.
+  double inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const;
+  bool contradicted(const Eigen::Vector3d& q, std::optional<double> heading, const Observations& obs) const;
+  void search(const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, bool twins_equal, bool searching);
+
+  UkfMhParams p_;
+  Field field_;
+  FieldMap map_;
+  MarkingAssociation assoc_;
+  AlternativePoses alt_;
+  std::vector<Hypothesis> set_;
+  std::uint32_t next_id_ = 0;
+  std::int64_t best_id_ = -1;
+  bool was_valid_ = false;
+  std::optional<double> last_t_;
+  double last_search_t_ = -1e300;
+  int proposals_ = 0;
+  struct Motion {
+    double t0, t1;
+    Pose2 delta;
+  };
+  std::deque<Motion> history_;
+};
+
+}  // namespace omniloc::modern

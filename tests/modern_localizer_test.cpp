@@ -1,0 +1,286 @@
+// The modern reference localizer (localization/modern/): its parts against known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "core/field.hpp"
+#include "core/rng.hpp"
+#include "localization/field_map.hpp"
+#include "localization/modern/alternative_poses.hpp"
+#include "localization/modern/hypothesis_set.hpp"
+#include "localization/modern/marking_association.hpp"
+#include "localization/modern/ukf_mh.hpp"
+#include "localization/modern/ukf_pose.hpp"
+#include "testing/scenes.hpp"
+
+using namespace omniloc;
+using namespace omniloc::modern;
+
+namespace {
+
+Eigen::Matrix3d spd(double a, double b, double c, double ab, double ac, double bc) {
+  Eigen::Matrix3d p;
+  p << a, ab, ac, ab, b, bc, ac, bc, c;
+  return p;
+}
+
+}  // namespace
+
+// On linear measurements the sigma-point update is the Kalman filter's: x+ = x + K (z - H x),
+// P+ = (I - K H) P with K = P H^T (H P H^T + R)^-1, for two scalar measurements at once.
+TEST(UkfPose, LinearUpdateEqualsKalmanFilter) {
+  const Eigen::Vector3d x0(1.0, -2.0, 0.3);
+  const Eigen::Matrix3d p0 = spd(0.04, 0.09, 0.01, 0.01, 0.002, -0.003);
+  Eigen::Matrix<double, 2, 3> h;
+  h << 1.0, 0.5, -2.0, 0.0, 1.0, 3.0;
+  const Eigen::Vector2d z(1.2, -1.0), r(0.01, 0.02);
+  UkfPose ukf;
+  ukf.reset(Pose2(x0.x(), x0.y(), x0.z()), p0);
+  const auto linearise = [&](const Eigen::Vector3d&, const SigmaPoints& sp, InformationSum& sum) {
+    for (int m = 0; m < 2; ++m) {
+      std::array<double, 6> v{};
+      for (int s = 0; s < 6; ++s) v[static_cast<std::size_t>(s)] = h.row(m).dot(sp[s]);
+      sp.add(v, sp.predict(v), z[m], r[m], sum);
+    }
+  };
+  ukf.update(linearise, 1, Eigen::Matrix3d::Zero());
+  const Eigen::Matrix2d s = h * p0 * h.transpose() + Eigen::Matrix2d(r.asDiagonal());
+  const Eigen::Matrix<double, 3, 2> k = p0 * h.transpose() * s.inverse();
+  const Eigen::Vector3d x1 = x0 + k * (z - h * x0);
+  const Eigen::Matrix3d p1 = (Eigen::Matrix3d::Identity() - k * h) * p0;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(ukf.mean()[i], x1[i], 1e-9) << i;
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(ukf.covariance()(i, j), p1(i, j), 1e-9) << i << "," << j;
+  }
+  // Iterating a linear update changes nothing (Gauss-Newton converges in one step).
+  UkfPose again;
+  again.reset(Pose2(x0.x(), x0.y(), x0.z()), p0);
+  again.update(linearise, 3, Eigen::Matrix3d::Zero());
+  EXPECT_NEAR((again.mean() - x1).norm(), 0.0, 1e-9);
+}
+
+// A frame-common error C: the points act as one pose measurement of covariance I^-1 + C.
+TEST(UkfPose, CommonErrorCapsTheInformation) {
+  const Eigen::Matrix3d p0 = Eigen::Vector3d(0.01, 0.01, 0.001).asDiagonal();
+  UkfPose ukf;
+  ukf.reset(Pose2(0, 0, 0), p0);
+  // 1000 direct measurements of x with variance 1e-4: alone, information 1e7.
+  const auto linearise = [&](const Eigen::Vector3d&, const SigmaPoints& sp, InformationSum& sum) {
+    for (int m = 0; m < 1000; ++m) {
+      std::array<double, 6> v{};
+      for (int s = 0; s < 6; ++s) v[static_cast<std::size_t>(s)] = sp[s].x();
+      sp.add(v, sp.predict(v), 0.1, 1e-4, sum);
+    }
+  };
+  const Eigen::Matrix3d common = Eigen::Vector3d(0.0009, 0.0009, 0.0001).asDiagonal();
+  ukf.update(linearise, 1, common);
+  // Scalar check along x: the measurement's variance is 1e-7 + 9e-4.
+  const double r = 1e-4 / 1000 + 0.0009;
+  const double k = 0.01 / (0.01 + r);
+  EXPECT_NEAR(ukf.mean().x(), k * 0.1, 1e-9);
+  EXPECT_NEAR(ukf.covariance()(0, 0), (1 - k) * 0.01, 1e-9);
+  EXPECT_NEAR(ukf.covariance()(1, 1), 0.01, 1e-12);  // y was not measured
+}
+
+// Prediction by a pure turn is linear: mean rotated, covariance P + Q.
+TEST(UkfPose, PredictPureTurnIsLinear) {
+  const Eigen::Matrix3d p0 = spd(0.04, 0.09, 0.01, 0.01, 0.002, -0.003);
+  UkfPose ukf;
+  ukf.reset(Pose2(2.0, 1.0, 3.0), p0);
+  const Eigen::Matrix3d q = Eigen::Vector3d(1e-4, 1e-4, 4e-4).asDiagonal();
+  ukf.predict(Pose2(0, 0, 0.5), q);
+  EXPECT_NEAR(ukf.mean().x(), 2.0, 1e-12);
+  EXPECT_NEAR(ukf.mean().y(), 1.0, 1e-12);
+  EXPECT_NEAR(ukf.mean().z(), wrap_angle(3.5), 1e-12);  // wrapped across pi
+  EXPECT_NEAR((ukf.covariance() - (p0 + q)).norm(), 0.0, 1e-11);  // the Cholesky's 1e-12 load
+}
+
+TEST(UkfPose, MotionNoiseGrowsWithDistanceAndTurn) {
+  const MotionNoise n;  // defaults
+  const Eigen::Matrix3d still = motion_covariance(Pose2(0, 0, 0), 0.0, n);
+  const Eigen::Matrix3d drive = motion_covariance(Pose2(0.04, 0.0, 0.0), 0.0, n);
+  const Eigen::Matrix3d turn = motion_covariance(Pose2(0, 0, 0.2), 0.0, n);
+  EXPECT_NEAR(still(0, 0), n.floor_xy * n.floor_xy, 1e-15);
+  EXPECT_NEAR(drive(0, 0), 0.015 * 0.015 * 0.04 + 0.0004 * 0.0004 + 1e-6, 1e-15);
+  EXPECT_NEAR(turn(2, 2), 0.035 * 0.035 * 0.2 + 1e-6, 1e-15);
+  EXPECT_GT(drive(2, 2), still(2, 2));
+}
+
+// The nearest marking and its signed distance, at known places of the 2012 MSL field.
+TEST(MarkingAssociation, PicksTheNearestMarking) {
+  const Field f = Field::preset("msl2012");
+  const MarkingAssociation a(f);
+  // 7 cm beside the halfway line (x = 0), half-way to the touch line: the halfway line.
+  const LocalMarking halfway = a.associate(Eigen::Vector2d(0.07, 4.5));
+  ASSERT_GE(halfway.marking, 0);
+  EXPECT_FALSE(halfway.circle);
+  EXPECT_NEAR(halfway.distance, 0.07, 1e-12);
+  EXPECT_NEAR(a.distance(halfway.marking, Eigen::Vector2d(0.0, -5.0)), 0.0, 1e-12);  // the whole line
+  EXPECT_NEAR(halfway.value(0.07, 4.5), 0.07, 1e-12);
+  EXPECT_NEAR(halfway.value(-0.03, 4.5), -0.03, 1e-12);  // signed: across the line
+  // On the centre circle's inside (radius 2 m), away from the halfway line: the circle.
+  const Eigen::Vector2d inside(1.9 * std::cos(0.7), 1.9 * std::sin(0.7));
+  const LocalMarking circle = a.associate(inside);
+  ASSERT_TRUE(circle.circle);
+  EXPECT_NEAR(circle.distance, 0.1, 1e-9);
+  EXPECT_NEAR(circle.value(inside.x(), inside.y()), 0.1, 1e-9);
+  // Everywhere: the association's distance is the field's exact distance to the nearest marking
+  // (except spots, which it does not use).
+  Rng rng(5);
+  Field no_spots = f;
+  no_spots.spots.clear();
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector2d p(rng.uniform(-10, 10), rng.uniform(-7, 7));
+    EXPECT_NEAR(a.associate(p).distance, no_spots.distance_to_marking(p), 1e-9) << p.transpose();
+  }
+}
+
+TEST(HypothesisSet, MergesOneBasinAndTwinsOnlyWhenAsked) {
+  const HypothesisSetParams p;
+  const auto make = [](double x, double y, double th, double v, std::uint32_t id) {
+    Hypothesis h;
+    h.ukf.reset(Pose2(x, y, th), Eigen::Matrix3d::Identity() * 0.01);
+    h.validity = v;
+    h.id = id;
+    return h;
+  };
+  std::vector<Hypothesis> s = {make(1.0, 2.0, 0.1, 0.3, 0), make(1.1, 2.05, 0.15, 0.8, 1), make(-1.0, -2.0, 0.1 + kPi, 0.5, 2)};
+  merge(s, p, false);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].id, 1u);  // the more valid of the close pair stays
+  EXPECT_EQ(s[1].id, 2u);  // the twin stays: something could tell it apart
+  merge(s, p, true);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].id, 1u);
+  // Pruning: old and invalid goes, never the last one; best() keeps the lead within the hysteresis.
+  std::vector<Hypothesis> t = {make(0, 0, 0, 0.05, 0), make(3, 0, 0, 0.6, 1), make(-3, 0, 0, 0.62, 2)};
+  for (auto& h : t) h.age = 2.0;
+  prune(t, p);
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(best(t, 0, 0.05), 0);  // index 0 (id 1) leads; 0.62 is not 0.05 above 0.6
+  EXPECT_EQ(best(t, -1, 0.05), 1);
+}
+
+TEST(AlternativePoses, SimplexFitsThePoseFromAnOffsetStart) {
+  const Field f = Field::preset("msl2012");
+  const FieldMap map(f, 0.05);
+  Rng rng(3);
+  const Pose2 truth(-3.0, 1.0, 0.4);
+  const auto pts = scenes::line_points(f, truth, 40, rng);
+  const Candidate c = simplex_fit(map, pts, Eigen::Vector3d(truth.x + 0.3, truth.y - 0.25, truth.theta + 0.1), AlternativePoseParams{});
+  EXPECT_LT(std::hypot(c.pose.x() - truth.x, c.pose.y() - truth.y), 0.02);
+  EXPECT_LT(std::fabs(angle_diff(c.pose.z(), truth.theta)), 0.01);
+  EXPECT_LT(c.score, 0.05);
+}
+
+namespace {
+// Frames of exact line points seen from `truth` (a standing robot), fed to a fresh localizer.
+struct ColdStart {
+  double first_valid_s = -1;
+  Estimate last;
+};
+ColdStart cold_start(const Pose2& truth, std::optional<double> heading, std::uint64_t seed) {
+  const Field f = Field::preset("msl2012");
+  UkfMhLocalizer loc(f, UkfMhParams{}, seed, "");
+  const FieldMap prefilter(f, 0.05);
+  loc.reset(std::nullopt);
+  Rng rng(seed);
+  ColdStart out;
+  for (int k = 0; k < 60; ++k) {  // 2 s at 30 Hz
+    Observations obs;
+    obs.t = k / 30.0;
+    obs.line_points = scenes::line_points(f, truth, 80, rng, {.noise = 0.02, .prefilter = &prefilter});
+    out.last = loc.update(obs, Odometry{obs.t, Pose2()}, heading);
+    if (out.first_valid_s < 0 && out.last.valid) out.first_valid_s = obs.t;
+  }
+  return out;
+}
+}  // namespace
+
+// A cold start on synthetic frames: right (5 cm, 0.05 rad) and valid within 1 s, with a compass on
+// the true pose, without one on the true pose or its twin.
+TEST(UkfMh, ColdStartConverges) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const Pose2 truth(-2.0 + seed, 1.5 - 0.7 * seed, -0.5 + 0.6 * seed);
+    const ColdStart with = cold_start(truth, truth.theta, seed);
+    ASSERT_TRUE(with.last.valid) << seed;
+    EXPECT_GE(with.first_valid_s, 0.0);
+    EXPECT_LE(with.first_valid_s, 1.0) << seed;
+    EXPECT_LT(std::hypot(with.last.pose.x - truth.x, with.last.pose.y - truth.y), 0.05) << seed;
+    EXPECT_LT(std::fabs(angle_diff(with.last.pose.theta, truth.theta)), 0.05) << seed;
+    EXPECT_EQ(with.last.extra.at("twin_ambiguous"), 0.0);
+    const ColdStart without = cold_start(truth, std::nullopt, seed);
+    ASSERT_TRUE(without.last.valid) << seed;
+    EXPECT_LE(without.first_valid_s, 1.0) << seed;
+    const double sign = without.last.pose.x * truth.x > 0 ? 1.0 : -1.0;  // the truth or its twin
+    EXPECT_LT(std::hypot(without.last.pose.x - sign * truth.x, without.last.pose.y - sign * truth.y), 0.05) << seed;
+    EXPECT_LT(std::fabs(angle_diff(without.last.pose.theta, truth.theta + (sign > 0 ? 0.0 : kPi))), 0.05) << seed;
+    EXPECT_EQ(without.last.extra.at("twin_ambiguous"), 1.0);
+  }
+}
+
+// A kidnap: tracking one pose, then the points come from another. The old pose must stop being
+// valid within a second and the new one be found.
+TEST(UkfMh, RecoversFromAKidnap) {
+  const Field f = Field::preset("msl2012");
+  UkfMhLocalizer loc(f, UkfMhParams{}, 7, "");
+  const Pose2 a(-4.0, 2.0, 0.3), b(3.0, -1.5, 0.3);
+  loc.reset(a);
+  const FieldMap prefilter(f, 0.05);
+  Rng rng(7);
+  double invalid_at = -1, found_at = -1;
+  for (int k = 0; k < 120; ++k) {
+    const bool after = k >= 30;
+    Observations obs;
+    obs.t = k / 30.0;
+    obs.line_points = scenes::line_points(f, after ? b : a, 80, rng, {.noise = 0.02, .prefilter = &prefilter});
+    const Estimate e = loc.update(obs, Odometry{obs.t, Pose2()}, 0.3);
+    if (!after) {
+      ASSERT_TRUE(e.valid) << k;
+      continue;
+    }
+    const double err = std::hypot(e.pose.x - b.x, e.pose.y - b.y);
+    if (invalid_at < 0 && (!e.valid || err < 0.25)) invalid_at = obs.t - 1.0;
+    if (found_at < 0 && e.valid && err < 0.05) found_at = obs.t - 1.0;
+    if (e.valid) {
+      EXPECT_TRUE(err < 0.5 || obs.t - 1.0 <= 1.0) << "valid " << err << " m off at " << obs.t;
+    }
+  }
+  EXPECT_GE(invalid_at, 0.0);
+  EXPECT_LE(invalid_at, 1.0);
+  EXPECT_GE(found_at, 0.0);
+  EXPECT_LE(found_at, 2.0);
+}
+
+// Twins on the legacy field (coloured goals), no compass: a yellow blob decides between a pose and
+// its point mirror. Seen where the yellow goal is from the truth, it ends on the truth; seen where
+// the twin would see it (pi further round), on the twin.
+TEST(UkfMh, GoalColourDecidesTheTwin) {
+  const Field f = Field::preset("msl2007");
+  const FieldMap prefilter(f, 0.05);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed)
+    for (bool mirrored : {false, true}) {
+      const Pose2 truth(-1.5 + seed, 1.0 - 0.5 * seed, 2.5 - 1.7 * seed);
+      const Pose2 want = mirrored ? Pose2(-truth.x, -truth.y, truth.theta + kPi) : truth;
+      UkfMhLocalizer loc(f, UkfMhParams{}, seed, "");
+      loc.reset(std::nullopt);
+      Rng rng(seed);
+      Estimate e;
+      for (int k = 0; k < 60; ++k) {
+        Observations obs;
+        obs.t = k / 30.0;
+        obs.line_points = scenes::line_points(f, truth, 80, rng, {.noise = 0.02, .prefilter = &prefilter});
+        Blob yellow;
+        yellow.colour = kYellow;  // the goal at +x, seen from `want`
+        yellow.bearing = wrap_angle(std::atan2(0.0 - want.y, 6.0 - want.x) - want.theta);
+        obs.blobs.push_back(yellow);
+        e = loc.update(obs, Odometry{obs.t, Pose2()}, std::nullopt);
+      }
+      ASSERT_TRUE(e.valid) << seed << " " << mirrored;
+      EXPECT_EQ(e.extra.at("twin_ambiguous"), 0.0);
+      EXPECT_LT(std::hypot(e.pose.x - want.x, e.pose.y - want.y), 0.05) << seed << " " << mirrored << ": " << e.pose.x << ", " << e.pose.y;
+      EXPECT_LT(std::fabs(angle_diff(e.pose.theta, want.theta)), 0.05) << seed << " " << mirrored;
+    }
+}
