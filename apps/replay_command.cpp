@@ -22,12 +22,9 @@ const cli::Command kReplay{"replay", "RECORDING", 1, 1,
                             {"--overwrite", "", "replace what is at -o DIR"},
                             {"--quiet", "", "no progress log on stderr"}}};
 
-namespace {
-Json localizer_argument(const std::string& v) { return localizer_values(v, "replay", false).front(); }
-}  // namespace
 
 int cmd_replay(const cli::Args& a) {
-  const Json localizer = localizer_argument(a.value("--localizer"));
+  const harness::LocalizerSpec localizer(localizer_values(a.value("--localizer"), "replay", false).front(), "--localizer");
   check_output_target(a, true);
   harness::RecordingHeader header = harness::RecordingHeader::read(a.positional[0]);
   const harness::Scenario s = harness::replay_scenario(header, localizer);

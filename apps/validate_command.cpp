@@ -50,7 +50,7 @@ int validate_one(const std::string& file) {
   }
   const auto s = harness::parse_scenario(j, std::filesystem::path(file).stem().string(), file);
   std::cout << file << ": ok (scenario \"" << s.name << "\", " << s.robots.size() << " robot(s), "
-            << s.duration << " s, localizer " << s.localizer.value("type", "?") << ")\n";
+            << s.duration << " s, localizer " << s.localizer.json.value("type", "?") << ")\n";
   return 0;
 }
 

@@ -63,7 +63,17 @@ FIXTURES = {
     "sweep_hand.json": {"name": "cmp", "scenarios": [{"recording": str(HAND)}], "localizers": [{"type": "matching", "bogus": 2}]},
     "sweep_hand_own.json": {"name": "cmp", "scenarios": [{"recording": str(HAND)}]},
     "notjson.json": "this is not json",
+    "sweep_rec_own_bad.json": {"name": "cmp", "scenarios": [{"recording": "rec_badloc"}]},
+    "sweep_rec_own_label.json": {"name": "cmp", "scenarios": [{"recording": "rec_badlabel"}]},
 }
+
+
+def recording_with_localizer(dest, localizer):
+    """A copy of REC whose recorded scenario holds `localizer`: a recording made with a bad one."""
+    shutil.copytree(REC, dest)
+    h = json.loads((dest / "recording.json").read_text())
+    h["scenario"]["localizer"] = localizer
+    (dest / "recording.json").write_text(json.dumps(h, indent=1))
 
 CPP = ["run", "record", "replay", "render", "calibrate", "colour-calibrate", "validate", "gl-devices", "list", "schema", "sweep",
        "experiment", "cache"]
@@ -127,6 +137,8 @@ def run_case(binary, args, work):
     work.mkdir(parents=True)
     for name, content in FIXTURES.items():
         (work / name).write_text(content if isinstance(content, str) else json.dumps(content, indent=1))
+    recording_with_localizer(work / "rec_badloc", {"type": "mcl", "bogus": 1})
+    recording_with_localizer(work / "rec_badlabel", {"type": "mcl", "label": "a b"})
     (work / "nonempty").mkdir()
     (work / "nonempty" / "x").write_text("x")
     env = {k: v for k, v in os.environ.items() if not k.startswith("OMNILOC_")}
