@@ -316,7 +316,8 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   Scenario s;
   s.source = source;
   s.input = j;
-  if (localizer) s.input["localizer"] = localizer->json;  // a replay's recording keeps the scenario it ran
+  // What was run: a replay's or sweep's localizer in place of the scenario's own.
+  if (localizer && s.input.is_object()) s.input["localizer"] = localizer->json;
   JsonReader r(j, "", &s.effective);
   r.allow("comment");
   s.name = r.string("name", name_from_stem(name));
