@@ -1,4 +1,5 @@
 #include "apps/cache_command.hpp"
+#include "apps/commands.hpp"
 
 #include <sys/stat.h>
 

@@ -6,10 +6,6 @@
 
 namespace omniloc::app {
 
-/// `omniloc cache list|size|prune`.
-extern const cli::Command kCache;
-int cmd_cache(const cli::Args& a);
-
 /// The cache a command uses: the environment's (OMNILOC_CACHE, OMNILOC_CACHE_MAX_SIZE), then its
 /// --cache DIR / --no-cache options.
 harness::WorldCacheOptions cache_options(const cli::Args& a);

@@ -48,12 +48,11 @@ std::string bounded_id(const std::string& id) {
 namespace {
 
 using Combo = std::vector<std::pair<std::string, Json>>;       // JSON pointer -> value
-// One entry of a "localizers" list: its row label, the localizer JSON (null = the scenario's own) and
-// where it stands in the sweep file, so an error in its keys names the sweep's JSON path.
+// One entry of a "localizers" list: its row label and the localizer with where it stands in the
+// sweep file (or on the command line), so an error in its keys names that path; none: the scenario's own.
 struct LocalizerEntry {
   std::string label;
-  Json json;
-  std::string at;
+  std::optional<harness::LocalizerSpec> given;
 };
 using Localizers = std::vector<LocalizerEntry>;
 
@@ -97,7 +96,8 @@ Localizers parse_localizers(const Json& l, const std::string& at) {
     // It names the sweep's row; a built-in localizer's reader never sees it. An external client's run
     // keeps it: the name its results carry is the label the user gave (docs/protocol.md "Which name").
     if (lj["type"] != "external") lj.erase("label");
-    locs.push_back({sanitize(label), lj, lp});
+    external::anchor_external_paths(lj);
+    locs.push_back({sanitize(label), harness::LocalizerSpec(std::move(lj), lp)});
   }
   return locs;
 }
@@ -244,27 +244,32 @@ Json apply_combo(const Json& scenario, const Combo& combo, std::string& label) {
   return patched;
 }
 
-// The run of a {"recording": DIR} entry with one localizer (null: the recording's own), validated
-// as the replay will read it.
-void add_recording_run(const std::string& path, const ScenarioEntry& sc, const std::string& llabel, const Json& lj, const std::string& lat,
-                       std::set<std::string>& ids, SweepSpec& spec) {
+// A sweep's own localizer entry (`given`) is named by its path in the sweep file, with the run it was
+// found in after it; any other error after the run it was found in.
+[[noreturn]] void rethrow_in(const ConfigError& e, bool given, const std::string& context) {
+  if (given && dynamic_cast<const harness::LocalizerError*>(&e)) throw ConfigError(e.path() + " (" + context + ")", e.value(), e.expected());
+  throw ConfigError(context + ": " + (e.path().empty() ? "/" : e.path()), e.value(), e.expected());
+}
+
+// The run of a {"recording": DIR} entry with one localizer (none given: the recording's own),
+// validated as the replay will read it.
+void add_recording_run(const std::string& path, const ScenarioEntry& sc, const LocalizerEntry& le, std::set<std::string>& ids, SweepSpec& spec) {
   const harness::RecordingHeader& h = *sc.header;
-  Json loc = lj;
-  if (loc.is_null()) {
+  harness::LocalizerSpec loc;
+  if (le.given) {
+    loc = *le.given;
+  } else {
     if (!h.scenario.is_object() || !h.scenario.contains("localizer"))
-      throw ConfigError(lat.empty() ? "/localizers" : lat, "nothing", "a localizer for the recording " + sc.recording + " (it has none of its own)");
-    loc = h.scenario["localizer"];
+      throw ConfigError("/localizers", "nothing", "a localizer for the recording " + sc.recording + " (it has none of its own)");
+    loc = harness::LocalizerSpec(h.scenario["localizer"], h.dir + "/recording.json /scenario/localizer");
+    external::anchor_external_paths(loc.json);
   }
-  external::anchor_external_paths(loc);
-  const std::string label = lj.is_null() ? sanitize(row_label(loc, "/localizer")) : llabel;
+  const std::string label = le.given ? le.label : sanitize(row_label(loc.json, loc.path));
   harness::Scenario parsed;
   try {
     parsed = harness::replay_scenario(h, loc);
   } catch (const ConfigError& e) {
-    const std::string context = "sweep " + path + ", recording " + sc.recording + ", localizer \"" + label + "\"";
-    const std::string& ep = e.path();
-    if (!lj.is_null() && ep.rfind("--localizer", 0) == 0) throw ConfigError(lat + ep.substr(11) + " (" + context + ")", e.value(), e.expected());
-    throw ConfigError(context + ": " + ep, e.value(), e.expected());
+    rethrow_in(e, le.given.has_value(), "sweep " + path + ", recording " + sc.recording + ", localizer \"" + label + "\"");
   }
   SweepRun run;
   run.index = spec.runs.size();
@@ -306,33 +311,29 @@ void add_runs(const std::string& path, const std::vector<ScenarioEntry>& scenari
               SweepSpec& spec) {
   std::set<std::string> ids;
   for (const auto& sc : scenarios)
-    for (const auto& [llabel, lj, lat] : sc.locs)
+    for (const auto& le : sc.locs)
       for (const auto& combo : sc.combos) {
         if (sc.header) {
-          add_recording_run(path, sc, llabel, lj, lat, ids, spec);
+          add_recording_run(path, sc, le, ids, spec);
           continue;
         }
         std::string plabel;
         Json patched = apply_combo(sc.json, combo, plabel);
-        if (!lj.is_null()) patched["localizer"] = lj;
-        if (patched.contains("localizer")) external::anchor_external_paths(patched["localizer"]);
-        std::string loc_label = llabel;
+        std::string loc_label = le.label;
+        harness::Scenario parsed;
         try {
           // The scenario's own localizer names the row; its label is checked before it is read.
-          if (lj.is_null()) {
+          if (!le.given) {
             const Json own = patched.is_object() ? patched.value("localizer", Json::object()) : Json::object();
             loc_label = sanitize(own.is_object() ? row_label(own, "/localizer") : std::string("?"));
           }
-          parse_scenario(patched, sc.name);
+          parsed = parse_scenario(patched, sc.name, "", le.given ? &*le.given : nullptr);
         } catch (const ConfigError& e) {
-          const std::string context = "sweep " + path + ", scenario \"" + sc.name + "\", localizer \"" + loc_label + "\"" +
-                                      (plabel.empty() ? "" : ", " + plabel);
-          // A key of one of the sweep's own localizer entries: named by its path in the sweep file.
-          const std::string& ep = e.path();
-          if (!lj.is_null() && ep.rfind("/localizer", 0) == 0 && (ep.size() == 10 || ep[10] == '/'))
-            throw ConfigError(lat + ep.substr(10) + " (" + context + ")", e.value(), e.expected());
-          throw ConfigError(context + ": " + (ep.empty() ? "/" : ep), e.value(), e.expected());
+          rethrow_in(e, le.given.has_value(),
+                     "sweep " + path + ", scenario \"" + sc.name + "\", localizer \"" + loc_label + "\"" + (plabel.empty() ? "" : ", " + plabel));
         }
+        // The runs read the localizer as parsed: the given one in place of the scenario's, external paths absolute.
+        if (le.given || patched.contains("localizer")) patched["localizer"] = parsed.localizer.json;
         for (std::uint64_t seed : seeds) {
           SweepRun run;
           run.index = spec.runs.size();
@@ -370,7 +371,7 @@ SweepSpec load_sweep(const std::string& path, const Json& localizers) {
   // Sweep-wide localizers and parameters apply to every scenario entry; an entry written as
   // {"file": ..., "parameters": {...}, "localizers": [...]} adds its own parameters to the sweep's and
   // replaces the sweep's localizers, so one file can hold rows that vary different things (the paper suite).
-  Localizers locs = {{"", Json(), ""}};
+  Localizers locs = {{"", std::nullopt}};
   if (const Json* l = r.raw("localizers")) locs = parse_localizers(*l, "/localizers");
   std::vector<Combo> combos = {{}};
   if (const Json* pj = r.raw("parameters")) combos = parse_combos(*pj, "/parameters", combos);

@@ -46,7 +46,7 @@ const std::string& recording() {
 static void BM_ReplayTrackingMatching(benchmark::State& state) {
   const std::string dir = recording();
   const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
-  const harness::Scenario sc = harness::replay_scenario(head, {{"type", "matching"}});
+  const harness::Scenario sc = harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer"));
   harness::RunOptions o;
   o.out_dir = tmp("replay_out").string();
   o.replay = true;
@@ -76,7 +76,7 @@ BENCHMARK(BM_ReadTrackingRecording)->Unit(benchmark::kMillisecond)->MeasureProce
 static void BM_MatchingAloneOnTrackingFrames(benchmark::State& state) {
   const std::string dir = recording();
   const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
-  const harness::Scenario sc = harness::replay_scenario(head, {{"type", "matching"}});
+  const harness::Scenario sc = harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer"));
   std::vector<harness::FrameData> frames;
   {
     harness::RecordingSource source(harness::RecordingHeader::read(dir));
@@ -87,7 +87,7 @@ static void BM_MatchingAloneOnTrackingFrames(benchmark::State& state) {
   ctx.cache_dir = harness::build_cache_dir("fieldmaps");
   double n = 0;
   for (auto _ : state) {
-    auto loc = harness::make_localizer(sc.localizer, "/localizer", ctx, nullptr);
+    auto loc = harness::make_localizer(sc.localizer, ctx, nullptr);
     loc->reset(head.robots.at(0).start);
     for (const auto& f : frames) benchmark::DoNotOptimize(loc->update(f.robots[0].obs, f.robots[0].odometry, f.robots[0].heading));
     n += static_cast<double>(frames.size());

@@ -74,6 +74,14 @@ const LocalizerInfo& localizer_info(const std::string& type, const std::string& 
   throw ConfigError(path, "\"" + type + "\"", "a localizer type: one of " + known);
 }
 
+const LocalizerInfo& localizer_info(const LocalizerSpec& l) {
+  try {
+    return localizer_info(l.type(), json_child(l.path, "type"));
+  } catch (const ConfigError& e) {
+    throw LocalizerError(e);
+  }
+}
+
 std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx,
                                           Json* effective) {
   JsonReader r(j, path, effective);
@@ -85,15 +93,27 @@ std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path
   return loc;
 }
 
-void check_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx) {
-  Json effective;
-  JsonReader r(j, path, &effective);
-  r.allow("comment");
-  const std::string type = r.string("type", std::nullopt);
-  const LocalizerInfo& info = localizer_info(type, r.child_path("type"));
-  if (info.check) info.check(r);
-  else info.make(r, ctx);
-  r.finish();
+std::unique_ptr<Localizer> make_localizer(const LocalizerSpec& l, const LocalizerContext& ctx, Json* effective) {
+  try {
+    return make_localizer(l.json, l.path, ctx, effective);
+  } catch (const ConfigError& e) {
+    throw LocalizerError(e);
+  }
+}
+
+void check_localizer(const LocalizerSpec& l, const LocalizerContext& ctx) {
+  try {
+    Json effective;
+    JsonReader r(l.json, l.path, &effective);
+    r.allow("comment");
+    const std::string type = r.string("type", std::nullopt);
+    const LocalizerInfo& info = localizer_info(type, r.child_path("type"));
+    if (info.check) info.check(r);
+    else info.make(r, ctx);
+    r.finish();
+  } catch (const ConfigError& e) {
+    throw LocalizerError(e);
+  }
 }
 
 }  // namespace omniloc::harness

@@ -10,6 +10,7 @@
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
 #include "external/external_localizer.hpp"
+#include "harness/localizer_spec.hpp"
 #include "localization/localizer.hpp"
 
 namespace omniloc::harness {
@@ -44,12 +45,17 @@ const std::vector<LocalizerInfo>& localizers();
 /// Throws ConfigError naming `path` when the type is unknown.
 const LocalizerInfo& localizer_info(const std::string& type, const std::string& path);
 
-/// Reads {"type": ..., params...} strictly and builds the localizer.
+/// The registry's entry for the spec's type; LocalizerError naming its path/type when there is none.
+const LocalizerInfo& localizer_info(const LocalizerSpec& l);
+
+/// Reads the spec's {"type": ..., params...} strictly and builds the localizer. Throws LocalizerError.
+std::unique_ptr<Localizer> make_localizer(const LocalizerSpec& l, const LocalizerContext& ctx, Json* effective = nullptr);
+/// The same for a localizer object at `path` of an experiment's description.
 std::unique_ptr<Localizer> make_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx,
                                           Json* effective = nullptr);
 
-/// Reads {"type": ..., params...} strictly and checks it as far as possible without a run: built-in
-/// localizers are built (and dropped), an external one's program is checked, not started.
-void check_localizer(const Json& j, const std::string& path, const LocalizerContext& ctx);
+/// Reads the spec strictly and checks it as far as possible without a run: built-in localizers are
+/// built (and dropped), an external one's program is checked, not started. Throws LocalizerError.
+void check_localizer(const LocalizerSpec& l, const LocalizerContext& ctx);
 
 }  // namespace omniloc::harness

@@ -119,15 +119,9 @@ Json frame_to_json(const FrameData& f);
 /// `truth`: the frames carry the true pose ("truth"; recording.json "ground_truth").
 FrameData frame_from_json(const Json& j, const std::string& at, const std::vector<RecordedRobot>& robots, bool truth = true);
 
-struct ReplayOptions {
-  Json localizer;                     ///< the localizer to run ({"type": ...}), as in a scenario
-  std::optional<std::uint64_t> seed;  ///< the localizer's random stream; default the recording's seed
-  std::string out_dir;                ///< default: results/runs/<scenario>/<seed>
-  std::ostream* log = nullptr;
-};
-
 /// The scenario a replay runs: the recorded one with `localizer` in place of its own (or, for a log
-/// not made by omniloc, one built from the header). Checks that the robots and field agree.
-Scenario replay_scenario(const RecordingHeader& header, const Json& localizer);
+/// not made by omniloc, one built from the header). Checks that the robots and field agree. Errors in
+/// the recorded scenario name the recording; errors in the localizer (LocalizerError) its own path.
+Scenario replay_scenario(const RecordingHeader& header, const LocalizerSpec& localizer);
 
 }  // namespace omniloc::harness

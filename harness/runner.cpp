@@ -56,7 +56,7 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
       ctx.session = &session;
     }
     Json eff;
-    tr.localizer = make_localizer(sc.localizer, "/localizer", ctx, &eff);
+    tr.localizer = make_localizer(sc.localizer, ctx, &eff);
     effective["localizer"] = eff;
     tr.start_pose_given = info.needs_start_pose || tr.localizer->wants_start_pose();
     tr.localizer->reset(tr.start_pose_given ? std::optional<Pose2>(sc.robot(id)->spec.start) : std::nullopt);
@@ -219,7 +219,7 @@ RunResult run_frames_after_hello(const Scenario& sc, std::uint64_t seed, const F
   EventLog log;
   Json effective = sc.effective;
   effective["seed"] = seed;
-  const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
+  const LocalizerInfo& info = localizer_info(sc.localizer);
   std::vector<Tracked> tracked = make_tracked(sc, seed, info, hello, dir.staging(), effective);
   bool wants_images = false;
   for (const auto& tr : tracked)
@@ -262,7 +262,7 @@ RunResult run_frames_after_hello(const Scenario& sc, std::uint64_t seed, const F
 
 RunResult run_scenario(const Scenario& sc, const RunOptions& opt) {
   const std::uint64_t seed = opt.seed.value_or(sc.seed);
-  const LocalizerInfo& info = localizer_info(sc.localizer.value("type", std::string()), "/localizer/type");
+  const LocalizerInfo& info = localizer_info(sc.localizer);
   LiveSource source(sc, seed, info.needs_vision || !opt.frames_dir.empty());
   Json provenance = Json::object();
   if (const auto dev = source.perception().render_device()) {

@@ -312,10 +312,12 @@ void read_camera_and_vision(JsonReader& r, Scenario& s) {
 
 }  // namespace
 
-Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source) {
+Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source, const LocalizerSpec* localizer) {
   Scenario s;
   s.source = source;
   s.input = j;
+  // What was run: a replay's or sweep's localizer in place of the scenario's own.
+  if (localizer && s.input.is_object()) s.input["localizer"] = localizer->json;
   JsonReader r(j, "", &s.effective);
   r.allow("comment");
   s.name = r.string("name", name_from_stem(name));
@@ -346,9 +348,13 @@ Scenario parse_scenario(const Json& j, const std::string& name, const std::strin
   if (const Json* occ = r.raw("occlusion")) s.occlusion = sim::OcclusionMask::from_json(*occ, "/occlusion");
   read_lighting(r, s);
   const Json* loc = r.raw("localizer");
-  s.localizer = loc ? *loc : Json{{"type", "odometry_only"}};
-  if (!s.localizer.is_object()) throw ConfigError("/localizer", json_brief(s.localizer), "an object {\"type\": ...}");
-  external::anchor_external_paths(s.localizer);
+  if (localizer) {
+    s.localizer = *localizer;
+  } else if (loc) {
+    if (!loc->is_object()) throw ConfigError("/localizer", json_brief(*loc), "an object {\"type\": ...}");
+    s.localizer.json = *loc;
+    external::anchor_external_paths(s.localizer.json);
+  }
 
   read_camera_and_vision(r, s);
   {
@@ -366,7 +372,7 @@ void validate_deep(const Scenario& s) {
   LocalizerContext ctx;
   ctx.field = &s.field;
   ctx.seed = s.seed;
-  check_localizer(s.localizer, "/localizer", ctx);
+  check_localizer(s.localizer, ctx);
 }
 
 Scenario load_scenario(const std::string& path) {

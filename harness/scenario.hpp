@@ -12,6 +12,7 @@
 #include "core/json_reader.hpp"
 #include "harness/metrics.hpp"
 #include "harness/events.hpp"
+#include "harness/localizer_spec.hpp"
 #include "sim/occlusion.hpp"
 #include "sim/sensors.hpp"
 #include "sim/world_state.hpp"
@@ -60,7 +61,7 @@ struct Scenario {
   sim::Lighting lighting;           ///< at t = 0
   std::vector<Eigen::Vector2d> sun_velocity;  ///< m/s per sun patch (sun moving slowly)
   Scoring scoring;           ///< recall thresholds (docs/results.md "Coverage and recall")
-  Json localizer;            ///< {"type": ..., params}
+  LocalizerSpec localizer;   ///< {"type": ..., params} and where it was given
   Json camera;               ///< camera configuration (profile defaults merged)
   Json vision;               ///< vision front-end configuration (calibration, colour table, scan lines)
   Json effective;            ///< every value read, defaults filled in: saved as config.json
@@ -72,8 +73,10 @@ struct Scenario {
   std::vector<int> localized_robots() const;
 };
 
-/// Parses and validates; `name` defaults to the file's stem. Throws ConfigError.
-Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source = "");
+/// Parses and validates; `name` defaults to the file's stem. Throws ConfigError (LocalizerError for
+/// the localizer). `localizer`: the one to run instead of the scenario's own "localizer" (replay
+/// --localizer, a sweep's localizers), read where it was given; the scenario's own is then not read.
+Scenario parse_scenario(const Json& j, const std::string& name, const std::string& source = "", const LocalizerSpec* localizer = nullptr);
 /// Reads a scenario file (JSON syntax errors are ConfigErrors too, with line and column).
 Scenario load_scenario(const std::string& path);
 /// Builds everything the run would build (localizer, scripts) without running: full validation.

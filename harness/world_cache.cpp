@@ -155,8 +155,7 @@ WorldCacheOptions world_cache_from_env() {
 }
 
 std::string world_cache_ineligible(const Scenario& sc, const RunOptions& opt) {
-  const std::string type = sc.localizer.value("type", std::string());
-  if (type != "external" && !localizer_info(type, "/localizer/type").needs_vision) return "a localizer without vision runs live";
+  if (sc.localizer.type() != "external" && !localizer_info(sc.localizer).needs_vision) return "a localizer without vision runs live";
   if (!opt.frames_dir.empty()) return "--frames draws the images";
   const std::string backend = sc.camera.is_object() ? sc.camera.value("backend", std::string("osmesa")) : std::string("osmesa");
   if (backend != "osmesa") return "the " + backend + " renderer's pixels depend on the machine";
@@ -439,7 +438,7 @@ RunResult run_with_world_cache(const Scenario& sc, const RunOptions& opt, WorldC
     provenance["world_cache"] = lease->key();
     return *source;
   };
-  if (sc.localizer.value("type", std::string()) != "external") {
+  if (sc.localizer.type() != "external") {
     Json provenance = Json::object();
     FrameSource& s = open(false, provenance);
     return run_frames(sc, seed, s, o, provenance);

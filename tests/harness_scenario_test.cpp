@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "core/atomic_file.hpp"
+#include "harness/localizer_registry.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 
@@ -150,6 +151,40 @@ TEST(Scenario, LampSubsetsSwitchAndDarkenTheirPartOfTheHall) {
   EXPECT_NEAR(off.artificial_at({1e4, 0.0}), 0.5, 1e-12);
   // A later global event scales the whole pattern.
   EXPECT_NEAR(s.lighting_at(2.5).at({0.0, 0.0}), 0.25, 1e-12);
+}
+
+// A localizer given apart from the scenario (replay --localizer, a sweep's localizers) replaces the
+// scenario's own, unread, and its errors name where it was given, as a LocalizerError; the scenario's
+// other errors stay plain ConfigErrors at their own paths.
+TEST(ScenarioValidation, AGivenLocalizerIsReadInPlaceOfTheOwnAndNamedWhereItWasGiven) {
+  Json j = base();
+  j["localizer"] = Json::array({"not", "a", "localizer"});
+  const LocalizerSpec mcl({{"type", "mcl"}, {"particles", 300}}, "--localizer");
+  const Scenario s = parse_scenario(j, "t", "", &mcl);
+  EXPECT_EQ(s.localizer.type(), "mcl");
+  EXPECT_EQ(s.localizer.path, "--localizer");
+  EXPECT_EQ(s.input["localizer"], mcl.json);  // what a recording of this run keeps
+  EXPECT_EQ(error_path(j), "/localizer");     // without it, the own one is read
+
+  const LocalizerSpec bad({{"type", "mcl"}, {"particles", "many"}}, "/localizers/3");
+  try {
+    parse_scenario(base(), "t", "", &bad);
+    FAIL();
+  } catch (const LocalizerError& e) {
+    EXPECT_EQ(e.path(), "/localizers/3/particles");
+  }
+  Json other = base();
+  other["duration"] = -1;
+  try {
+    parse_scenario(other, "t", "", &mcl);
+    FAIL();
+  } catch (const LocalizerError& e) {
+    FAIL() << "the scenario's own error taken for the localizer's: " << e.what();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "/duration");
+  }
+  const LocalizerSpec unknown({{"type", "nope"}}, "--localizer/0");
+  EXPECT_THROW(localizer_info(unknown), LocalizerError);
 }
 
 TEST(ScenarioValidation, SyntaxErrorNamesTheFile) {

@@ -23,7 +23,7 @@ struct Accuracy {
 
 Accuracy replay(const std::string& dir, const Json& localizer, const std::string& out) {
   harness::RecordingHeader header = harness::RecordingHeader::read(dir);
-  const harness::Scenario s = harness::replay_scenario(header, localizer);
+  const harness::Scenario s = harness::replay_scenario(header, harness::LocalizerSpec(localizer, "/localizer"));
   harness::RecordingSource source(std::move(header));
   harness::RunOptions o;
   o.seed = source.header().seed;

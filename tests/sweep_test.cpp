@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/install_paths.hpp"
 #include "harness/run_directory.hpp"
 #include "batch/sweep.hpp"
 
@@ -297,6 +298,41 @@ TEST(Sweep, LocalizerOverrideReplacesEveryEntrysLocalizers) {
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.path(), "--localizer/1/type") << e.what();
+  }
+}
+
+// A localizer error names where the localizer was written: a sweep's own entry by its path in the
+// sweep file, a recording's own by the recording's file (no --localizer was given for it).
+TEST(Sweep, ErrorsInARecordingsLocalizerNameWhereItWasWritten) {
+  fs::remove_all(test_dir());
+  fs::create_directories(test_dir());
+  const fs::path rec = test_dir() / "rec";
+  fs::copy(fs::path(source_dir()) / "data/recordings/ci_tracking/1", rec);
+  Json h = Json::parse(read_file((rec / "recording.json").string()));
+  h["scenario"]["localizer"] = {{"type", "mcl"}, {"bogus", 1}};
+  write_file_atomic((rec / "recording.json").string(), h.dump());
+  const std::string own = (test_dir() / "own.json").string();
+  write_file_atomic(own, R"({"name": "own", "scenarios": [{"recording": "rec"}]})");
+  const std::string run = "recording " + rec.string() + ", localizer \"mcl\"";
+  try {
+    load_sweep(own);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "sweep " + own + ", " + run + ": " + rec.string() + "/recording.json /scenario/localizer/bogus") << e.what();
+  }
+  const std::string given = (test_dir() / "given.json").string();
+  write_file_atomic(given, R"({"name": "given", "scenarios": [{"recording": "rec", "localizers": [{"type": "odometry_only"}, {"type": "mcl", "x": 1}]}]})");
+  try {
+    load_sweep(given);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "/scenarios/0/localizers/1/x (sweep " + given + ", " + run + ")") << e.what();
+  }
+  try {
+    load_sweep(given, Json::array({{{"type", "nope"}}}));
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.path(), "--localizer/0/type (sweep " + given + ", recording " + rec.string() + ", localizer \"nope\")") << e.what();
   }
 }
 
