@@ -22,7 +22,7 @@ PKGS=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
   libbenchmark-dev libgtest-dev libgmock-dev
-  libssl-dev zlib1g-dev libsimdjson-dev  # simdjson: the recording reader's fast path (harness/frames_reader.cpp)
+  libssl-dev zlib1g-dev libsimdjson-dev  # simdjson: the recording reader's fast path (harness/recording/frames_reader.cpp)
   python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
   ccache  # a compile cache (CMakeLists.txt OMNILOC_CCACHE): a fresh clone builds from earlier objects

@@ -1,4 +1,4 @@
-#include "harness/field_picture.hpp"
+#include "experiments/field_picture.hpp"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 
 #include "core/error.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 FieldPicture::FieldPicture(const Field& field, double px_per_m, double border) : s_(px_per_m) {
   const double hx = 0.5 * field.length + border, hy = 0.5 * field.width + border;
@@ -32,4 +32,4 @@ std::string png_bytes(const cv::Mat& bgr) {
   return std::string(reinterpret_cast<const char*>(buf.data()), buf.size());
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments
