@@ -42,6 +42,7 @@
 #include "batch/sweep_spec.hpp"
 #include "harness/vision_setup.hpp"
 #include "sim/render/camera_config.hpp"
+#include "sim/render/egl_device.hpp"
 #include "sim/render/gl_context.hpp"
 #include "sim/motion.hpp"
 

@@ -11,7 +11,7 @@
 #include "localization/localizer.hpp"
 #include "localization/vision/calibration_map.hpp"
 #include "sim/occlusion.hpp"
-#include "sim/render/egl_device.hpp"
+#include "sim/render/gl_device_info.hpp"
 #include "sim/world_state.hpp"
 
 namespace omniloc::harness {
