@@ -58,7 +58,4 @@ class NoPerception : public Perception {
   }
 };
 
-/// Builds the perception a scenario needs (camera + vision when its localizer needs vision).
-std::unique_ptr<Perception> make_perception(const Scenario& s, bool needs_vision, std::uint64_t seed);
-
 }  // namespace omniloc::harness
