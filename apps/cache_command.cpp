@@ -72,7 +72,7 @@ struct Entry {
   std::time_t last_used = 0;
 };
 
-// The files of the root's fieldmaps/<build>/ and vision/<build>/ folders (harness/cache_dirs.hpp),
+// The files of the root's fieldmaps/<build>/ and vision/<build>/ folders (harness/cache/cache_dirs.hpp),
 // named "<build>/<file>". A file being written (name.tmp.<pid>) is not an entry yet.
 std::vector<Entry> file_entries(const std::string& root) {
   std::vector<Entry> out;

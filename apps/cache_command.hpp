@@ -2,7 +2,7 @@
 // `omniloc cache` (the world cache, docs/recording.md "World cache") and the options run and sweep
 // share to choose it.
 #include "core/cli_args.hpp"
-#include "harness/world_cache.hpp"
+#include "harness/cache/world_cache.hpp"
 
 namespace omniloc::app {
 

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "core/error.hpp"
+#include "sim/render/egl_device.hpp"
 #include "sim/render/gl_context.hpp"
 
 namespace omniloc::app {

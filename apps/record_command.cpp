@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "apps/command_support.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/recording_writer.hpp"
 #include "harness/scenario.hpp"
 
 namespace omniloc::app {

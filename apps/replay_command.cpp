@@ -5,7 +5,8 @@
 #include <iostream>
 
 #include "apps/command_support.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/recording_source.hpp"
+#include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 

@@ -8,7 +8,7 @@
 #include "core/path_check.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
-#include "harness/world_cache.hpp"
+#include "harness/cache/world_cache.hpp"
 
 namespace omniloc::app {
 

@@ -20,7 +20,7 @@ struct SweepOptions {
   bool resume = false;
   bool aggregate_only = false;
   bool share_worlds = true;    ///< runs with the same SweepRun::world replay one recording of it (false: each draws its own)
-  /// Each run finds its world in the world cache (harness/world_cache.hpp; the folder is in the
+  /// Each run finds its world in the world cache (harness/cache/world_cache.hpp; the folder is in the
   /// environment, OMNILOC_CACHE) instead of the sweep folder's recordings/; with share_worlds.
   bool world_cache = false;
   bool debug_view = false;  ///< every run writes view.jsonl (omniloc run --debug-view)

@@ -12,7 +12,7 @@
 #include "harness/scenario_schema.hpp"
 #include "external/sha256.hpp"
 #include "harness/localizer_registry.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/replay_scenario.hpp"
 
 namespace omniloc::batch {
 

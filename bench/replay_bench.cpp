@@ -10,9 +10,11 @@
 #include <fstream>
 #include <string>
 
-#include "harness/cache_dirs.hpp"
+#include "harness/cache/cache_dirs.hpp"
 #include "harness/localizer_registry.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/recording_writer.hpp"
+#include "harness/recording/recording_source.hpp"
+#include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "core/install_paths.hpp"

@@ -32,7 +32,7 @@ find_path(EGL_INCLUDE_DIR EGL/egl.h REQUIRED)
 
 # SHA-256 of an external localizer's program and script (summary.json provenance).
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)
-# gzip of a recording's frames (harness/recording.cpp, docs/recording.md).
+# gzip of a recording's frames (harness/recording/format/gzip.cpp, docs/recording.md).
 find_package(ZLIB REQUIRED)
-# simdjson: the recording reader's fast path (harness/frames_reader.cpp; docs/performance.md "Replay").
+# simdjson: the recording reader's fast path (harness/recording/frames_reader.cpp; docs/performance.md "Replay").
 find_package(simdjson REQUIRED)

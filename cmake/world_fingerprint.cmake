@@ -1,7 +1,7 @@
 # Run at every build: the fingerprint of everything in this source tree that determines a world's
-# frames (the world cache's key, harness/world_cache.cpp; docs/recording.md "World cache"): the
+# frames (the world cache's key, harness/cache/world_cache.cpp; docs/recording.md "World cache"): the
 # simulation, rendering, vision and recording code and the data they read; and the distance table's
-# code, whose cached tables are kept per fingerprint too (harness/cache_dirs.hpp). Written to OUT only when
+# code, whose cached tables are kept per fingerprint too (harness/cache/cache_dirs.hpp). Written to OUT only when
 # it changed, so an unchanged tree recompiles nothing. A change to any of these files gives every
 # world a new key: the cache misses rather than serve frames an older build drew.
 file(GLOB_RECURSE files RELATIVE "${SRC}"

@@ -12,6 +12,7 @@
 
 #include "core/rng.hpp"
 #include "experiments/cooperative_001_report.hpp"
+#include "experiments/cooperative_001_results.hpp"
 #include "harness/run_directory.hpp"
 #include "localization/cooperative/ball_trackers.hpp"
 #include "localization/cooperative/hough_ball.hpp"
@@ -30,14 +31,6 @@ void CoopErrorAcc::add_trial(double s, double s2, double n) {
 double CoopErrorAcc::mean() const { return count > 0 ? sum / count : 0.0; }
 
 double CoopErrorAcc::rms_per_axis() const { return count > 0 ? std::sqrt(sumsq / count / 2.0) : 0.0; }
-
-const CoopPathStats& CoopDirectResult::model(CoopNoiseModel m) const {
-  for (const auto& [key, s] : by_model)
-    if (key == m) return s;
-  throw std::logic_error("cooperative_001: no results for noise model " + std::string(to_string(m)));
-}
-
-bool usable(const BallFix& f) { return f.status != BallFix::Status::NoObservation; }
 
 // --- simulation -----------------------------------------------------------------------------------------
 

@@ -12,7 +12,7 @@
 #include "core/angles.hpp"
 #include "core/rng.hpp"
 #include "experiments/report_format.hpp"
-#include "harness/cache_dirs.hpp"
+#include "harness/cache/cache_dirs.hpp"
 #include "harness/camera_perception.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/vision_setup.hpp"

@@ -11,18 +11,15 @@
 
 #include "core/angles.hpp"
 #include "experiments/report_format.hpp"
-#include "harness/field_picture.hpp"
-#include "harness/plot.hpp"
+#include "experiments/field_picture.hpp"
+#include "experiments/plot.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/vision_setup.hpp"
 
 namespace omniloc::experiments {
 
 using harness::RunDirectory;
-using harness::Series;
 using harness::camera_tag;
-using harness::line_plot;
-using harness::png_bytes;
 
 namespace {
 

@@ -1,12 +1,14 @@
 #pragma once
 // Report of the experiment "cooperative_001": the markdown report (also printed), the CSV tables,
-// the plots and cooperative_001.json, all from the result structs of cooperative_001.hpp and
-// cooperative_001_rendered.hpp. Reads the published figures from results/reference/papers.json.
+// the plots and cooperative_001.json, all from the result structs of cooperative_001_results.hpp
+// and cooperative_001_rendered.hpp. Reads the published figures from results/reference/papers.json.
 #include <cstdint>
 #include <iosfwd>
 #include <string>
 
-#include "experiments/cooperative_001.hpp"
+#include "experiments/cooperative_001_config.hpp"
+#include "experiments/cooperative_001_rendered.hpp"
+#include "experiments/cooperative_001_results.hpp"
 
 namespace omniloc::harness {
 class RunDirectory;

@@ -8,8 +8,8 @@
 
 #include "experiments/report_format.hpp"
 #include "harness/camera_perception.hpp"
-#include "harness/field_picture.hpp"
-#include "harness/plot.hpp"
+#include "experiments/field_picture.hpp"
+#include "experiments/plot.hpp"
 #include "harness/render_frame.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
@@ -24,12 +24,8 @@ namespace omniloc::experiments {
 using harness::CameraPerception;
 using harness::RunDirectory;
 using harness::Scenario;
-using harness::Series;
 using harness::VisionConfig;
-using harness::heat_map;
-using harness::line_plot;
 using harness::load_scenario;
-using harness::png_bytes;
 using harness::world_at;
 
 // --- configuration --------------------------------------------------------------------------------------

@@ -8,10 +8,10 @@
 
 #include "core/angles.hpp"
 #include "experiments/report_format.hpp"
-#include "harness/cache_dirs.hpp"
+#include "harness/cache/cache_dirs.hpp"
 #include "harness/camera_perception.hpp"
-#include "harness/field_picture.hpp"
-#include "harness/plot.hpp"
+#include "experiments/field_picture.hpp"
+#include "experiments/plot.hpp"
 #include "harness/render_frame.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/scenario.hpp"
@@ -22,15 +22,11 @@ namespace omniloc::experiments {
 
 using harness::CameraPerception;
 using harness::Event;
-using harness::FieldPicture;
 using harness::FrameConditions;
 using harness::PerceptionOutput;
 using harness::RunDirectory;
 using harness::Scenario;
-using harness::Series;
-using harness::line_plot;
 using harness::load_scenario;
-using harness::png_bytes;
 using harness::world_at;
 
 // --- configuration --------------------------------------------------------------------------------------

@@ -9,17 +9,13 @@
 
 #include "experiments/landmark_maps.hpp"
 #include "experiments/report_format.hpp"
-#include "harness/field_picture.hpp"
-#include "harness/plot.hpp"
+#include "experiments/field_picture.hpp"
+#include "experiments/plot.hpp"
 #include "harness/run_directory.hpp"
 
 namespace omniloc::experiments {
 
 using harness::RunDirectory;
-using harness::Series;
-using harness::heat_map;
-using harness::line_plot;
-using harness::png_bytes;
 
 namespace {
 

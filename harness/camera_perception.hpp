@@ -68,4 +68,8 @@ class CameraPerception : public Perception {
   std::map<int, ExposureController> controllers_;
 };
 
+/// Builds the perception a scenario needs: this camera and vision when its localizer needs vision,
+/// else NoPerception (perception.hpp).
+std::unique_ptr<Perception> make_perception(const Scenario& s, bool needs_vision, std::uint64_t seed);
+
 }  // namespace omniloc::harness

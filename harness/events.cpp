@@ -4,7 +4,6 @@
 #include <utility>
 
 #include "core/error.hpp"
-#include "harness/simulation.hpp"
 
 namespace omniloc::harness {
 
@@ -89,47 +88,6 @@ Slip parse(std::in_place_type_t<Slip>, JsonReader& r, const Json&, const std::st
   return k;
 }
 
-// --- apply: what the kind does to the running simulation, and what events.jsonl records ------------
-
-// Teleport and kidnap move the robot alike: to the given pose or one drawn from the stream "events".
-template <class K>
-void move_robot(const K& k, const Event& e, Simulation& sim, Json& log) {
-  const Pose2 target = k.random_pose ? sim.random_pose_on_field() : k.pose;
-  sim.teleport(e.robot, target);
-  log["pose"] = {target.x, target.y, target.theta};
-}
-
-void apply(const Teleport& k, const Event& e, Simulation& sim, Json& log) { move_robot(k, e, sim, log); }
-
-void apply(const Cover& k, const Event& e, Simulation& sim, Json& log) {
-  sim.cover_camera(e.robot, sim.time() + k.duration);
-  log["duration"] = k.duration;
-}
-
-// A kidnap is a teleport under a covered camera.
-void apply(const Kidnap& k, const Event& e, Simulation& sim, Json& log) {
-  move_robot(k, e, sim, log);
-  apply(Cover{k.duration}, e, sim, log);
-}
-
-void apply(const Occlude& k, const Event& e, Simulation& sim, Json& log) {
-  sim.occlude_camera(e.robot, sim.time() + k.duration, k.mask);
-  log["duration"] = k.duration;
-  log["fraction"] = k.mask.fraction();
-}
-
-// The light is a function of time (Scenario::lighting_at, through Lights::shade): nothing to change.
-void apply(const Lights& k, const Event&, Simulation&, Json& log) {
-  log["level"] = k.level;
-  log["transition"] = k.transition;
-}
-
-void apply(const Slip& k, const Event& e, Simulation& sim, Json& log) {
-  sim.slip_wheels(e.robot, sim.time() + k.duration, k.scale);
-  log["duration"] = k.duration;
-  log["scale"] = k.scale;
-}
-
 template <std::size_t... I>
 EventKind parse_kind(const std::string& type, JsonReader& r, const Json& raw, const std::string& path, int robot, const EventContext& ctx,
                      std::index_sequence<I...>) {
@@ -184,12 +142,6 @@ Event parse_event(const Json& j, const std::string& path, const EventContext& ct
   e.kind = parse_kind(type, r, j, path, e.robot, ctx, std::make_index_sequence<std::variant_size_v<EventKind>>{});
   r.finish();
   return e;
-}
-
-Json apply_event(const Event& e, Simulation& sim) {
-  Json log{{"t", sim.time()}, {"type", e.type()}, {"robot", e.robot}};
-  std::visit([&](const auto& k) { apply(k, e, sim, log); }, e.kind);
-  return log;
 }
 
 }  // namespace omniloc::harness

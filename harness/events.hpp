@@ -1,8 +1,9 @@
 #pragma once
 // Scripted scenario events. Each kind is one struct holding its parameters and, in events.cpp, its
-// parse (from the scenario file), apply (to the running Simulation) and log (events.jsonl) code;
-// an event is a time, a robot and one of those kinds in a std::variant. Adding a kind: a struct
-// here, its three functions in events.cpp, a test and a row in docs/scenario.md (docs/extending.md).
+// parse (from the scenario file); what it does to the running Simulation and what events.jsonl logs
+// of it is its apply function in simulation.cpp. An event is a time, a robot and one of those kinds
+// in a std::variant. Adding a kind: a struct here, its parse in events.cpp, its apply in
+// simulation.cpp, a test and a row in docs/scenario.md (docs/extending.md).
 //
 // Units: seconds, metres, radians; poses in the world frame.
 #include <string>
@@ -16,8 +17,6 @@
 #include "sim/occlusion.hpp"
 
 namespace omniloc::harness {
-
-class Simulation;
 
 /// Moves the robot instantly to `pose` (no odometry of the move).
 struct Teleport {
@@ -98,7 +97,5 @@ Event parse_event(const Json& j, const std::string& path, const EventContext& ct
 /// The names of every event kind, in the variant's order (for messages and docs).
 std::vector<std::string> event_type_names();
 
-/// Acts on the simulation (teleport, cover the camera, ...) and returns the events.jsonl record.
-Json apply_event(const Event& e, Simulation& sim);
 
 }  // namespace omniloc::harness

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "harness/camera_perception.hpp"
 #include "harness/external_session.hpp"
 
 namespace omniloc::harness {

@@ -4,7 +4,7 @@
 // (odometry, heading, the perception's observations) and what scoring needs (the true pose, contact),
 // plus the lines the world and the perception add to events.jsonl. The live source simulates and
 // perceives (harness/simulation, harness/perception); a recording source reads what a live source
-// wrote (harness/recording.hpp, docs/recording.md). The run loop (harness/runner.cpp) does not know
+// wrote (harness/recording/recording_source.hpp, docs/recording.md). The run loop (harness/runner.cpp) does not know
 // which one it reads, so a replay writes the same run folder as the live run it was recorded from.
 //
 // Units: seconds, metres, radians; poses in the world frame, observations in the robot frame.
@@ -17,38 +17,13 @@
 #include "core/json_reader.hpp"
 #include "core/messages.hpp"
 #include "core/pose2.hpp"
+#include "harness/frame_data.hpp"
 #include "harness/perception.hpp"
 #include "harness/scenario.hpp"
 #include "harness/simulation.hpp"
 #include "localization/localizer.hpp"
 
 namespace omniloc::harness {
-
-/// One localized robot at one camera frame.
-struct RobotFrame {
-  int id = 0;
-  // What the robot's localizer is given.
-  Odometry odometry;              ///< since the previous frame, robot frame of the previous frame
-  std::optional<double> heading;  ///< compass / MTi, world frame
-  Observations obs;               ///< t, camera_ok, line points, blobs, image (when rendered or recorded)
-  // What the run records beside it.
-  bool covered = false;                    ///< lens covered: a localizer without vision still sees camera_ok = false
-  std::optional<CameraSettings> settings;  ///< the settings an image was taken with (none when nothing was rendered)
-  bool stop_robot = false;                 ///< perception asked the robot to stand still from the next step
-  std::vector<std::string> events;         ///< events.jsonl lines of this robot's perception (warnings, camera, pause)
-  double render_ms = 0.0, vision_ms = 0.0; ///< wall time (timing.csv only)
-  // Scoring only: never given to a localizer.
-  std::optional<Pose2> truth;  ///< none in a log without ground truth
-  bool contact = false;
-};
-
-/// One camera frame of every localized robot.
-struct FrameData {
-  long long k = 0;
-  double t = 0.0;                   ///< seconds: the physics step the frame was taken at
-  std::vector<std::string> events;  ///< events.jsonl lines of the scenario's events applied before this frame
-  std::vector<RobotFrame> robots;   ///< in the scenario's order of localized robots
-};
 
 class FrameSource {
  public:

@@ -11,7 +11,7 @@
 #include "localization/localizer.hpp"
 #include "localization/vision/calibration_map.hpp"
 #include "sim/occlusion.hpp"
-#include "sim/render/egl_device.hpp"
+#include "sim/render/gl_device_info.hpp"
 #include "sim/world_state.hpp"
 
 namespace omniloc::harness {
@@ -57,8 +57,5 @@ class NoPerception : public Perception {
     return o;
   }
 };
-
-/// Builds the perception a scenario needs (camera + vision when its localizer needs vision).
-std::unique_ptr<Perception> make_perception(const Scenario& s, bool needs_vision, std::uint64_t seed);
 
 }  // namespace omniloc::harness

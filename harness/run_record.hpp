@@ -1,7 +1,7 @@
 #pragma once
 // What a run records per camera frame of each localized robot: the truth (for scoring only), the
 // localizer's answer, the vision statistics and the wall-clock stage times. The scoring
-// (harness/metrics) and the result files (harness/run_writer) are computed from these records alone.
+// (harness/scoring/metrics) and the result files (harness/run_writer) are computed from these records alone.
 #include <cstddef>
 #include <map>
 #include <optional>

@@ -11,7 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/version.hpp"
 #include "external/external_localizer.hpp"
-#include "harness/cache_dirs.hpp"
+#include "harness/cache/cache_dirs.hpp"
 #include "harness/external_session.hpp"
 #include "harness/frame_source.hpp"
 #include "harness/localizer_registry.hpp"

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/json_reader.hpp"
-#include "harness/metrics.hpp"
+#include "harness/scoring/metrics.hpp"
 #include "harness/scenario.hpp"
 
 namespace omniloc::harness {

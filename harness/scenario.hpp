@@ -10,7 +10,7 @@
 
 #include "core/field.hpp"
 #include "core/json_reader.hpp"
-#include "harness/metrics.hpp"
+#include "harness/scoring/metrics.hpp"
 #include "harness/events.hpp"
 #include "harness/localizer_spec.hpp"
 #include "sim/occlusion.hpp"

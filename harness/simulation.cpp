@@ -4,6 +4,59 @@
 
 namespace omniloc::harness {
 
+namespace {
+
+// What each event kind (harness/events.hpp) does to the running simulation, and what events.jsonl
+// records of it. Here rather than in events.cpp: the events are the scenario's data, the simulation
+// is what acts on them.
+
+// Teleport and kidnap move the robot alike: to the given pose or one drawn from the stream "events".
+template <class K>
+void move_robot(const K& k, const Event& e, Simulation& sim, Json& log) {
+  const Pose2 target = k.random_pose ? sim.random_pose_on_field() : k.pose;
+  sim.teleport(e.robot, target);
+  log["pose"] = {target.x, target.y, target.theta};
+}
+
+void apply(const Teleport& k, const Event& e, Simulation& sim, Json& log) { move_robot(k, e, sim, log); }
+
+void apply(const Cover& k, const Event& e, Simulation& sim, Json& log) {
+  sim.cover_camera(e.robot, sim.time() + k.duration);
+  log["duration"] = k.duration;
+}
+
+// A kidnap is a teleport under a covered camera.
+void apply(const Kidnap& k, const Event& e, Simulation& sim, Json& log) {
+  move_robot(k, e, sim, log);
+  apply(Cover{k.duration}, e, sim, log);
+}
+
+void apply(const Occlude& k, const Event& e, Simulation& sim, Json& log) {
+  sim.occlude_camera(e.robot, sim.time() + k.duration, k.mask);
+  log["duration"] = k.duration;
+  log["fraction"] = k.mask.fraction();
+}
+
+// The light is a function of time (Scenario::lighting_at, through Lights::shade): nothing to change.
+void apply(const Lights& k, const Event&, Simulation&, Json& log) {
+  log["level"] = k.level;
+  log["transition"] = k.transition;
+}
+
+void apply(const Slip& k, const Event& e, Simulation& sim, Json& log) {
+  sim.slip_wheels(e.robot, sim.time() + k.duration, k.scale);
+  log["duration"] = k.duration;
+  log["scale"] = k.scale;
+}
+
+Json apply_event(const Event& e, Simulation& sim) {
+  Json log{{"t", sim.time()}, {"type", e.type()}, {"robot", e.robot}};
+  std::visit([&](const auto& k) { apply(k, e, sim, log); }, e.kind);
+  return log;
+}
+
+}  // namespace
+
 Simulation::Simulation(const Scenario& s, std::uint64_t seed, EventLog* log)
     : sc_(s), log_(log), world_(s.field, s.physics_rate), event_rng_(Rng::stream(seed, "events")) {
   for (const auto& rc : s.robots) {

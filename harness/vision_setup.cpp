@@ -11,8 +11,8 @@
 #include "core/calibration_patch.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
-#include "harness/cache_dirs.hpp"
-#include "harness/metrics.hpp"
+#include "harness/cache/cache_dirs.hpp"
+#include "harness/scoring/metrics.hpp"
 #include "sim/render/panoramic_camera.hpp"
 
 namespace omniloc::harness {

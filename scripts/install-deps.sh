@@ -30,7 +30,7 @@ PKGS=(
   libpng-dev libjpeg-dev  # PNG and JPEG files (harness/image_file.cpp)
   libosmesa6-dev libegl-dev libegl-mesa0 libgles-dev mesa-common-dev
   libbenchmark-dev libgtest-dev libgmock-dev
-  libssl-dev zlib1g-dev libsimdjson-dev  # simdjson: the recording reader's fast path (harness/frames_reader.cpp)
+  libssl-dev zlib1g-dev libsimdjson-dev  # simdjson: the recording reader's fast path (harness/recording/frames_reader.cpp)
   python3 python3-matplotlib python3-jsonschema python3-numpy perl
   valgrind
   ccache  # a compile cache (CMakeLists.txt OMNILOC_CCACHE): a fresh clone builds from earlier objects

@@ -1,4 +1,6 @@
-#include "sim/behaviour.hpp"
+// The match-like behaviours of BehaviourScript (declared with the other motion scripts in
+// sim/motion.hpp, whose factory builds them from a scenario's "behaviour" motion).
+#include "sim/motion.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,5 @@
 #include "sim/motion.hpp"
 
-#include "sim/behaviour.hpp"
-
 #include <algorithm>
 #include <cmath>
 

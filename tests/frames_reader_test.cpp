@@ -1,4 +1,4 @@
-// The streaming recording reader (harness/frames_reader.hpp) against the whole-file reader it
+// The streaming recording reader (harness/recording/frames_reader.hpp) against the whole-file reader it
 // replaced, kept here as the reference: on every shipped recording and on hand-made lines at the
 // edges of the fast path (integers for doubles, unknown keys, duplicate keys, blobs, events, values
 // at and past the limits, damaged files), both give the same frames or the same error message.
@@ -19,8 +19,10 @@
 #include "core/install_paths.hpp"
 #include "core/json_parse.hpp"
 #include "external/sha256.hpp"
-#include "harness/gzip.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/format/gzip.hpp"
+#include "harness/recording/format/frame_codec.hpp"
+#include "harness/recording/frames_reader.hpp"
+#include "harness/recording/recording_source.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;

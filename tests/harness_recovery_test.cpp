@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "harness/metrics.hpp"
-#include "harness/recovery.hpp"
+#include "harness/scoring/metrics.hpp"
+#include "harness/scoring/recovery.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;

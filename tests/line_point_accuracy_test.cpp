@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "harness/camera_perception.hpp"
 #include "harness/perception.hpp"
 #include "harness/scenario.hpp"
 #include "harness/simulation.hpp"

@@ -1,9 +1,9 @@
-// The experiments' OpenCV plots (harness/plot.*): round ticks, titles that fit.
+// The experiments' OpenCV plots (experiments/plot.*): round ticks, titles that fit.
 #include <gtest/gtest.h>
 
-#include "harness/plot.hpp"
+#include "experiments/plot.hpp"
 
-using namespace omniloc::harness;
+using namespace omniloc::experiments;
 
 TEST(Plot, TicksAreRoundAndCoverTheData) {
   // The report showed ticks at 734 / 587 / 440 (a fifth of the data's range each).

@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "harness/recording.hpp"
+#include "harness/recording/recording_writer.hpp"
+#include "harness/recording/recording_source.hpp"
+#include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "core/install_paths.hpp"

@@ -8,7 +8,8 @@
 #include <iostream>
 
 #include "core/install_paths.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/recording_source.hpp"
+#include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 
@@ -18,7 +19,7 @@ namespace {
 
 Json replay(const std::string& dir, const Json& localizer, const std::string& out) {
   harness::RecordingHeader header = harness::RecordingHeader::read(dir);
-  const harness::Scenario s = harness::replay_scenario(header, localizer);
+  const harness::Scenario s = harness::replay_scenario(header, harness::LocalizerSpec(localizer, "--localizer"));
   harness::RecordingSource source(std::move(header));
   harness::RunOptions o;
   o.seed = source.header().seed;

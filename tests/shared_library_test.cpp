@@ -1,4 +1,4 @@
-// Reading which libraries a shared library links, without loading it (harness/shared_library.hpp):
+// Reading which libraries a shared library links, without loading it (harness/cache/shared_library.hpp):
 // the world cache's key names the OSMesa library and what it links (LLVM among them), so a Mesa or
 // LLVM update misses the cache. Checked against binutils' readelf where it is installed, and on
 // damaged files, which must give an empty list, never a crash or a read past the file.
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/shared_library.hpp"
+#include "harness/cache/shared_library.hpp"
 
 using namespace omniloc;
 namespace fs = std::filesystem;

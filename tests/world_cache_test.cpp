@@ -1,4 +1,4 @@
-// The world cache (harness/world_cache.hpp, docs/recording.md section 9): what the key holds, that a
+// The world cache (harness/cache/world_cache.hpp, docs/recording.md section 9): what the key holds, that a
 // run from the cache writes the live run's files, that a damaged entry is redrawn and never used,
 // and that pruning removes the least recently used entries but never one in use.
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 
 #include "core/error.hpp"
 #include "core/install_paths.hpp"
-#include "harness/world_cache.hpp"
+#include "harness/cache/world_cache.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;

@@ -8,15 +8,6 @@
 
 namespace omniloc::landmarks {
 
-Fix no_fix(std::string reason) {
-  Fix f;
-  f.ok = false;
-  f.pose = Pose2();
-  f.reliability = 0.0;
-  f.reason = std::move(reason);
-  return f;
-}
-
 double landmark_scale(std::span<const BearingObs> obs) {
   double best = 0.0;
   for (std::size_t i = 0; i < obs.size(); ++i)

@@ -16,29 +16,9 @@
 #include <Eigen/Core>
 
 #include "core/pose2.hpp"
+#include "localization/landmarks/fix.hpp"
 
 namespace omniloc::landmarks {
-
-/// One landmark seen by the robot.
-struct BearingObs {
-  Eigen::Vector2d landmark = Eigen::Vector2d::Zero();  ///< known landmark position, world frame, metres
-  double bearing = 0.0;  ///< radians, robot frame, anticlockwise from the robot's x axis
-};
-
-/// Result of a landmark solver.
-struct Fix {
-  bool ok = false;
-  Pose2 pose;  ///< world frame: x, y in metres, theta in radians (-pi, pi]; all zero when !ok
-  /// Larger = better; 0 when !ok. All solvers use the same measure: the inverse of the position
-  /// dilution of precision of the bearings at the solution, 1 / sqrt(trace of the (x, y) block of
-  /// (J^T J)^-1), J the Jacobian of the bearings w.r.t. (x, y, theta). Unit: radians per metre, i.e.
-  /// 1 / (metres of position error per radian of bearing noise). It goes to 0 on the singular set.
-  double reliability = 0.0;
-  std::string reason;  ///< why there is no fix; empty when ok
-};
-
-/// A refused fix (ok = false, zero pose, zero reliability).
-Fix no_fix(std::string reason);
 
 /// Checks shared by all solvers: at least 3 observations, all numbers finite, no landmark given
 /// twice (closer than kSameLandmark), not all landmarks on one line. Returns the reason, or "" when
@@ -47,12 +27,6 @@ std::string check_input(std::span<const BearingObs> obs);
 
 /// As check_input, and exactly three observations (the closed-form solvers).
 std::string check_triple(std::span<const BearingObs> obs);
-
-/// Two landmarks closer than this (metres) are taken to be the same landmark given twice.
-inline constexpr double kSameLandmark = 1e-6;
-/// Relative tolerance for the collinearity of landmarks and for the closed forms' denominators
-/// (the robot on the circle through the three landmarks, or on the line through two of them).
-inline constexpr double kSingularTol = 1e-9;
 
 /// Heading of a robot at `position` given the bearings: the circular mean of
 /// atan2(L_i - position) - bearing_i, each term weighted by the landmark's distance (far landmarks

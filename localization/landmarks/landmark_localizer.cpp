@@ -141,15 +141,14 @@ void sequences(int n, int k, std::vector<int>& cur, std::vector<bool>& used, std
   }
 }
 
-}  // namespace
+// Usable blobs and the objects they can be, grouped by (colour, kind): (blob indices, object indices).
+using BlobGroups = std::map<std::pair<int, int>, std::pair<std::vector<int>, std::vector<int>>>;
 
-LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std::optional<Pose2>& predicted) const {
-  LandmarkFrame res;
-  // Group usable blobs and the objects they can be by (colour, kind).
-  std::map<std::pair<int, int>, std::pair<std::vector<int>, std::vector<int>>> groups;
+BlobGroups group_blobs(const std::vector<Blob>& blobs, const std::vector<KnownObject>& objects, bool skip_occluded) {
+  BlobGroups groups;
   for (int i = 0; i < static_cast<int>(blobs.size()); ++i) {
     const Blob& b = blobs[i];
-    if (p_.skip_occluded) {
+    if (skip_occluded) {
       if (b.kind == Blob::Kind::kRegion && (b.left_occluded || b.right_occluded)) continue;
       if (b.kind == Blob::Kind::kLeftEdge && b.left_occluded) continue;
       if (b.kind == Blob::Kind::kRightEdge && b.right_occluded) continue;
@@ -157,15 +156,23 @@ LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std
     const std::pair<int, int> key{b.colour, static_cast<int>(b.kind)};
     groups[key].first.push_back(i);
   }
-  for (int j = 0; j < static_cast<int>(objects_.size()); ++j) {
-    const std::pair<int, int> key{objects_[j].colour, static_cast<int>(objects_[j].kind)};
+  for (int j = 0; j < static_cast<int>(objects.size()); ++j) {
+    const std::pair<int, int> key{objects[j].colour, static_cast<int>(objects[j].kind)};
     auto it = groups.find(key);
     if (it != groups.end()) it->second.second.push_back(j);
   }
-  // Per group: every one-to-one pairing of min(#blobs, #objects) blobs and objects. At most two
-  // surplus blobs per group are considered (the largest).
-  std::vector<std::vector<std::vector<std::pair<int, int>>>> options;
-  int matched = 0;
+  return groups;
+}
+
+// One group's candidate pairings, each a list of (blob, object).
+using GroupOptions = std::vector<std::vector<std::pair<int, int>>>;
+
+// Per group: every one-to-one pairing of min(#blobs, #objects) blobs and objects. At most two
+// surplus blobs per group are considered (the largest). `matched`: the bearings one assignment
+// (one pairing per group) holds.
+std::vector<GroupOptions> pairings(BlobGroups& groups, const std::vector<Blob>& blobs, int& matched) {
+  std::vector<GroupOptions> options;
+  matched = 0;
   for (auto& [key, g] : groups) {
     auto& [bl, ob] = g;
     if (ob.empty()) continue;
@@ -178,7 +185,7 @@ LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std
     std::vector<int> cur;
     std::vector<bool> used(static_cast<std::size_t>(n), false);
     sequences(n, k, cur, used, seqs);
-    std::vector<std::vector<std::pair<int, int>>> opts;
+    GroupOptions opts;
     for (const auto& s : seqs) {
       std::vector<std::pair<int, int>> pairs;
       for (int i = 0; i < k; ++i)
@@ -188,16 +195,99 @@ LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std
     matched += k;
     options.push_back(std::move(opts));
   }
-  res.matched = matched;
-  if (matched < p_.min_landmarks) {
+  return options;
+}
+
+// Solves one assignment into c.fix; goal edges are re-chosen from each fix until they no longer
+// change (at most 3 solves). Returns the bearings of the last solve.
+std::vector<BearingObs> solve_assignment(Candidate& c, const std::vector<Blob>& blobs, const std::vector<KnownObject>& objects,
+                                         const std::optional<Pose2>& predicted) {
+  Eigen::Vector2d view = predicted ? predicted->translation() : Eigen::Vector2d::Zero();
+  std::vector<BearingObs> obs;
+  for (int pass = 0; pass < 3; ++pass) {
+    std::vector<BearingObs> next;
+    for (const auto& [bi, oj] : c.pairs) next.push_back({objects[oj].seen_from(view), blobs[bi].bearing});
+    bool same = pass > 0 && next.size() == obs.size();
+    for (std::size_t i = 0; same && i < next.size(); ++i) same = (next[i].landmark - obs[i].landmark).norm() < 1e-12;
+    if (same) break;
+    obs = std::move(next);
+    c.fix = obs.size() >= 4 ? landmarks::least_squares_bearings(obs) : landmarks::total_like(obs);
+    if (!c.fix.ok) break;
+    view = c.fix.pose.translation();
+  }
+  return obs;
+}
+
+// The cost of a fix: its bearing residuals (in units of the bearing sigma), the seen distances
+// against the expected ones and, with a predicted pose, the distance from it; and the bearings' RMS.
+void score(Candidate& c, const std::vector<BearingObs>& obs, const std::vector<Blob>& blobs, const std::vector<KnownObject>& objects,
+           const LandmarkLocalizerParams& p, const std::optional<Pose2>& predicted) {
+  const double sb = deg2rad(p.bearing_sigma_deg);
+  const bool use_pred = predicted.has_value() && p.prediction_sigma > 0;
+  const Eigen::Vector2d P = c.fix.pose.translation();
+  double ss = 0.0, cost = 0.0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const Eigen::Vector2d d = obs[i].landmark - P;
+    const double r = angle_diff(std::atan2(d.y(), d.x()) - c.fix.pose.theta, obs[i].bearing);
+    ss += r * r;
+    const Blob& b = blobs[c.pairs[i].first];
+    if (p.distance_sigma > 0 && b.has_distance) {
+      const double expect = d.norm() - objects[c.pairs[i].second].half_size;
+      const double e = (expect - b.distance) / (p.distance_sigma * std::max(b.distance, 0.5));
+      cost += e * e;
+    }
+  }
+  c.rms = std::sqrt(ss / static_cast<double>(obs.size()));
+  cost += ss / (sb * sb);
+  if (use_pred) {
+    const double dp = (P - predicted->translation()).norm() / p.prediction_sigma;
+    const double dt = angle_diff(c.fix.pose.theta, predicted->theta) / deg2rad(p.prediction_sigma_theta_deg);
+    cost += dp * dp + dt * dt;
+  }
+  c.cost = cost;
+}
+
+// The next assignment: an odometer over the groups' options. False after the last one.
+bool next_assignment(std::vector<std::size_t>& idx, const std::vector<GroupOptions>& options) {
+  std::size_t g = 0;
+  for (; g < options.size(); ++g) {
+    if (++idx[g] < options[g].size()) break;
+    idx[g] = 0;
+  }
+  return g != options.size();
+}
+
+// Refuses the best fix when another assignment as cheap puts the robot elsewhere (ambiguous), or
+// when its four or more bearings disagree (inconsistent).
+void refuse_doubtful(LandmarkFrame& res, const std::vector<Candidate>& cands, const Candidate& best, const LandmarkLocalizerParams& p) {
+  for (const auto& c : cands) {
+    if (&c == &best) continue;
+    const bool elsewhere = (c.fix.pose.translation() - best.fix.pose.translation()).norm() > 0.5 ||
+                           std::fabs(angle_diff(c.fix.pose.theta, best.fix.pose.theta)) > deg2rad(10.0);
+    if (c.cost < best.cost + p.ambiguity_margin && elsewhere) {
+      res.reason = NoFixReason::kAmbiguous;
+      res.detail = "two assignments within " + std::to_string(p.ambiguity_margin) + " of the best cost";
+      return;
+    }
+  }
+  if (best.pairs.size() >= 4 && best.rms > deg2rad(p.max_bearing_rms_deg)) {
+    res.reason = NoFixReason::kInconsistent;
+    res.detail = "bearing RMS " + std::to_string(rad2deg(best.rms)) + " deg";
+  }
+}
+
+}  // namespace
+
+LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std::optional<Pose2>& predicted) const {
+  LandmarkFrame res;
+  BlobGroups groups = group_blobs(blobs, objects_, p_.skip_occluded);
+  const std::vector<GroupOptions> options = pairings(groups, blobs, res.matched);
+  if (res.matched < p_.min_landmarks) {
     res.reason = NoFixReason::kTooFewLandmarks;
-    res.detail = std::to_string(matched) + " matched blobs, " + std::to_string(p_.min_landmarks) + " needed";
+    res.detail = std::to_string(res.matched) + " matched blobs, " + std::to_string(p_.min_landmarks) + " needed";
     return res;
   }
 
-  const double sb = deg2rad(p_.bearing_sigma_deg);
-  const bool use_pred = predicted.has_value() && p_.prediction_sigma > 0;
-  const Eigen::Vector2d view0 = predicted ? predicted->translation() : Eigen::Vector2d::Zero();
   std::vector<Candidate> cands;
   std::string last_reason;
   std::vector<std::size_t> idx(options.size(), 0);
@@ -207,55 +297,16 @@ LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std
     for (std::size_t g = 0; g < options.size(); ++g)
       for (const auto& pr : options[g][idx[g]]) c.pairs.push_back(pr);
     ++tried;
-    // Solve; goal edges are re-chosen from each fix until they no longer change.
-    Eigen::Vector2d view = view0;
-    std::vector<BearingObs> obs;
-    for (int pass = 0; pass < 3; ++pass) {
-      std::vector<BearingObs> next;
-      for (const auto& [bi, oj] : c.pairs) next.push_back({objects_[oj].seen_from(view), blobs[bi].bearing});
-      bool same = pass > 0 && next.size() == obs.size();
-      for (std::size_t i = 0; same && i < next.size(); ++i) same = (next[i].landmark - obs[i].landmark).norm() < 1e-12;
-      if (same) break;
-      obs = std::move(next);
-      c.fix = obs.size() >= 4 ? landmarks::least_squares_bearings(obs) : landmarks::total_like(obs);
-      if (!c.fix.ok) break;
-      view = c.fix.pose.translation();
-    }
+    const std::vector<BearingObs> obs = solve_assignment(c, blobs, objects_, predicted);
     if (!c.fix.ok) {
       last_reason = c.fix.reason;
     } else if (!field_.inside_floor(c.fix.pose.translation(), -p_.floor_slack)) {
       last_reason = "fix off the floor";
     } else {
-      const Eigen::Vector2d P = c.fix.pose.translation();
-      double ss = 0.0, cost = 0.0;
-      for (std::size_t i = 0; i < obs.size(); ++i) {
-        const Eigen::Vector2d d = obs[i].landmark - P;
-        const double r = angle_diff(std::atan2(d.y(), d.x()) - c.fix.pose.theta, obs[i].bearing);
-        ss += r * r;
-        const Blob& b = blobs[c.pairs[i].first];
-        if (p_.distance_sigma > 0 && b.has_distance) {
-          const double expect = d.norm() - objects_[c.pairs[i].second].half_size;
-          const double e = (expect - b.distance) / (p_.distance_sigma * std::max(b.distance, 0.5));
-          cost += e * e;
-        }
-      }
-      c.rms = std::sqrt(ss / static_cast<double>(obs.size()));
-      cost += ss / (sb * sb);
-      if (use_pred) {
-        const double dp = (P - predicted->translation()).norm() / p_.prediction_sigma;
-        const double dt = angle_diff(c.fix.pose.theta, predicted->theta) / deg2rad(p_.prediction_sigma_theta_deg);
-        cost += dp * dp + dt * dt;
-      }
-      c.cost = cost;
+      score(c, obs, blobs, objects_, p_, predicted);
       cands.push_back(std::move(c));
     }
-    // Next assignment (odometer over the groups' options).
-    std::size_t g = 0;
-    for (; g < options.size(); ++g) {
-      if (++idx[g] < options[g].size()) break;
-      idx[g] = 0;
-    }
-    if (g == options.size()) break;
+    if (!next_assignment(idx, options)) break;
   }
   res.assignments = tried;
   if (cands.empty()) {
@@ -268,21 +319,7 @@ LandmarkFrame LandmarkLocalizer::solve(const std::vector<Blob>& blobs, const std
   res.cost = best->cost;
   res.bearing_rms = best->rms;
   for (const auto& [bi, oj] : best->pairs) res.ids.push_back(objects_[oj].id);
-  for (const auto& c : cands) {
-    if (&c == &*best) continue;
-    const bool elsewhere = (c.fix.pose.translation() - best->fix.pose.translation()).norm() > 0.5 ||
-                           std::fabs(angle_diff(c.fix.pose.theta, best->fix.pose.theta)) > deg2rad(10.0);
-    if (c.cost < best->cost + p_.ambiguity_margin && elsewhere) {
-      res.reason = NoFixReason::kAmbiguous;
-      res.detail = "two assignments within " + std::to_string(p_.ambiguity_margin) + " of the best cost";
-      return res;
-    }
-  }
-  if (best->pairs.size() >= 4 && best->rms > deg2rad(p_.max_bearing_rms_deg)) {
-    res.reason = NoFixReason::kInconsistent;
-    res.detail = "bearing RMS " + std::to_string(rad2deg(best->rms)) + " deg";
-    return res;
-  }
+  refuse_doubtful(res, cands, *best, p_);
   return res;
 }
 

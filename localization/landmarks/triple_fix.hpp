@@ -9,7 +9,7 @@
 
 #include "core/angles.hpp"
 #include "core/fast_trig.hpp"
-#include "localization/landmarks/landmark_fix.hpp"
+#include "localization/landmarks/fix.hpp"
 
 namespace omniloc::landmarks::detail {
 

@@ -93,58 +93,8 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     return d;
   }
   if (state_ == State::Idle) {
-    if (first && p_.search_at_start) {
-      start(t, 0.0, entropy);
-      d.event = "search_start (first frame)";
-      propose(t, next_probe(), d);
-      d.settings = cur_;
-      d.searching = true;
-      return d;
-    } else if (saved_brightness_ < 0) {
-      if (t + 1e-9 < settled_at_) {  // the final setting has not settled yet
-        d.settings = cur_;
-        return d;
-      }
-      saved_brightness_ = brightness;
-      // The light changed while the search ran (lamps warming up over a second): the entropies it
-      // compared were taken under different light, and the chosen setting was measured under light
-      // that is gone. The body at the chosen setting must look as it did when that setting was
-      // measured; otherwise search again now (the normal trigger compares later frames with this
-      // frame, so it would never fire, e.g. with a body clipped at 255 in the returned light).
-      const double measured = check_brightness_;
-      check_brightness_ = -1.0;
-      if (measured >= 0 && std::fabs(brightness - measured) > p_.change_threshold) {
-        d.settings = cur_;
-        d.searching = true;
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "search_start (light changed during the search: body brightness %.1f, %.1f when the setting was measured)",
-                      brightness, measured);
-        d.event = buf;
-        start(t, brightness - measured, -1.0);
-        return d;
-      }
-    } else {
-      const double change = brightness - saved_brightness_;
-      over_ = std::fabs(change) > p_.change_threshold ? over_ + 1 : 0;
-      if (over_ >= p_.confirm_frames) {
-        over_ = 0;
-        d.settings = cur_;
-        d.searching = true;
-        char buf[120];
-        std::snprintf(buf, sizeof buf, "search_start (body brightness %.1f, saved %.1f)", brightness, saved_brightness_);
-        d.event = buf;
-        // The entropy of this frame is not known yet (not computed while idle): the first probe is the
-        // current setting itself, measured on the next frame.
-        start(t, change, -1.0);
-        return d;
-      }
-      d.settings = cur_;
-      return d;
-    }
-    if (state_ == State::Idle) {
-      d.settings = cur_;
-      return d;
-    }
+    watch(t, brightness, entropy, first, d);
+    return d;
   }
   // Searching: frames taken before the last setting settled do not count.
   d.searching = true;
@@ -152,36 +102,111 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     d.settings = cur_;
     return d;
   }
+  measure_probe(brightness, entropy);
+  skip_clamped_probes(d);
+  if (step_ < p_.min_step || steps_ >= p_.max_steps) {
+    end_search(t, d);
+    return d;
+  }
+  propose(t, next_probe(), d);
+  d.settings = cur_;
+  return d;
+}
+
+void ExposureController::watch(double t, double brightness, double entropy, bool first, ExposureDecision& d) {
+  if (first && p_.search_at_start) {
+    start(t, 0.0, entropy);
+    d.event = "search_start (first frame)";
+    propose(t, next_probe(), d);
+    d.settings = cur_;
+    d.searching = true;
+    return;
+  }
+  if (saved_brightness_ < 0) {
+    save_settled_brightness(t, brightness, d);
+    return;
+  }
+  watch_brightness(t, brightness, d);
+}
+
+void ExposureController::save_settled_brightness(double t, double brightness, ExposureDecision& d) {
+  if (t + 1e-9 < settled_at_) {  // the final setting has not settled yet
+    d.settings = cur_;
+    return;
+  }
+  saved_brightness_ = brightness;
+  // The light changed while the search ran (lamps warming up over a second): the entropies it
+  // compared were taken under different light, and the chosen setting was measured under light
+  // that is gone. The body at the chosen setting must look as it did when that setting was
+  // measured; otherwise search again now (the normal trigger compares later frames with this
+  // frame, so it would never fire, e.g. with a body clipped at 255 in the returned light).
+  const double measured = check_brightness_;
+  check_brightness_ = -1.0;
+  if (measured >= 0 && std::fabs(brightness - measured) > p_.change_threshold) {
+    d.settings = cur_;
+    d.searching = true;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "search_start (light changed during the search: body brightness %.1f, %.1f when the setting was measured)",
+                  brightness, measured);
+    d.event = buf;
+    start(t, brightness - measured, -1.0);
+    return;
+  }
+  d.settings = cur_;
+}
+
+void ExposureController::watch_brightness(double t, double brightness, ExposureDecision& d) {
+  const double change = brightness - saved_brightness_;
+  over_ = std::fabs(change) > p_.change_threshold ? over_ + 1 : 0;
+  if (over_ >= p_.confirm_frames) {
+    over_ = 0;
+    d.settings = cur_;
+    d.searching = true;
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "search_start (body brightness %.1f, saved %.1f)", brightness, saved_brightness_);
+    d.event = buf;
+    // The entropy of this frame is not known yet (not computed while idle): the first probe is the
+    // current setting itself, measured on the next frame.
+    start(t, change, -1.0);
+    return;
+  }
+  d.settings = cur_;
+}
+
+void ExposureController::measure_probe(double brightness, double entropy) {
   const double g = cur_.gain;
   if (best_h_ < 0) {  // the starting setting, measured on this frame
     best_h_ = entropy;
     best_brightness_ = brightness;
     path_.assign(1, {g, entropy});
-  } else {
-    path_.push_back({g, entropy});
-    const bool better = entropy > best_h_;
-    if (better) {
-      best_h_ = entropy;
-      best_g_ = g;
-      best_brightness_ = brightness;
-    }
-    if (coarse_) {
-      // Coarse phase: geometric steps in one direction; a plateau or a local dip (clipping makes the
-      // curve step-shaped) is crossed by allowing `patience` worse probes before giving up.
-      if (better) {
-        improved_ = true;
-        fails_ = 0;
-      } else {
-        ++fails_;
-      }
-      last_g_ = g;
-      if (fails_ >= p_.patience) end_coarse_direction();
-    } else if (better) {
-      tried_other_ = true;  // the other side is where we came from, known to be worse
-    } else {
-      fail();
-    }
+    return;
   }
+  path_.push_back({g, entropy});
+  const bool better = entropy > best_h_;
+  if (better) {
+    best_h_ = entropy;
+    best_g_ = g;
+    best_brightness_ = brightness;
+  }
+  if (coarse_) {
+    // Coarse phase: geometric steps in one direction; a plateau or a local dip (clipping makes the
+    // curve step-shaped) is crossed by allowing `patience` worse probes before giving up.
+    if (better) {
+      improved_ = true;
+      fails_ = 0;
+    } else {
+      ++fails_;
+    }
+    last_g_ = g;
+    if (fails_ >= p_.patience) end_coarse_direction();
+  } else if (better) {
+    tried_other_ = true;  // the other side is where we came from, known to be worse
+  } else {
+    fail();
+  }
+}
+
+void ExposureController::skip_clamped_probes(ExposureDecision& d) {
   // Probes that the camera's range clamps onto a measured setting are skipped (with a warning).
   for (int guard = 0; guard < 8 && (coarse_ || step_ >= p_.min_step); ++guard) {
     const double next = on_line(next_probe()).gain;
@@ -190,28 +215,25 @@ ExposureDecision ExposureController::update(double t, double brightness, double 
     if (coarse_) end_coarse_direction();
     else fail();
   }
-  if (step_ < p_.min_step || steps_ >= p_.max_steps) {
-    if (steps_ >= p_.max_steps) {
-      char buf[120];
-      std::snprintf(buf, sizeof buf, "exposure search stopped after the maximum of %d settings", p_.max_steps);
-      d.warnings.push_back(buf);
-    }
-    cur_ = on_line(best_g_);
-    state_ = State::Idle;
-    saved_brightness_ = -1.0;  // re-measured on the next frame, taken with the final setting
-    check_brightness_ = best_brightness_;
-    settled_at_ = t + p_.settle_s;
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "search_end (gain %.2f, exposure %.2f ms, entropy %.3f, %d settings tried)", cur_.gain, cur_.exposure_ms, best_h_,
-                  steps_);
-    d.event = buf;
-    d.settings = cur_;
-    d.searching = false;
-    return d;
+}
+
+void ExposureController::end_search(double t, ExposureDecision& d) {
+  if (steps_ >= p_.max_steps) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "exposure search stopped after the maximum of %d settings", p_.max_steps);
+    d.warnings.push_back(buf);
   }
-  propose(t, next_probe(), d);
+  cur_ = on_line(best_g_);
+  state_ = State::Idle;
+  saved_brightness_ = -1.0;  // re-measured on the next frame, taken with the final setting
+  check_brightness_ = best_brightness_;
+  settled_at_ = t + p_.settle_s;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "search_end (gain %.2f, exposure %.2f ms, entropy %.3f, %d settings tried)", cur_.gain, cur_.exposure_ms, best_h_,
+                steps_);
+  d.event = buf;
   d.settings = cur_;
-  return d;
+  d.searching = false;
 }
 
 double ExposureController::next_probe() const {

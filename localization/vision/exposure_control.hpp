@@ -63,6 +63,16 @@ class ExposureController {
 
  private:
   enum class State { Idle, Searching };
+  // The steps of update(). While idle: start a search on the first frame (search_at_start), keep
+  // the settled body brightness (and search again when the light changed during the last search),
+  // or watch it for a change. While searching: judge the probe measured on this frame, skip probes
+  // the camera's range clamps onto a measured setting, end the search or propose the next probe.
+  void watch(double t, double brightness, double entropy, bool first, ExposureDecision& d);
+  void save_settled_brightness(double t, double brightness, ExposureDecision& d);
+  void watch_brightness(double t, double brightness, ExposureDecision& d);
+  void measure_probe(double brightness, double entropy);
+  void skip_clamped_probes(ExposureDecision& d);
+  void end_search(double t, ExposureDecision& d);
   void start(double t, double brightness_change, double entropy);
   void propose(double t, double g, ExposureDecision& d);
   void fail();

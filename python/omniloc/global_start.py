@@ -6,7 +6,7 @@ that settles on a wrong pose 8 m away lifts the mean of twenty runs by 40 cm whi
 nineteen track at 3 cm. So, per localizer over the runs (seeds) given:
 
 - **ended right**: runs that give a valid estimate in the last second and every valid one there
-  within 0.3 m / 0.2 rad of the truth (the recovery tolerances of harness/recovery.hpp; a frame
+  within 0.3 m / 0.2 rad of the truth (the recovery tolerances of harness/scoring/recovery.hpp; a frame
   the localizer marks invalid, e.g. MCL's spread briefly over its threshold, says "not sure", not
   "wrong"), with the Wilson score 95 %
   interval (Wilson 1927; the interval Brown, Cai and DasGupta 2001 recommend for small n: unlike
@@ -17,7 +17,7 @@ nineteen track at 3 cm. So, per localizer over the runs (seeds) given:
 - **error while right**: mean |x|, |y| (cm), |theta| (rad) and the position RMSE over the valid
   frames that are not wrong (below), pooled over the runs: the papers' table, on correct frames;
 - **wrong frames**: valid frames more than 0.5 m or 0.35 rad off (the `wrong_frames` definition of
-  harness/metrics.cpp), as a fraction of all frames, and the number of runs with any;
+  harness/scoring/metrics.cpp), as a fraction of all frames, and the number of runs with any;
 - **mean over all**: mean position error over every valid frame, the statistic that hides both;
 - **beyond the walls**: frames whose estimate lies outside the floor (field.json beside the run),
   valid ones and all (an invalid MCL estimate is still the set's mean, written to frames.csv);
@@ -45,10 +45,10 @@ from omniloc.core.rundir import Run
 from omniloc.core.stats import wilson
 
 
-POS_TOL, THETA_TOL, HOLD_S = 0.3, 0.2, 1.0      # harness/recovery.hpp RecoveryCriteria
+POS_TOL, THETA_TOL, HOLD_S = 0.3, 0.2, 1.0      # harness/scoring/recovery.hpp RecoveryCriteria
 
 
-WRONG_POS, WRONG_THETA = 0.5, 0.35              # harness/metrics.cpp wrong_frames
+WRONG_POS, WRONG_THETA = 0.5, 0.35              # harness/scoring/metrics.cpp wrong_frames
 
 
 @dataclass

@@ -1,6 +1,7 @@
 #include "sim/render/camera_config.hpp"
 
 #include "core/angles.hpp"
+#include "sim/render/egl_device.hpp"
 #include "sim/render/gl_context.hpp"
 #include "sim/render/mirror.hpp"
 

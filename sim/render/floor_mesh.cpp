@@ -9,7 +9,7 @@
 
 #include "core/angles.hpp"
 #include "core/error.hpp"
-#include "sim/render/panoramic_camera.hpp"
+#include "sim/render/label_class.hpp"
 #include "sim/render/photometry.hpp"
 
 namespace omniloc::sim {

@@ -13,7 +13,7 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
-#include "sim/render/egl_device.hpp"
+#include "sim/render/gl_device_info.hpp"
 
 namespace omniloc::sim {
 

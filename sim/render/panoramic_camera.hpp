@@ -25,28 +25,13 @@
 #include "core/rng.hpp"
 #include "sim/render/camera_config.hpp"
 #include "sim/render/gl_context.hpp"
+#include "sim/render/label_class.hpp"
 #include "sim/render/mirror.hpp"
 #include "sim/world_state.hpp"
 
 namespace omniloc::sim {
 
 struct PanoramicCameraImpl;
-
-/// Classes of render_labels(), one per pixel (value in every channel).
-enum LabelClass : std::uint8_t {
-  kLabelUnknown = 0,
-  kLabelField = 1,
-  kLabelLine = 2,
-  kLabelBall = 3,
-  kLabelObstacle = 4,
-  kLabelBody = 5,
-  kLabelYellow = 6,
-  kLabelBlue = 7,
-  kLabelRed = 8,
-  kLabelFloorOutside = 9,
-  kLabelWall = 10,
-  kLabelGoal = 11,
-};
 
 class PanoramicCamera {
  public:

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/angles.hpp"
-#include "sim/render/panoramic_camera.hpp"
+#include "sim/render/label_class.hpp"
 #include "sim/render/photometry.hpp"
 
 namespace omniloc::sim {

@@ -1,4 +1,4 @@
-#include "harness/plot.hpp"
+#include "experiments/plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 namespace {
 const cv::Scalar kColours[] = {{180, 80, 30}, {40, 120, 230}, {60, 160, 60}, {40, 40, 200}, {150, 90, 160}, {90, 90, 90}, {30, 180, 200}};
@@ -152,4 +152,4 @@ cv::Mat heat_map(const std::vector<double>& v, int cols, int rows, double x0, do
   return m;
 }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

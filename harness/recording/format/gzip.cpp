@@ -1,4 +1,4 @@
-#include "harness/gzip.hpp"
+#include "harness/recording/format/gzip.hpp"
 
 #include <cerrno>
 #include <cstdio>

@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 struct Series {
   std::string label;
@@ -26,4 +26,4 @@ cv::Mat line_plot(const std::vector<Series>& series, const std::string& title, c
 cv::Mat heat_map(const std::vector<double>& values, int cols, int rows, double x0, double x1, double y0, double y1,
                  const std::string& title, const std::string& xlabel, const std::string& ylabel, int cell_px = 24);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

@@ -1,4 +1,4 @@
-#include "harness/cache_dirs.hpp"
+#include "harness/cache/cache_dirs.hpp"
 
 #include <string>
 

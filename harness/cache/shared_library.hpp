@@ -1,7 +1,7 @@
 #pragma once
 // Where a shared library the process will dlopen lives and what it links, read from the file
 // without loading it: the world cache's key names the rendering libraries that draw a world's pixels
-// (harness/world_cache.cpp; docs/recording.md "World cache").
+// (harness/cache/world_cache.cpp; docs/recording.md "World cache").
 #include <string>
 #include <vector>
 

@@ -1,7 +1,8 @@
 #pragma once
-// Scoring: the only place where ground truth meets estimates. Errors per frame, and the papers'
-// table layout (mean, std and max of |x|, |y| errors in cm and |theta| error in rad) plus position
-// mean, RMSE and percentiles.
+// Scoring: the only place where ground truth meets estimates. A robot's score over a run (error
+// statistics, recall, recovery from kidnaps, the tracking phase) and the papers' table layout (mean,
+// std and max of |x|, |y| errors in cm and |theta| error in rad) plus position mean, RMSE and
+// percentiles.
 #include <cmath>
 #include <optional>
 #include <string>
@@ -10,34 +11,10 @@
 #include "core/json_reader.hpp"
 #include "core/pose2.hpp"
 #include "harness/events.hpp"
+#include "harness/scoring/error_stats.hpp"
 #include "harness/run_record.hpp"
 
 namespace omniloc::harness {
-
-struct FrameError {
-  double t = 0.0;
-  double ex = 0.0, ey = 0.0;  ///< estimate - truth, world frame, metres
-  double eth = 0.0;           ///< wrapped, radians
-};
-
-struct AxisStats {
-  double mean = 0.0, std = 0.0, max = 0.0;  ///< of absolute errors
-};
-
-struct ErrorSummary {
-  std::size_t frames = 0;        ///< frames scored
-  AxisStats x_cm, y_cm;          ///< |x|, |y| errors, centimetres (papers' unit)
-  AxisStats theta_rad;           ///< |theta| error, radians
-  double pos_mean_m = 0.0;       ///< mean(hypot(ex, ey)), metres: the typical error (RMSE weighs large ones more)
-  double pos_rmse_m = 0.0;       ///< sqrt(mean(ex^2 + ey^2)), metres
-  double pos_p50_m = 0.0, pos_p90_m = 0.0, pos_p95_m = 0.0, pos_max_m = 0.0;
-  double theta_rmse_rad = 0.0;
-};
-
-ErrorSummary summarize(const std::vector<FrameError>& errors);
-/// The summary's JSON. Over no frame (no estimate) every statistic is null, never 0: a localizer
-/// that never answers must not score a perfect RMSE.
-Json to_json(const ErrorSummary& s);
 
 /// One recall threshold: a frame counts as localized when its estimate lies within `position_m`
 /// (metres) and `heading_rad` (radians) of the truth. `key` names it in summary.json ("25cm_10deg").
@@ -97,7 +74,5 @@ struct RobotScore {
 /// `events`: the scenario's, in time order; `duration`: the run's, seconds.
 RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& events, double duration, const Scoring& scoring = {});
 
-/// Percentile (0..100) of a sample by linear interpolation between order statistics.
-double percentile(std::vector<double> v, double p);
 
 }  // namespace omniloc::harness

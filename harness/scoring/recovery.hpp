@@ -6,7 +6,7 @@
 
 #include "core/json_reader.hpp"
 #include "core/pose2.hpp"
-#include "harness/metrics.hpp"
+#include "harness/scoring/error_stats.hpp"
 
 namespace omniloc::harness {
 

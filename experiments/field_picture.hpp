@@ -8,7 +8,7 @@
 
 #include "core/field.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 class FieldPicture {
  public:
@@ -29,4 +29,4 @@ class FieldPicture {
 /// Encodes a BGR picture as PNG into a byte string (for RunDirectory::write).
 std::string png_bytes(const cv::Mat& bgr);
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

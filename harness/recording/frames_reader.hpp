@@ -5,7 +5,7 @@
 //
 // Every check of the whole-file reader it replaced is kept, with the same messages: the SHA-256 of
 // the JSON lines, whole lines, the frame count, the order of k and t, the type and range of every
-// value (harness/recording.cpp frame_from_json), the gzip stream's integrity. What changes is *when*
+// value (harness/recording/format/frame_codec.cpp frame_from_json), the gzip stream's integrity. What changes is *when*
 // a damaged file is found: while reading, not before the first frame. A replay that meets one fails
 // (exit 2) and writes nothing, and the error reported is the one the whole-file reader reported:
 // the rest of the file is read first, so a cut or changed file (gzip, SHA-256) is named before the
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/frame_source.hpp"
+#include "harness/frame_data.hpp"
 
 namespace omniloc::harness {
 

@@ -1,4 +1,4 @@
-#include "harness/recovery.hpp"
+#include "harness/scoring/recovery.hpp"
 
 #include <algorithm>
 #include <cmath>

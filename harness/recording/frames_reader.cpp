@@ -1,4 +1,4 @@
-#include "harness/frames_reader.hpp"
+#include "harness/recording/frames_reader.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -13,9 +13,9 @@
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "external/sha256.hpp"
-#include "harness/gzip.hpp"
-#include "harness/recording.hpp"
-#include "harness/recording_limits.hpp"
+#include "harness/recording/format/gzip.hpp"
+#include "harness/recording/format/frame_codec.hpp"
+#include "harness/recording/format/limits.hpp"
 
 namespace omniloc::harness {
 

@@ -1,4 +1,4 @@
-#include "harness/field_picture.hpp"
+#include "experiments/field_picture.hpp"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 #include "core/error.hpp"
 #include "harness/image_file.hpp"
 
-namespace omniloc::harness {
+namespace omniloc::experiments {
 
 FieldPicture::FieldPicture(const Field& field, double px_per_m, double border) : s_(px_per_m) {
   const double hx = 0.5 * field.length + border, hy = 0.5 * field.width + border;
@@ -26,6 +26,6 @@ cv::Point FieldPicture::px(const Eigen::Vector2d& w) const {
   return {static_cast<int>(std::lround((w.x() - x0_) * s_)), static_cast<int>(std::lround((y0_ - w.y()) * s_))};
 }
 
-std::string png_bytes(const cv::Mat& bgr) { return encode_png(bgr); }
+std::string png_bytes(const cv::Mat& bgr) { return harness::encode_png(bgr); }
 
-}  // namespace omniloc::harness
+}  // namespace omniloc::experiments

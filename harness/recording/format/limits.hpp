@@ -1,6 +1,6 @@
 #pragma once
 // The physical limits of a recording's numbers (docs/recording.md section 7), one list for both
-// readers of frames (harness/recording.cpp's strict one and harness/frames_reader.cpp's fast path,
+// readers of frames (harness/recording/format/frame_codec.cpp's strict one and harness/recording/frames_reader.cpp's fast path,
 // which must accept exactly what the strict one accepts). A value outside them cannot come from a
 // robot on a field omniloc accepts, and huge ones overflow a localizer's sums (a line point at
 // -1e308 m became -inf cells in the distance map lookup).

@@ -1,4 +1,4 @@
-#include "harness/world_cache.hpp"
+#include "harness/cache/world_cache.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -23,9 +23,10 @@
 #include "external/sha256.hpp"
 #include "harness/frame_source.hpp"
 #include "harness/localizer_registry.hpp"
-#include "harness/recording.hpp"
+#include "harness/recording/recording_writer.hpp"
+#include "harness/recording/recording_source.hpp"
 #include "harness/run_directory.hpp"
-#include "harness/shared_library.hpp"
+#include "harness/cache/shared_library.hpp"
 #include "omniloc_world_fingerprint.hpp"
 
 namespace omniloc::harness {

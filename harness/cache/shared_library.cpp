@@ -1,4 +1,4 @@
-#include "harness/shared_library.hpp"
+#include "harness/cache/shared_library.hpp"
 
 #include <elf.h>
 #include <sys/stat.h>
