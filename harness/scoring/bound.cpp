@@ -225,6 +225,16 @@ Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& 
   return 0.5 * (out + out.transpose());
 }
 
+BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h) {
+  BoundRow row;
+  const Eigen::Vector2d d = world - pose.translation();
+  row.h = Eigen::Vector3d(m.normal.x(), m.normal.y(), d.x() * m.normal.y() - d.y() * m.normal.x());
+  row.var = var;
+  row.a = tilt_jacobian(robot, h).transpose() * (pose.rotation().transpose() * m.normal);
+  row.e = m.residual;
+  return row;
+}
+
 namespace {
 
 // A frame's line point matched at the exposure pose.
@@ -580,13 +590,11 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     line_of.clear();
     for (const auto& q : fw.pts) {
       if (!q.inlier) continue;
-      const Eigen::Vector2d t = fw.pose.translation();
-      BoundRow row;
-      row.h = Eigen::Vector3d(q.normal.x(), q.normal.y(), cross2(q.world - t, q.normal));
+      MarkingMatch mm;
+      mm.normal = q.normal;
+      mm.residual = q.residual;
       const double s = sigma[static_cast<std::size_t>(q.band)];
-      row.var = (1.0 - line_corr) * s * s;
-      row.a = tilt_row(q, fw.pose, h);
-      row.e = q.residual;
+      BoundRow row = bound_row(mm, q.world, fw.pose, q.robot, (1.0 - line_corr) * s * s, h);
       row.line = line_of.try_emplace(q.marking, static_cast<int>(line_of.size())).first->second;
       row.load = s;
       rows.push_back(row);

@@ -92,6 +92,10 @@ struct MarkingMatch {
 };
 MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w);
 
+/// The measurement row of a robot-frame point `robot` seen from `pose`, mapped to `world` and matched
+/// as `m`: d(signed distance)/d(x, y, theta) = (n_x, n_y, (w - t) x n), its tilt loading and residual.
+BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h);
+
 /// What the scenario declares (the bound's "declared" figures and the odometry model's noise).
 struct BoundSetup {
   const Field* field = nullptr;
