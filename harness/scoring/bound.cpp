@@ -38,6 +38,7 @@ constexpr std::size_t kClasses = 2 * kBands;
 // A class measured from fewer points takes its band's pooled figure.
 constexpr std::size_t kMinClassPoints = 30;
 
+// By value: callers that no longer need their sample move it in (nth_element reorders it).
 double median(std::vector<double> v) {
   if (v.empty()) return std::nan("");
   const std::size_t n = v.size() / 2;
@@ -48,12 +49,11 @@ double median(std::vector<double> v) {
 }
 
 // 1.4826 x the median absolute deviation from the median; NaN for an empty sample.
-double robust_sigma(const std::vector<double>& v) {
+double robust_sigma(std::vector<double> v) {
   if (v.empty()) return std::nan("");
   const double m = median(v);
-  std::vector<double> d(v.size());
-  for (std::size_t i = 0; i < v.size(); ++i) d[i] = std::fabs(v[i] - m);
-  return kMadToSigma * median(std::move(d));
+  for (double& x : v) x = std::fabs(x - m);
+  return kMadToSigma * median(std::move(v));
 }
 
 int band_of(double r) {
@@ -94,7 +94,14 @@ void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, int index, do
   const Eigen::Vector2d dc = w - arc.centre;
   const double r = dc.norm();
   if (!(r > 1e-9)) return;
-  const bool inside = arc.sweep >= kTwoPi - 1e-12 || wrap_angle_positive(std::atan2(dc.y(), dc.x()) - arc.start) <= arc.sweep;
+  bool inside = arc.sweep >= kTwoPi - 1e-12;
+  if (!inside && arc.sweep <= kPi) {
+    // Within the sweep: anticlockwise of its start direction and clockwise of its end (no atan2).
+    const Eigen::Vector2d e0(std::cos(arc.start), std::sin(arc.start)), e1(std::cos(arc.start + arc.sweep), std::sin(arc.start + arc.sweep));
+    inside = e0.x() * dc.y() - e0.y() * dc.x() >= 0 && dc.x() * e1.y() - dc.y() * e1.x() >= 0;
+  } else if (!inside) {
+    inside = wrap_angle_positive(std::atan2(dc.y(), dc.x()) - arc.start) <= arc.sweep;
+  }
   if (inside) {
     const double d = std::fabs(r - arc.radius);
     if (!(d < best)) return;
@@ -152,14 +159,21 @@ Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h) {
 Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen::Matrix2d& tilt_cov, double line_corr, Eigen::Vector3d* score) {
   // J = H^T R^-1 H with R = D + A C A^T; Woodbury: R^-1 = D^-1 - D^-1 A (C^-1 + A^T D^-1 A)^-1 A^T D^-1.
   // The nuisances: the tilt (2) and, with line_corr > 0, one offset per marking.
+  // At most kMaxLines markings get an offset of their own (a frame sees about ten); the points of
+  // any further one are taken as independent. Bounded sizes keep the matrices off the heap.
+  constexpr int kMaxLines = 30;
+  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 2 + kMaxLines, 2 + kMaxLines>;
+  using Row3 = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 2 + kMaxLines>;
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 2 + kMaxLines, 1>;
   int lines = 0;
   if (line_corr > 0)
-    for (const auto& r : rows) lines = std::max(lines, r.line + 1);
+    for (const auto& r : rows) lines = std::max(lines, std::min(r.line + 1, kMaxLines));
   const int m = 2 + lines;
   Eigen::Matrix3d HDH = Eigen::Matrix3d::Zero();
-  Eigen::MatrixXd HDA = Eigen::MatrixXd::Zero(3, m), ADA = Eigen::MatrixXd::Zero(m, m);
+  Row3 HDA = Row3::Zero(3, m);
+  Mat ADA = Mat::Zero(m, m);
   Eigen::Vector3d HDe = Eigen::Vector3d::Zero();
-  Eigen::VectorXd ADe = Eigen::VectorXd::Zero(m);
+  Vec ADe = Vec::Zero(m);
   for (const auto& r : rows) {
     const double w = 1.0 / r.var;
     HDH.noalias() += w * r.h * r.h.transpose();
@@ -169,7 +183,7 @@ Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen
       HDe += w * r.e * r.h;
       ADe.head<2>() += w * r.e * r.a;
     }
-    if (lines > 0 && r.line >= 0) {
+    if (lines > 0 && r.line >= 0 && r.line < kMaxLines) {
       const int c = 2 + r.line;
       HDA.col(c) += w * r.load * r.h;
       ADA(c, c) += w * r.load * r.load;
@@ -178,7 +192,7 @@ Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen
       if (score) ADe(c) += w * r.load * r.e;
     }
   }
-  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(m, m);
+  Mat C = Mat::Zero(m, m);
   C.topLeftCorner<2, 2>() = tilt_cov;
   for (int c = 2; c < m; ++c) C(c, c) = line_corr;
   if (C.isZero(0.0)) {
@@ -186,7 +200,7 @@ Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen
     return HDH;
   }
   // (C^-1 + ADA)^-1 = C (I + ADA C)^-1: defined also for a singular C (one axis without vibration).
-  const Eigen::MatrixXd S = C * (Eigen::MatrixXd::Identity(m, m) + ADA * C).partialPivLu().inverse();
+  const Mat S = C * Mat(Mat::Identity(m, m) + ADA * C).partialPivLu().inverse();
   if (score) *score = HDe - HDA * (S * ADe);
   Eigen::Matrix3d J = HDH - HDA * S * HDA.transpose();
   return 0.5 * (J + J.transpose());
@@ -243,6 +257,7 @@ struct PointRes {
   double residual = 0.0;
   Eigen::Vector2d normal, world, robot;
   int marking = -1;
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();  // d(residual)/d(tilt)
   bool near = false;    // within the wide first gate
   bool inlier = false;  // and within its frame's gate once the tilt is out
 };
@@ -256,11 +271,8 @@ struct FrameWork {
   Eigen::Matrix2d tilt_var = Eigen::Matrix2d::Zero();
 };
 
-// d(residual)/d(tilt) of a point: the tilt's floor shift, turned to the world, along the normal.
-Eigen::Vector2d tilt_row(const PointRes& q, const Pose2& pose, double h) {
-  const Eigen::Vector2d nr = pose.rotation().transpose() * q.normal;
-  return tilt_jacobian(q.robot, h).transpose() * nr;
-}
+// d(residual)/d(tilt) of a point, computed once when it is matched (bound_row's a).
+const Eigen::Vector2d& tilt_row(const PointRes& q, const Pose2&, double) { return q.a; }
 
 // The pose each frame's image was exposed at: the truth `latency` before the frame, on the
 // simulation's step grid as the renderer picks it (harness/simulation.cpp camera_view),
@@ -444,6 +456,70 @@ Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<d
   return j;
 }
 
+namespace {
+
+// The markings near each 0.5 m cell of the floor, so that a point is compared with the few that can
+// be its nearest instead of all of them (the bound's cost is mostly this match). A point farther
+// than kMatchReach from every marking matches none: a false detection whatever the noise (4 sigma of
+// the widest band measured on the tracking path is 0.8 m).
+constexpr double kMatchReach = 1.0;
+class MarkingIndex {
+ public:
+  explicit MarkingIndex(const Field& f) : f_(f) {
+    x0_ = -f.half_floor_x() - kMatchReach;
+    y0_ = -f.half_floor_y() - kMatchReach;
+    nx_ = static_cast<int>(std::ceil(2 * (f.half_floor_x() + kMatchReach) / kCell));
+    ny_ = static_cast<int>(std::ceil(2 * (f.half_floor_y() + kMatchReach) / kCell));
+    cells_.resize(static_cast<std::size_t>(nx_ * ny_));
+    const double reach = kMatchReach + kCell * std::sqrt(0.5);  // any point of the cell
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i) {
+        const Eigen::Vector2d c(x0_ + (i + 0.5) * kCell, y0_ + (j + 0.5) * kCell);
+        auto& cell = cells_[static_cast<std::size_t>(j * nx_ + i)];
+        for (std::size_t k = 0; k < f.segments.size(); ++k)
+          if (distance_to_segment(c, f.segments[k].a, f.segments[k].b) <= reach) cell.segments.push_back(static_cast<int>(k));
+        for (std::size_t k = 0; k < f.arcs.size(); ++k)
+          if (distance_to_arc(c, f.arcs[k]) <= reach) cell.arcs.push_back(static_cast<int>(k));
+        for (std::size_t k = 0; k < f.spots.size(); ++k)
+          if ((c - f.spots[k].centre).norm() - f.spots[k].radius <= reach) cell.spots.push_back(static_cast<int>(k));
+      }
+  }
+  /// As match_marking, for points within kMatchReach of a marking (kind 0 beyond).
+  MarkingMatch match(const Eigen::Vector2d& w) const {
+    MarkingMatch m;
+    const int i = static_cast<int>(std::floor((w.x() - x0_) / kCell)), j = static_cast<int>(std::floor((w.y() - y0_) / kCell));
+    if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return m;
+    const Cell& cell = cells_[static_cast<std::size_t>(j * nx_ + i)];
+    double best = kMatchReach;
+    const int nseg = static_cast<int>(f_.segments.size());
+    for (int k : cell.segments) consider_segment(w, f_.segments[static_cast<std::size_t>(k)].a, f_.segments[static_cast<std::size_t>(k)].b, k, best, m);
+    for (int k : cell.arcs) consider_arc(w, f_.arcs[static_cast<std::size_t>(k)], nseg + k, best, m);
+    for (int k : cell.spots) {
+      const auto& s = f_.spots[static_cast<std::size_t>(k)];
+      const double d = std::max(0.0, (w - s.centre).norm() - s.radius);
+      if (d < best) {
+        best = d;
+        m.kind = 2;
+        m.marking = -1;
+        m.residual = d;
+      }
+    }
+    return m;
+  }
+
+ private:
+  static constexpr double kCell = 0.5;
+  struct Cell {
+    std::vector<int> segments, arcs, spots;
+  };
+  const Field& f_;
+  double x0_ = 0, y0_ = 0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<Cell> cells_;
+};
+
+}  // namespace
+
 RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   RobotBound out;
   const auto& frames = robot.frames;
@@ -456,16 +532,18 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   const std::vector<Pose2> poses = exposure_poses(robot, setup);
   std::vector<FrameWork> work(nf);
   std::array<std::vector<double>, kClasses> raw;
+  const MarkingIndex index(field);
   for (std::size_t k = 0; k < nf; ++k) {
     FrameWork& fw = work[k];
     fw.pose = poses[k];
     fw.raw_points = frames[k].line_points.size();
     if (!frames[k].camera_ok) continue;
     fw.pts.reserve(fw.raw_points);
+    const Eigen::Matrix2d rot = fw.pose.rotation();
     for (const auto& pf : frames[k].line_points) {
       const Eigen::Vector2d p(pf[0], pf[1]);
-      const Eigen::Vector2d w = fw.pose.transform(p);
-      const MarkingMatch m = match_marking(field, w);
+      const Eigen::Vector2d w = rot * p + fw.pose.translation();
+      const MarkingMatch m = index.match(w);
       if (m.kind == 2) {
         ++fw.spot_points;
         continue;
@@ -483,6 +561,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
       q.world = w;
       q.robot = p;
       q.marking = m.marking;
+      q.a = tilt_jacobian(p, h).transpose() * (rot.transpose() * m.normal);
       raw[static_cast<std::size_t>(q.band)].push_back(q.residual);
       fw.pts.push_back(q);
     }
@@ -590,11 +669,13 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     line_of.clear();
     for (const auto& q : fw.pts) {
       if (!q.inlier) continue;
-      MarkingMatch mm;
-      mm.normal = q.normal;
-      mm.residual = q.residual;
       const double s = sigma[static_cast<std::size_t>(q.band)];
-      BoundRow row = bound_row(mm, q.world, fw.pose, q.robot, (1.0 - line_corr) * s * s, h);
+      BoundRow row;  // bound_row's, from what the match already computed
+      const Eigen::Vector2d d = q.world - fw.pose.translation();
+      row.h = Eigen::Vector3d(q.normal.x(), q.normal.y(), d.x() * q.normal.y() - d.y() * q.normal.x());
+      row.var = (1.0 - line_corr) * s * s;
+      row.a = q.a;
+      row.e = q.residual;
       row.line = line_of.try_emplace(q.marking, static_cast<int>(line_of.size())).first->second;
       row.load = s;
       rows.push_back(row);
