@@ -49,9 +49,11 @@ double median(std::vector<double> v) {
 }
 
 // 1.4826 x the median absolute deviation from the median; NaN for an empty sample.
-double robust_sigma(std::vector<double> v) {
+double robust_sigma(std::vector<double> v, double* centre = nullptr) {
+  if (centre) *centre = std::nan("");
   if (v.empty()) return std::nan("");
   const double m = median(v);
+  if (centre) *centre = m;
   for (double& x : v) x = std::fabs(x - m);
   return kMadToSigma * median(std::move(v));
 }
@@ -230,13 +232,20 @@ CovarianceBound invert_information(const Eigen::Matrix3d& info) {
   return b;
 }
 
-Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& F, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Jz) {
-  const Eigen::MatrixXd Pp = F * P * F.transpose() + Q;
-  const Eigen::Index n = Pp.rows();
+namespace {
+template <class M>
+M posterior_step_impl(const M& P, const M& F, const M& Q, const M& Jz) {
+  const M Pp = F * P * F.transpose() + Q;
   // (I + Pp Jz) is invertible for positive semi-definite Pp and Jz (its eigenvalues are 1 + those of
   // Pp^1/2 Jz Pp^1/2 >= 1).
-  Eigen::MatrixXd out = (Eigen::MatrixXd::Identity(n, n) + Pp * Jz).partialPivLu().solve(Pp);
+  const M I = M::Identity(Pp.rows(), Pp.cols());
+  const M out = M(I + Pp * Jz).partialPivLu().solve(Pp);
   return 0.5 * (out + out.transpose());
+}
+}  // namespace
+
+Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& F, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Jz) {
+  return posterior_step_impl<Eigen::MatrixXd>(P, F, Q, Jz);
 }
 
 BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h) {
@@ -345,9 +354,10 @@ std::array<double, kClasses> white_sigmas(const std::vector<FrameWork>& work, co
   }
   std::array<double, kClasses> out;
   for (std::size_t b = 0; b < kClasses; ++b) {
-    out[b] = robust_sigma(res[b]);
     if (counts) (*counts)[b] = res[b].size();
-    if (medians) (*medians)[b] = median(res[b]);
+    double m = 0;
+    out[b] = robust_sigma(std::move(res[b]), &m);
+    if (medians) (*medians)[b] = m;
   }
   return out;
 }
@@ -358,7 +368,7 @@ std::array<double, kClasses> white_sigmas(const std::vector<FrameWork>& work, co
 double line_correlation(const std::vector<FrameWork>& work, const std::array<double, kClasses>& sigma, const std::array<double, kClasses>& medians,
                         double h) {
   double num = 0, den = 0;
-  std::map<int, std::pair<double, int>> groups;
+  std::vector<std::pair<double, int>> groups;  // by marking index
   for (const auto& fw : work) {
     if (!fw.tilt_fitted) continue;
     groups.clear();
@@ -368,11 +378,12 @@ double line_correlation(const std::vector<FrameWork>& work, const std::array<dou
       const Eigen::Vector2d a = tilt_row(q, fw.pose, h);
       const double lev = std::clamp(a.dot(fw.tilt_var * a) / (sigma[c] * sigma[c]), 0.0, 0.9);
       const double med = std::isfinite(medians[c]) ? medians[c] : 0.0;
-      auto& g = groups[q.marking];
+      if (static_cast<std::size_t>(q.marking) >= groups.size()) groups.resize(static_cast<std::size_t>(q.marking) + 1, {0.0, 0});
+      auto& g = groups[static_cast<std::size_t>(q.marking)];
       g.first += ((q.residual - a.dot(fw.tilt)) / std::sqrt(1.0 - lev) - med) / sigma[c];
       ++g.second;
     }
-    for (const auto& [mk, g] : groups) {
+    for (const auto& g : groups) {
       const double n = g.second;
       num += g.first * g.first - n;
       den += n * (n - 1);
@@ -569,9 +580,10 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   // The gate: kGateSigmas of each band's total spread (white and common together, as a false point
   // is judged before any fit); a true point lies beyond it once in 16 000 for Gaussian errors.
   std::array<double, kClasses> total{}, centre{};
+  std::array<std::size_t, kClasses> raw_count{};
   for (std::size_t b = 0; b < kClasses; ++b) {
-    total[b] = std::max(kSigmaFloor, robust_sigma(raw[b]));
-    centre[b] = median(raw[b]);
+    raw_count[b] = raw[b].size();
+    total[b] = std::max(kSigmaFloor, robust_sigma(std::move(raw[b]), &centre[b]));
   }
   std::size_t false_points = 0, spot_points = 0;
   for (auto& fw : work) {
@@ -584,16 +596,15 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     }
   }
 
-  // Pass 2: the per-frame tilt and the white noise, three times (weights from the total spread
-  // first, then from the white sigmas they gave). From the second on, a point is judged against its
+  // Pass 2: the per-frame tilt and the white noise, twice (weights from the total spread first,
+  // then from the white sigmas they gave). The second time, a point is first judged against its
   // own frame's tilt: farther than kGateSigmas white sigmas from its marking once the frame's tilt
   // is taken out, it is not that marking's (a far point can be 30 cm off through the tilt alone, so
   // the first gate must be wide; this one is not).
   std::array<double, kClasses> sigma = total;
   std::array<std::size_t, kClasses> counts{};
   std::array<double, kClasses> medians{};
-  for (int it = 0; it < 3; ++it) {
-    fit_tilts(work, sigma, h);
+  for (int it = 0; it < 2; ++it) {
     if (it > 0)
       for (auto& fw : work)
         for (auto& q : fw.pts) {
@@ -601,7 +612,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
           const double white = q.residual - tilt_row(q, fw.pose, h).dot(fw.tilt);
           q.inlier = std::fabs(white) <= kGateSigmas * sigma[static_cast<std::size_t>(q.band)];
         }
-    if (it > 0) fit_tilts(work, sigma, h);
+    fit_tilts(work, sigma, h);
     std::array<double, kClasses> white = white_sigmas(work, sigma, h, &counts, &medians);
     for (std::size_t b = 0; b < kClasses; ++b) {
       // Too few points for a class of its own: the larger of its band's two (the conservative side
@@ -718,23 +729,24 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
 
   // The posterior bound: pose and, with a wheel-scale error, the three scale factors (constant over
   // the run, so their error is carried from frame to frame rather than drawn anew).
-  const bool scales = setup.scale_sigma > 0;
-  const int n = scales ? 6 : 3;
+  // Always six states: without a scale error their variance is 0 and they change nothing.
+  constexpr bool scales = true;
+  using M6 = Eigen::Matrix<double, 6, 6>;
   const double fx = 2.0 * field.half_floor_x(), fy = 2.0 * field.half_floor_y();
   // Without the start pose, and after a kidnap, the localizer knows only that the robot is on the
   // floor: a prior with the variance of a uniform position on it and a uniform heading.
   const Eigen::Vector3d uniform(fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0);
-  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
+  M6 P = M6::Zero();
   if (!setup.start_pose_given) P.topLeftCorner<3, 3>() = uniform.asDiagonal();
   if (scales) P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
   Series post;
   std::size_t reset_at = 0;
   std::vector<double> resets = setup.resets;
   std::sort(resets.begin(), resets.end());
-  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(n, n), Q = Eigen::MatrixXd::Zero(n, n), Jz = Eigen::MatrixXd::Zero(n, n);
+  M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
   // The motion model x_b = x_a (+) (s * u) at the true poses and the true increment u: its Jacobian
   // F and the odometry's noise Q over the increment.
-  const auto motion = [&](const Pose2& a, const Pose2& to, Eigen::MatrixXd& Fm, Eigen::MatrixXd& Qm) {
+  const auto motion = [&](const Pose2& a, const Pose2& to, M6& Fm, M6& Qm) {
     Fm.setIdentity();
     Qm.setZero();
     const Pose2 u = a.between(to);
@@ -774,10 +786,10 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     }
     Jz.setZero();
     Jz.topLeftCorner<3, 3>() = info[k];
-    P = posterior_step(P, F, Q, Jz);
+    P = posterior_step_impl<M6>(P, F, Q, Jz);
     // The recursion runs on the poses the images were exposed at; the pose scored is the frame's,
     // the latency later: carried forward through the odometry over it (its noise included).
-    Eigen::MatrixXd Pf = P;
+    M6 Pf = P;
     if (setup.latency_s > 0) {
       motion(poses[k], frames[k].truth, F, Q);
       Pf = F * P * F.transpose() + Q;
@@ -855,7 +867,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     band_pts.push_back(counts[i]);
     grazing_pts.push_back(counts[g]);
     band_med.push_back(counts[i] ? num_or_null(medians[i]) : Json(nullptr));
-    band_total.push_back(raw[i].empty() ? Json(nullptr) : num_or_null(total[i]));
+    band_total.push_back(raw_count[i] ? num_or_null(total[i]) : Json(nullptr));
   }
   b["noise"] = {{"bands_m", bands},
                 {"measured_sigma_m", measured},
