@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 
@@ -65,7 +66,6 @@ int band_of(double r) {
   return b;
 }
 
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 Json num_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
@@ -261,14 +261,16 @@ BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Po
 namespace {
 
 // A frame's line point matched at the exposure pose.
+// Kept small (64 bytes): the noise passes stream through every point of the run several times.
 struct PointRes {
-  int band = 0;
   double residual = 0.0;
-  Eigen::Vector2d normal, world, robot;
-  int marking = -1;
+  Eigen::Vector3d h = Eigen::Vector3d::Zero();  // d(residual)/d(x, y, theta): (normal, lever)
   Eigen::Vector2d a = Eigen::Vector2d::Zero();  // d(residual)/d(tilt)
-  bool near = false;    // within the wide first gate
-  bool inlier = false;  // and within its frame's gate once the tilt is out
+  float offset = 0.0f;  // normal . world point: which of parallel lines it lies on
+  std::int16_t marking = -1;
+  std::uint8_t band = 0;  // range band and incidence class
+  bool near = false;      // within the wide first gate
+  bool inlier = false;    // and within its frame's gate once the tilt is out
 };
 
 struct FrameWork {
@@ -402,8 +404,9 @@ std::string singular_reason(const FrameWork& fw) {
       first = &q;
       continue;
     }
-    parallel = parallel && std::fabs(cross2(first->normal, q.normal)) < 1e-6;
-    collinear = collinear && std::fabs(first->normal.dot(q.world - first->world)) < 0.05;
+    const double c = first->h.x() * q.h.y() - first->h.y() * q.h.x(), d = first->h.x() * q.h.x() + first->h.y() * q.h.y();
+    parallel = parallel && std::fabs(c) < 1e-6;
+    collinear = collinear && std::fabs((d < 0 ? -q.offset : q.offset) - first->offset) < 0.05f;
   }
   if (first && parallel) return collinear ? "points on one line" : "points on parallel lines";
   return "ill-conditioned";
@@ -566,12 +569,12 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
       PointRes q;
       const double r = p.norm();
       const bool grazing = r > 0 && std::fabs(m.normal.dot(fw.pose.rotation() * p) / r) < kGrazing;
-      q.band = band_of(r) + (grazing ? static_cast<int>(kBands) : 0);
+      q.band = static_cast<std::uint8_t>(band_of(r) + (grazing ? static_cast<int>(kBands) : 0));
       q.residual = m.residual;
-      q.normal = m.normal;
-      q.world = w;
-      q.robot = p;
-      q.marking = m.marking;
+      const Eigen::Vector2d lever = w - fw.pose.translation();
+      q.h = Eigen::Vector3d(m.normal.x(), m.normal.y(), lever.x() * m.normal.y() - lever.y() * m.normal.x());
+      q.offset = static_cast<float>(m.normal.dot(w));
+      q.marking = static_cast<std::int16_t>(m.marking);
       q.a = tilt_jacobian(p, h).transpose() * (rot.transpose() * m.normal);
       raw[static_cast<std::size_t>(q.band)].push_back(q.residual);
       fw.pts.push_back(q);
@@ -682,8 +685,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
       if (!q.inlier) continue;
       const double s = sigma[static_cast<std::size_t>(q.band)];
       BoundRow row;  // bound_row's, from what the match already computed
-      const Eigen::Vector2d d = q.world - fw.pose.translation();
-      row.h = Eigen::Vector3d(q.normal.x(), q.normal.y(), d.x() * q.normal.y() - d.y() * q.normal.x());
+      row.h = q.h;
       row.var = (1.0 - line_corr) * s * s;
       row.a = q.a;
       row.e = q.residual;
