@@ -270,10 +270,12 @@ std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, boo
   if (const auto nv = g.no_value.find("r0/position_m/rmse"); nv != g.no_value.end() && ci != "no estimate")
     ci += " (no estimate in " + std::to_string(nv->second) + " of " + std::to_string(g.finished) + " runs)";
   const std::string label = group_label(g, mark_given) + (phased ? " *" : "");
-  // The limit over all frames (summary.json efficiency: the posterior bound when the run has
-  // odometry) and the RMSE's multiple of it, over the same frames; "-" where no run has one.
+  // The limit (summary.json efficiency: the posterior bound when the run has odometry) and the
+  // RMSE's multiple of it, over the same frames (the tracking phase's where the runs have one, as
+  // the error columns); "-" where no run has one.
   const auto whole = [&](const std::string& k, const char* format, double scale) {
-    const auto it = ivs.find("r0/" + k);
+    const std::string key = phased ? "r0/" + k.substr(0, k.find('/')) + "/tracking_phase" + k.substr(k.find('/')) : "r0/" + k;
+    const auto it = ivs.find(key);
     if (it == ivs.end() || it->second.n == 0) return std::string("-");
     char b[32];
     std::snprintf(b, sizeof b, format, it->second.mean * scale);
@@ -353,7 +355,7 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
     any_phased = any_phased || phased;
   }
   if (any_phased) out.table += "* runs with kidnaps or covers: errors of the tracking phase (summary.json tracking_phase); RMSE over all frames\n";
-  out.table += "limit: the Cramer-Rao bound's position RMS over the frames with an estimate; x limit: RMSE / limit over them (docs/results.md)\n";
+  out.table += "limit: the Cramer-Rao bound's position RMS (cm) over the frames with an estimate; x limit: RMSE / limit over them (docs/results.md)\n";
   if (out.missing > 0) {
     // Not final: files a different state of this folder left (a sweep since extended, runs deleted)
     // would pass for this one's result.

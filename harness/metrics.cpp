@@ -260,7 +260,9 @@ Json rpe_json(const RobotRecord& robot, const std::vector<double>& moves) {
       const FrameRecord& b = f[i + step];
       if (!a.valid || !b.valid) continue;
       bool moved = false;
-      for (double tm : moves) moved = moved || (tm > a.t && tm <= b.t + 1e-12);
+      // The simulation applies an event at the first physics step at or after its time: one at a
+      // frame's own time moves the robot after that frame.
+      for (double tm : moves) moved = moved || (tm >= a.t - 1e-9 && tm < b.t - 1e-9);
       if (moved) continue;
       const Pose2 e = a.truth.between(b.truth).inverse().compose(a.est.between(b.est));
       st += e.x * e.x + e.y * e.y;

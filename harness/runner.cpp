@@ -216,7 +216,10 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
     dir.write("gt" + suffix + ".tum", truth_tum(rec));
     RobotScore score = score_robot(rec, sc.events, sc.duration, sc.scoring);
     // The limit beside the score (harness/scoring/bound.hpp).
-    RobotBound rb = bound_robot(rec, bound_setup(sc, rec.id, start_pose_given));
+    BoundSetup bs = bound_setup(sc, rec.id, start_pose_given);
+    if (score.json.contains("tracking_phase"))
+      for (const auto& iv : score.json["tracking_phase"]["excluded"]) bs.excluded.emplace_back(iv[0].get<double>(), iv[1].get<double>());
+    RobotBound rb = bound_robot(rec, bs);
     score.json["bound"] = std::move(rb.bound);
     score.json["efficiency"] = std::move(rb.efficiency);
     score.json["efficiency_single_frame"] = std::move(rb.efficiency_single);

@@ -260,6 +260,11 @@ BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Po
 
 namespace {
 
+// Whether a move without odometry (teleport, kidnap) at time `tm` falls between the frames at `ta`
+// and `tb`: the simulation applies an event at the first physics step at or after its time, so an
+// event at a frame's own time moves the robot after that frame.
+bool moved_between(double tm, double ta, double tb) { return tm >= ta - 1e-9 && tm < tb - 1e-9; }
+
 // A frame's line point matched at the exposure pose.
 // Kept small (64 bytes): the noise passes stream through every point of the run several times.
 struct PointRes {
@@ -300,10 +305,12 @@ std::vector<Pose2> exposure_poses(const RobotRecord& robot, const BoundSetup& se
     while (j > 0 && f[j].t > te + 1e-12) --j;
     if (f[j].t > te + 1e-12) continue;
     const std::size_t j1 = std::min(j + 1, k);
-    bool reset = false;
-    for (double tr : setup.resets) reset = reset || (tr > f[j].t && tr <= f[j1].t + 1e-12);
-    if (j1 == j || reset) {
-      out[k] = reset ? (te < f[j1].t ? f[j].truth : f[j1].truth) : f[j].truth;
+    std::optional<double> moved;
+    for (double tr : setup.resets)
+      if (moved_between(tr, f[j].t, f[j1].t)) moved = tr;
+    if (j1 == j || moved) {
+      // Across a move without odometry: the pose on the side of it the exposure lies.
+      out[k] = moved && te > *moved + 1e-9 ? f[j1].truth : f[j].truth;
       continue;
     }
     const double u = (te - f[j].t) / (f[j1].t - f[j].t);
@@ -433,11 +440,17 @@ Json series_json(const Series& s, std::size_t scored) {
 }  // namespace
 
 Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<double>>& pos_bound,
-                     const std::vector<std::optional<double>>& heading_bound, const std::string& against, const std::vector<Pose2>* exposure) {
+                     const std::vector<std::optional<double>>& heading_bound, const std::string& against, const std::vector<Pose2>* exposure,
+                     const std::vector<std::pair<double, double>>* excluded) {
   double se = 0, sb = 0, sth = 0, sbth = 0, sx = 0;
-  std::size_t n = 0;
+  std::size_t n = 0, scored = 0;
   for (std::size_t k = 0; k < robot.frames.size(); ++k) {
     const FrameRecord& r = robot.frames[k];
+    bool out = false;
+    if (excluded)
+      for (const auto& [a, b] : *excluded) out = out || (r.t >= a && r.t < b);
+    if (out) continue;
+    ++scored;
     if (!r.valid || !pos_bound[k] || !heading_bound[k]) continue;
     const double ex = r.est.x - r.truth.x, ey = r.est.y - r.truth.y, eth = angle_diff(r.est.theta, r.truth.theta);
     se += ex * ex + ey * ey;
@@ -447,7 +460,6 @@ Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<d
     if (exposure) sx += std::pow(r.est.x - (*exposure)[k].x, 2) + std::pow(r.est.y - (*exposure)[k].y, 2);
     ++n;
   }
-  const std::size_t scored = robot.frames.size();
   Json j{{"against", against}, {"frames", n}, {"share", scored ? Json(static_cast<double>(n) / static_cast<double>(scored)) : Json(nullptr)}};
   if (n == 0) {
     j["position"] = nullptr;
@@ -773,8 +785,8 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     F.setIdentity();
     Q.setZero();
     bool reset = false;
-    while (reset_at < resets.size() && k > 0 && resets[reset_at] <= frames[k].t + 1e-12) {
-      reset = reset || resets[reset_at] > frames[k - 1].t;
+    while (reset_at < resets.size() && k > 0 && resets[reset_at] < frames[k].t - 1e-9) {
+      reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
       ++reset_at;
     }
     if (reset) {
@@ -812,7 +824,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     const FrameRecord& r = frames[k];
     odometry = odometry || r.odometry.x != 0 || r.odometry.y != 0 || r.odometry.theta != 0;
     bool reset = false;
-    for (double tr : resets) reset = reset || (tr > frames[k - 1].t && tr <= r.t + 1e-12);
+    for (double tr : resets) reset = reset || moved_between(tr, frames[k - 1].t, r.t);
     if (reset) continue;
     const Pose2 u = frames[k - 1].truth.between(r.truth);
     ox.push_back(r.odometry.x - u.x);
@@ -924,6 +936,13 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   const std::vector<Pose2>* exp = setup.latency_s > 0 ? &poses : nullptr;
   out.efficiency_single = efficiency_json(robot, sp, sh, "single_frame", exp);
   out.efficiency = odometry ? efficiency_json(robot, pp, ph, "posterior", exp) : out.efficiency_single;
+  if (!setup.excluded.empty()) {
+    // After a kidnap the posterior bound starts from a prior as wide as the floor: a bound on the
+    // average over where the robot may be put, which one run's error (the distance it was carried)
+    // can lie below while the robot is blind. Tracking is judged without those intervals.
+    out.efficiency_single["tracking_phase"] = efficiency_json(robot, sp, sh, "single_frame", exp, &setup.excluded);
+    out.efficiency["tracking_phase"] = efficiency_json(robot, odometry ? pp : sp, odometry ? ph : sh, odometry ? "posterior" : "single_frame", exp, &setup.excluded);
+  }
   return out;
 }
 

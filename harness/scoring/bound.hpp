@@ -26,6 +26,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -110,6 +111,9 @@ struct BoundSetup {
   double heading_sigma = 0.0;      ///< declared white noise of the compass, radians
   bool start_pose_given = false;   ///< the localizer was reset with the true start pose
   std::vector<double> resets;      ///< times this robot was kidnapped: the posterior starts again
+  /// With kidnaps or covers, the intervals (seconds) scoring leaves out of the tracking phase
+  /// (summary.json tracking_phase.excluded): the efficiency is also given without them.
+  std::vector<std::pair<double, double>> excluded;
 };
 
 /// The bound of one frame; empty where none is finite.
@@ -133,6 +137,6 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup);
 /// images were exposed at (with camera latency), for rmse_at_exposure_m beside.
 Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<double>>& pos_bound,
                      const std::vector<std::optional<double>>& heading_bound, const std::string& against,
-                     const std::vector<Pose2>* exposure = nullptr);
+                     const std::vector<Pose2>* exposure = nullptr, const std::vector<std::pair<double, double>>* excluded = nullptr);
 
 }  // namespace omniloc::harness
