@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "core/angles.hpp"
+#include "harness/metrics.hpp"
 #include "harness/scoring/bound.hpp"
 
 using namespace omniloc;
@@ -315,4 +316,30 @@ TEST(Bound, PosteriorEqualsKalmanCovariance) {
     }
     EXPECT_LT((P - Pk).cwiseAbs().maxCoeff(), 1e-12) << "step " << k;
   }
+}
+
+// RPE over one frame (TUM / evo, no alignment): one estimate 3 cm off sideways spoils the two pairs
+// it belongs to by exactly 3 cm each; over one second there is no pair in half a second of frames
+// (null, never 0); a pair across a teleport is left out.
+TEST(Rpe, OneFrameJitterAndNullWithoutPairs) {
+  RobotRecord rec;
+  for (int k = 0; k < 5; ++k) {
+    FrameRecord r;
+    r.t = 0.1 * k;
+    r.truth = Pose2(0.1 * k, 0.0, 0.0);
+    r.est = r.truth;
+    if (k == 2) r.est.y += 0.03;
+    r.valid = true;
+    rec.frames.push_back(r);
+  }
+  const Json j = rpe_json(rec, {});
+  EXPECT_EQ(j["frame"]["pairs"], 4);
+  EXPECT_NEAR(j["frame"]["translation_rms_m"].get<double>(), 0.03 / std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(j["frame"]["rotation_rms_rad"].get<double>(), 0.0, 1e-12);
+  EXPECT_EQ(j["1s"]["pairs"], 0);
+  EXPECT_TRUE(j["1s"]["translation_rms_m"].is_null());
+  // A teleport at the frame of t = 0.1 s moves the robot after that frame: the pair (0.1, 0.2) goes.
+  const Json m = rpe_json(rec, {0.1});
+  EXPECT_EQ(m["frame"]["pairs"], 3);
+  EXPECT_NEAR(m["frame"]["translation_rms_m"].get<double>(), 0.03 / std::sqrt(3.0), 1e-12);
 }
