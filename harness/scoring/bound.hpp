@@ -22,7 +22,8 @@
 // Assumptions: known association, the measured noise is Gaussian and is the truth, unbiased
 // estimators. A real localizer may legitimately differ: it does not know the association (the bound
 // is then optimistic), a biased estimator (a prior, a robust cost that shrinks) can go below it, and
-// the run's noise estimate has sampling error.
+// the run's noise estimate has sampling error. Blobs (coloured goals, landmarks) are not in the
+// bound: a localizer that uses their bearings is not bounded by it.
 #include <array>
 #include <optional>
 #include <string>
