@@ -819,10 +819,11 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   // (the physics' wheel slip is not in the declared model and shows here).
   std::vector<double> ox, oy, ot;
   double px = 0, pt = 0;
-  bool odometry = false;
+  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
+  // the frames carry odometry at all, which the setup says.
+  const bool odometry = setup.has_odometry;
   for (std::size_t k = 1; k < nf; ++k) {
     const FrameRecord& r = frames[k];
-    odometry = odometry || r.odometry.x != 0 || r.odometry.y != 0 || r.odometry.theta != 0;
     bool reset = false;
     for (double tr : resets) reset = reset || moved_between(tr, frames[k - 1].t, r.t);
     if (reset) continue;

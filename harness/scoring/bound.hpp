@@ -111,6 +111,9 @@ struct BoundSetup {
   bool has_heading_sensor = false;
   double heading_sigma = 0.0;      ///< declared white noise of the compass, radians
   bool start_pose_given = false;   ///< the localizer was reset with the true start pose
+  /// Frames carry odometry (simulated robots and recordings of them always do): the efficiency is
+  /// then against the posterior bound, else against the single-frame one.
+  bool has_odometry = true;
   std::vector<double> resets;      ///< times this robot was kidnapped: the posterior starts again
   /// With kidnaps or covers, the intervals (seconds) scoring leaves out of the tracking phase
   /// (summary.json tracking_phase.excluded): the efficiency is also given without them.
