@@ -34,7 +34,8 @@ double t975(std::size_t df) {
 // of frames answered, of kidnaps recovered.
 bool is_fraction(const std::string& metric) {
   const auto ends = [&](const std::string& tail) { return metric.size() >= tail.size() && metric.compare(metric.size() - tail.size(), tail.size(), tail) == 0; };
-  return metric.find("/recall/") != std::string::npos || metric.rfind("recall/", 0) == 0 || ends("valid_fraction") || ends("recovered_fraction");
+  return metric.find("/recall/") != std::string::npos || metric.rfind("recall/", 0) == 0 || ends("valid_fraction") || ends("recovered_fraction") ||
+         ends("/share");
 }
 
 // A run's metrics: its numbers by path ("r0/position_m/rmse"), and the paths whose value is null (a
@@ -269,10 +270,22 @@ std::string table_line(const Group& g, std::map<std::string, Interval>& ivs, boo
   if (const auto nv = g.no_value.find("r0/position_m/rmse"); nv != g.no_value.end() && ci != "no estimate")
     ci += " (no estimate in " + std::to_string(nv->second) + " of " + std::to_string(g.finished) + " runs)";
   const std::string label = group_label(g, mark_given) + (phased ? " *" : "");
+  // The limit (summary.json efficiency: the posterior bound when the run has odometry) and the
+  // RMSE's multiple of it, over the same frames (the tracking phase's where the runs have one, as
+  // the error columns); "-" where no run has one.
+  const auto whole = [&](const std::string& k, const char* format, double scale) {
+    const std::string key = phased ? "r0/" + k.substr(0, k.find('/')) + "/tracking_phase" + k.substr(k.find('/')) : "r0/" + k;
+    const auto it = ivs.find(key);
+    if (it == ivs.end() || it->second.n == 0) return std::string("-");
+    char b[32];
+    std::snprintf(b, sizeof b, format, it->second.mean * scale);
+    return std::string(b);
+  };
   char line[640];
-  std::snprintf(line, sizeof line, " %4zu %4zu | %8s %8s | %9s %9s %9s | %s\n", g.finished, g.failed,
+  std::snprintf(line, sizeof line, " %4zu %4zu | %8s %8s | %9s %9s %9s | %8s %7s | %s\n", g.finished, g.failed,
                 g.recall_key.empty() ? "-" : cell("recall/" + g.recall_key, "%.1f%%", 100.0).c_str(), cell("valid_fraction", "%.1f%%", 100.0).c_str(),
-                cell("x_cm/mean", "%.3f", 1.0).c_str(), cell("y_cm/mean", "%.3f", 1.0).c_str(), cell("theta_rad/mean", "%.4f", 1.0).c_str(), ci.c_str());
+                cell("x_cm/mean", "%.3f", 1.0).c_str(), cell("y_cm/mean", "%.3f", 1.0).c_str(), cell("theta_rad/mean", "%.4f", 1.0).c_str(),
+                whole("efficiency/bound_rms_m", "%.3f", 100.0).c_str(), whole("efficiency/position", "%.2fx", 1.0).c_str(), ci.c_str());
   return label + std::string(static_cast<std::size_t>(std::max(0, width - static_cast<int>(label.size()))), ' ') + line;
 }
 
@@ -305,8 +318,8 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
   for (const auto& g : census.groups) width = std::max(width, static_cast<int>(group_label(g, mark_given).size()) + 2);
   char line[640];
   const std::string within = "in " + recall_header(census);
-  std::snprintf(line, sizeof line, "%-*s %4s %4s | %8s %8s | %9s %9s %9s | %-26s\n", width, "scenario / localizer / params", "ok", "fail",
-                within.c_str(), "answered", "mean x cm", "mean y cm", "mean th", "position RMSE m (t95 for n>=5, else seeds' range)");
+  std::snprintf(line, sizeof line, "%-*s %4s %4s | %8s %8s | %9s %9s %9s | %8s %7s | %-26s\n", width, "scenario / localizer / params", "ok", "fail",
+                within.c_str(), "answered", "mean x cm", "mean y cm", "mean th", "limit cm", "x limit", "position RMSE m (t95 for n>=5, else seeds' range)");
   out.table = line;
   for (const auto& g : census.groups) {
     const std::string given = group_given(g);
@@ -342,6 +355,7 @@ void write_aggregate_files(const SweepSpec& spec, const fs::path& dir, const Cen
     any_phased = any_phased || phased;
   }
   if (any_phased) out.table += "* runs with kidnaps or covers: errors of the tracking phase (summary.json tracking_phase); RMSE over all frames\n";
+  out.table += "limit: the Cramer-Rao bound's position RMS (cm) over the frames with an estimate; x limit: RMSE / limit over them (docs/results.md)\n";
   if (out.missing > 0) {
     // Not final: files a different state of this folder left (a sweep since extended, runs deleted)
     // would pass for this one's result.

@@ -2,7 +2,8 @@
 // of the paper's tracking path (60 s, 1801 frames) with `matching` (reading and checking
 // frames.jsonl.gz, the localizer, scoring and writing the run folder; target: 20,000 frames/s on one
 // core), of reading the recording alone, of the localizer alone on frames already in memory, and of
-// a live run and a recording of the same stretch, for the ratios in one process.
+// a live run and a recording of the same stretch, for the ratios in one process; and of the accuracy
+// bound scoring adds to a replay.
 // Run with LP_NUM_THREADS=1 so llvmpipe rendering stays on one core.
 #include <benchmark/benchmark.h>
 
@@ -17,6 +18,8 @@
 #include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
+#include "harness/scoring/bound.hpp"
+#include "sim/render/camera_config.hpp"
 #include "core/install_paths.hpp"
 
 using namespace omniloc;
@@ -114,3 +117,50 @@ static void BM_RecordTracking10s(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(harness::record_scenario(sc, o));
 }
 BENCHMARK(BM_RecordTracking10s)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// The accuracy bound (harness/scoring/bound.hpp) alone on the same 1801 frames, as scoring computes
+// it after a replay: its cost beside BM_ReplayTrackingMatching's (it must stay under 5 % of it).
+static void BM_BoundOnTrackingFrames(benchmark::State& state) {
+  const std::string dir = recording();
+  const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
+  const harness::Scenario sc = harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer"));
+  harness::RobotRecord rec;
+  {
+    harness::RecordingSource source(harness::RecordingHeader::read(dir));
+    while (auto f = source.next()) {
+      const harness::RobotFrame& rf = f->robots.at(0);
+      harness::FrameRecord r;
+      r.t = rf.obs.t;
+      r.truth = rf.truth.value_or(Pose2());
+      r.est = r.truth;
+      r.valid = true;
+      r.camera_ok = rf.obs.camera_ok;
+      for (const auto& p : rf.obs.line_points) r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
+      r.odometry = rf.odometry.delta;
+      r.heading = rf.heading;
+      rec.frames.push_back(std::move(r));
+    }
+  }
+  const sim::CameraConfig cam = sim::CameraConfig::from_json(sc.camera, "/camera");
+  harness::BoundSetup setup;
+  setup.field = &sc.field;
+  setup.mount_height = cam.mount_height;
+  setup.latency_s = cam.latency;
+  setup.vibration_std = cam.vibration_std;
+  setup.physics_dt = 1.0 / sc.physics_rate;
+  const harness::RobotConfig& rc = sc.robots.at(0);
+  setup.trans_sigma = rc.odometry.trans_sigma;
+  setup.rot_sigma = rc.odometry.rot_sigma;
+  setup.rot_per_trans = rc.odometry.rot_per_trans;
+  setup.scale_sigma = rc.odometry.scale_sigma;
+  setup.has_heading_sensor = rc.has_heading_sensor;
+  setup.heading_sigma = rc.heading.noise_sigma;
+  setup.start_pose_given = true;
+  double n = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(harness::bound_robot(rec, setup));
+    n += static_cast<double>(rec.frames.size());
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_BoundOnTrackingFrames)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();

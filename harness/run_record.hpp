@@ -2,6 +2,7 @@
 // What a run records per camera frame of each localized robot: the truth (for scoring only), the
 // localizer's answer, the vision statistics and the wall-clock stage times. The scoring
 // (harness/scoring/metrics) and the result files (harness/run_writer) are computed from these records alone.
+#include <array>
 #include <cstddef>
 #include <map>
 #include <optional>
@@ -26,6 +27,11 @@ struct FrameRecord {
   std::map<std::string, double> extra;  ///< localizer extras and the camera settings (frames.csv columns)
   double render_ms = 0.0, vision_ms = 0.0, localize_ms = 0.0;  ///< wall time: timing.csv only
   std::optional<double> compute_ms;  ///< an external client's own time for the frame (ms): timing.csv only
+  // What the accuracy bound (harness/scoring/bound.hpp) needs of the frame, as the localizer got it:
+  // scoring only. Floats: a micrometre at 10 m, half the memory of a run's points.
+  std::vector<std::array<float, 2>> line_points;  ///< robot frame, metres
+  Pose2 odometry;                 ///< increment since the previous frame, robot frame of that frame
+  std::optional<double> heading;  ///< compass / MTi reading, world frame (none without one)
 };
 
 struct RobotRecord {

@@ -22,16 +22,20 @@ std::string tum_line(double t, const Pose2& p) {
   return b;
 }
 
-std::string frames_csv(const std::vector<RobotRecord>& robots) {
-  std::string csv = "t,robot,gt_x,gt_y,gt_theta,est_x,est_y,est_theta,err_x,err_y,err_theta,err_pos,valid,mode,camera_ok,line_points,match_error,contact";
+std::string frames_csv(const std::vector<RobotRecord>& robots, const std::vector<std::vector<FrameBound>>& bounds) {
+  std::string csv =
+      "t,robot,gt_x,gt_y,gt_theta,est_x,est_y,est_theta,err_x,err_y,err_theta,err_pos,valid,mode,camera_ok,line_points,match_error,contact,"
+      "bound_pos_m,bound_heading_rad,pbound_pos_m,pbound_heading_rad";
   std::set<std::string> extra_keys;
   for (const auto& robot : robots)
     for (const auto& r : robot.frames)
       for (const auto& [k, v] : r.extra) extra_keys.insert(k);
   for (const auto& k : extra_keys) csv += "," + k;
   csv += "\n";
-  for (const auto& robot : robots)
-    for (const auto& r : robot.frames) {
+  for (std::size_t i = 0; i < robots.size(); ++i)
+    for (std::size_t k = 0; k < robots[i].frames.size(); ++k) {
+      const RobotRecord& robot = robots[i];
+      const FrameRecord& r = robot.frames[k];
       const double ex = r.est.x - r.truth.x, ey = r.est.y - r.truth.y, eth = angle_diff(r.est.theta, r.truth.theta);
       // Without ground truth (a log not made by omniloc) the truth and error cells stay empty.
       const auto t = [&](double v) { return robot.has_truth ? fmt("%.5f", v) : std::string(); };
@@ -40,6 +44,10 @@ std::string frames_csv(const std::vector<RobotRecord>& robots) {
              "," + t(std::hypot(ex, ey)) + "," +
              (r.valid ? "1" : "0") + "," + (r.mode_label.empty() ? std::string(mode_name(r.mode)) : r.mode_label) + "," + (r.camera_ok ? "1" : "0") + "," + std::to_string(r.points) + "," +
              fmt("%.6g", r.match_error) + "," + (r.contact ? "1" : "0");
+      const FrameBound* b = i < bounds.size() && k < bounds[i].size() ? &bounds[i][k] : nullptr;
+      const auto cell = [](const std::optional<double>& v) { return v ? fmt("%.6g", *v) : std::string(); };
+      csv += "," + (b ? cell(b->pos) : std::string()) + "," + (b ? cell(b->heading) : std::string()) + "," + (b ? cell(b->ppos) : std::string()) +
+             "," + (b ? cell(b->pheading) : std::string());
       for (const auto& k : extra_keys) {
         auto it = r.extra.find(k);
         csv += "," + (it == r.extra.end() ? std::string() : fmt("%.6g", it->second));

@@ -19,7 +19,9 @@
 #include "harness/render_frame.hpp"
 #include "harness/run_directory.hpp"
 #include "harness/run_writer.hpp"
+#include "harness/scoring/bound.hpp"
 #include "harness/simulation.hpp"
+#include "sim/render/camera_config.hpp"
 
 namespace omniloc::harness {
 
@@ -92,11 +94,13 @@ Estimate robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOp
   const double loc_ms = ms_since(t0);
 
   FrameRecord row{t, rf.truth.value_or(Pose2()), est.pose, est.valid, rf.obs.camera_ok, rf.contact, est.mode, est.mode_label,
-                  rf.obs.line_points.size(), est.match_error, est.extra, rf.render_ms, rf.vision_ms, loc_ms, est.compute_ms};
+                  rf.obs.line_points.size(), est.match_error, est.extra, rf.render_ms, rf.vision_ms, loc_ms, est.compute_ms, {}, rf.odometry.delta, rf.heading};
   if (rf.settings) {  // the camera settings the frame was taken with (exposure control, paper 002)
     row.extra["exposure_ms"] = rf.settings->exposure_ms;
     row.extra["gain"] = rf.settings->gain;
   }
+  row.line_points.reserve(rf.obs.line_points.size());
+  for (const auto& p : rf.obs.line_points) row.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
   tr.record.frames.push_back(std::move(row));
   const std::string mode = est.mode_label.empty() ? mode_name(est.mode) : est.mode_label;
   if (mode != tr.last_mode) {
@@ -136,6 +140,33 @@ std::string view_line(const Tracked& tr, const RobotFrame& rf, long long k, cons
   return j.dump() + "\n";
 }
 
+// What the accuracy bound of robot `id` takes from the scenario: the field, the camera's geometry,
+// latency and vibration, the declared odometry and compass noise, and when the robot was moved
+// without odometry (teleport, kidnap: the posterior bound starts again).
+BoundSetup bound_setup(const Scenario& sc, int id, bool start_pose_given) {
+  BoundSetup b;
+  b.field = &sc.field;
+  const sim::CameraConfig cam = sim::CameraConfig::from_json(sc.camera, "/camera");
+  b.mount_height = cam.mount_height;
+  b.latency_s = cam.latency;
+  b.vibration_std = cam.vibration_std;
+  b.tilt_per_accel = cam.tilt_per_accel;
+  b.physics_dt = 1.0 / sc.physics_rate;
+  b.camera_rate = sc.camera_rate;
+  if (const RobotConfig* rc = sc.robot(id)) {
+    b.trans_sigma = rc->odometry.trans_sigma;
+    b.rot_sigma = rc->odometry.rot_sigma;
+    b.rot_per_trans = rc->odometry.rot_per_trans;
+    b.scale_sigma = rc->odometry.scale_sigma;
+    b.has_heading_sensor = rc->has_heading_sensor;
+    b.heading_sigma = rc->heading.noise_sigma;
+  }
+  b.start_pose_given = start_pose_given;
+  for (const auto& e : sc.events)
+    if (e.robot == id && (e.as<Kidnap>() || e.as<Teleport>())) b.resets.push_back(e.t);
+  return b;
+}
+
 // Scores every robot and writes the result files; the table rows go to `result`.
 // `localizer`: the name results carry; `external`: an external client's provenance (else null);
 // `start_pose_given`: whether the localizer was reset with the true start pose.
@@ -165,6 +196,7 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   // replay, the recording the frames came from.
   for (auto it = provenance.begin(); it != provenance.end(); ++it) summary["omniloc"][it.key()] = it.value();
   std::vector<TableRow> rows;
+  std::vector<std::vector<FrameBound>> bounds(records.size());
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RobotRecord& rec = records[i];
     const std::string suffix = i == 0 ? "" : "_r" + std::to_string(rec.id);
@@ -183,6 +215,15 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
     }
     dir.write("gt" + suffix + ".tum", truth_tum(rec));
     RobotScore score = score_robot(rec, sc.events, sc.duration, sc.scoring);
+    // The limit beside the score (harness/scoring/bound.hpp).
+    BoundSetup bs = bound_setup(sc, rec.id, start_pose_given);
+    if (score.json.contains("tracking_phase"))
+      for (const auto& iv : score.json["tracking_phase"]["excluded"]) bs.excluded.emplace_back(iv[0].get<double>(), iv[1].get<double>());
+    RobotBound rb = bound_robot(rec, bs);
+    score.json["bound"] = std::move(rb.bound);
+    score.json["efficiency"] = std::move(rb.efficiency);
+    score.json["efficiency_single_frame"] = std::move(rb.efficiency_single);
+    bounds[i] = std::move(rb.frames);
     result.robots.push_back({rec.id, score.all, rec.frames.size(), score.all.frames});
     summary["robots"].push_back(score.json);
     const std::string label = sc.name + " r" + std::to_string(rec.id) + " " + localizer;
@@ -193,7 +234,7 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
       rows.push_back(score.tracking_row);
     }
   }
-  dir.write("frames.csv", frames_csv(records));
+  dir.write("frames.csv", frames_csv(records, bounds));
   dir.write("timing.csv", timing_csv(records));
   dir.write("events.jsonl", log.text());
   dir.write("summary.json", summary.dump(2) + "\n");

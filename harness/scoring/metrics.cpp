@@ -180,6 +180,38 @@ void add_first_fix(const RobotRecord& robot, const Scoring& scoring, Json& rj) {
 
 }  // namespace
 
+Json rpe_json(const RobotRecord& robot, const std::vector<double>& moves) {
+  const auto& f = robot.frames;
+  // The frame period from the records (the camera rate), so that "one second" is a whole number of frames.
+  std::vector<double> dts;
+  for (std::size_t k = 1; k < f.size(); ++k) dts.push_back(f[k].t - f[k - 1].t);
+  const double period = dts.empty() ? 0.0 : percentile(dts, 50);
+  const auto block = [&](std::size_t step) {
+    double st = 0, sr = 0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; step > 0 && i + step < f.size(); ++i) {
+      const FrameRecord& a = f[i];
+      const FrameRecord& b = f[i + step];
+      if (!a.valid || !b.valid) continue;
+      bool moved = false;
+      // The simulation applies an event at the first physics step at or after its time: one at a
+      // frame's own time moves the robot after that frame.
+      for (double tm : moves) moved = moved || (tm >= a.t - 1e-9 && tm < b.t - 1e-9);
+      if (moved) continue;
+      const Pose2 e = a.truth.between(b.truth).inverse().compose(a.est.between(b.est));
+      st += e.x * e.x + e.y * e.y;
+      sr += e.theta * e.theta;
+      ++n;
+    }
+    const double N = static_cast<double>(n);
+    return Json{{"translation_rms_m", n ? Json(std::sqrt(st / N)) : Json(nullptr)},
+                {"rotation_rms_rad", n ? Json(std::sqrt(sr / N)) : Json(nullptr)},
+                {"pairs", n}};
+  };
+  const std::size_t second = period > 0 ? static_cast<std::size_t>(std::lround(1.0 / period)) : 0;
+  return Json{{"frame", block(1)}, {"1s", block(second)}};
+}
+
 RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& events, double duration, const Scoring& scoring) {
   RobotScore score;
   std::vector<FrameError> errors;
@@ -197,6 +229,10 @@ RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& event
   add_coverage(errors, robot.frames.size(), scoring, rj, score.all_row);
   add_first_fix(robot, scoring, rj);
   add_frame_statistics(robot, rj);
+  std::vector<double> moves;
+  for (const auto& e : events)
+    if (e.robot == robot.id && (e.as<Kidnap>() || e.as<Teleport>())) moves.push_back(e.t);
+  rj["rpe"] = rpe_json(robot, moves);
   const auto kidnaps = episodes(events, robot.id, duration, [](const Event& e) { return e.as<Kidnap>() != nullptr; });
   if (!kidnaps.empty()) rj["recovery"] = recovery_json(scored, kidnaps);
   // With kidnaps or covers, the papers' tables describe only the tracking phase: the frames before

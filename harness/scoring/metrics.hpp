@@ -74,5 +74,11 @@ struct RobotScore {
 /// `events`: the scenario's, in time order; `duration`: the run's, seconds.
 RobotScore score_robot(const RobotRecord& robot, const std::vector<Event>& events, double duration, const Scoring& scoring = {});
 
+/// Relative pose error (the TUM / evo RPE, no alignment: the field frame is known) over one frame
+/// and over one second: for each pair of frames (i, j) with both estimates valid, E = (T_i^-1 T_j)^-1
+/// (P_i^-1 P_j); translation and rotation RMS of E over the pairs. Pairs across a move without
+/// odometry (`moves`: teleport and kidnap times) are left out. Null statistics over no pair.
+Json rpe_json(const RobotRecord& robot, const std::vector<double>& moves);
+
 
 }  // namespace omniloc::harness

@@ -1,0 +1,950 @@
+#include "harness/scoring/bound.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "core/angles.hpp"
+
+namespace omniloc::harness {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// 1.4826 x MAD is the standard deviation of a Gaussian sample, robust to up to half outliers.
+constexpr double kMadToSigma = 1.4826;
+// A band's sigma is never taken below 0.1 mm: a noiseless profile would otherwise give infinite
+// information (the line points still carry the image's sub-pixel sampling, far above this).
+constexpr double kSigmaFloor = 1e-4;
+// A compass declared perfect still gets a finite (tiny) variance, so the matrices stay invertible.
+constexpr double kCompassFloor = 1e-5;
+// A tilt is fitted to a frame only from this many points or more (two unknowns; fewer points leave
+// the fit's own noise larger than the vibration it is meant to measure).
+constexpr std::size_t kMinTiltPoints = 8;
+// A line point is the middle of the white run along its scan ray (localization/vision/scan_lines.cpp),
+// so its error lies along the ray. A ray that meets the line at a grazing angle (the line's normal
+// within 17.5 degrees of square to the ray, |n.u| < 0.3) runs over more than three line widths of
+// white whose ends are the line's blurred edges smeared along the ray: its point is several times
+// worse (on the tracking path 5-13 cm against 1.5-2.4 cm). Each range band has a sigma for the
+// points it crosses and one for the grazing ones: kClasses = 2 x 5.
+constexpr double kGrazing = 0.3;
+constexpr std::size_t kBands = kBoundBands.size();
+constexpr std::size_t kClasses = 2 * kBands;
+// A class measured from fewer points takes its band's pooled figure.
+constexpr std::size_t kMinClassPoints = 30;
+
+// By value: callers that no longer need their sample move it in (nth_element reorders it).
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  const std::size_t n = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n), v.end());
+  const double hi = v[n];
+  if (v.size() % 2) return hi;
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)));
+}
+
+// 1.4826 x the median absolute deviation from the median; NaN for an empty sample.
+double robust_sigma(std::vector<double> v, double* centre = nullptr) {
+  if (centre) *centre = std::nan("");
+  if (v.empty()) return std::nan("");
+  const double m = median(v);
+  if (centre) *centre = m;
+  for (double& x : v) x = std::fabs(x - m);
+  return kMadToSigma * median(std::move(v));
+}
+
+int band_of(double r) {
+  int b = 0;
+  for (std::size_t i = 1; i < kBoundBands.size(); ++i)
+    if (r >= kBoundBands[i]) b = static_cast<int>(i);
+  return b;
+}
+
+
+Json num_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+// Nearest point of a segment: the signed distance along its normal inside, the distance to the end
+// (along the direction to it) beyond an end.
+void consider_segment(const Eigen::Vector2d& w, const Eigen::Vector2d& a, const Eigen::Vector2d& b, int index, double& best, MarkingMatch& m) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  if (!(len2 > 0)) return;
+  const double u = (w - a).dot(ab) / len2;
+  const Eigen::Vector2d q = a + std::clamp(u, 0.0, 1.0) * ab;
+  const double d = (w - q).norm();
+  if (!(d < best)) return;
+  best = d;
+  const Eigen::Vector2d n0 = Eigen::Vector2d(-ab.y(), ab.x()) / std::sqrt(len2);
+  m.kind = 1;
+  m.marking = index;
+  if ((u > 0 && u < 1) || d < 1e-9) {
+    m.normal = n0;
+    m.residual = n0.dot(w - a);
+  } else {
+    m.normal = (w - q) / d;
+    m.residual = d;
+  }
+}
+
+void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, int index, double& best, MarkingMatch& m) {
+  const Eigen::Vector2d dc = w - arc.centre;
+  const double r = dc.norm();
+  if (!(r > 1e-9)) return;
+  bool inside = arc.sweep >= kTwoPi - 1e-12;
+  if (!inside && arc.sweep <= kPi) {
+    // Within the sweep: anticlockwise of its start direction and clockwise of its end (no atan2).
+    const Eigen::Vector2d e0(std::cos(arc.start), std::sin(arc.start)), e1(std::cos(arc.start + arc.sweep), std::sin(arc.start + arc.sweep));
+    inside = e0.x() * dc.y() - e0.y() * dc.x() >= 0 && dc.x() * e1.y() - dc.y() * e1.x() >= 0;
+  } else if (!inside) {
+    inside = wrap_angle_positive(std::atan2(dc.y(), dc.x()) - arc.start) <= arc.sweep;
+  }
+  if (inside) {
+    const double d = std::fabs(r - arc.radius);
+    if (!(d < best)) return;
+    best = d;
+    m.kind = 1;
+    m.marking = index;
+    m.normal = dc / r;
+    m.residual = r - arc.radius;
+    return;
+  }
+  for (const double ang : {arc.start, arc.start + arc.sweep}) {
+    const Eigen::Vector2d e = arc.centre + arc.radius * Eigen::Vector2d(std::cos(ang), std::sin(ang));
+    const double d = (w - e).norm();
+    if (!(d < best)) continue;
+    best = d;
+    m.kind = 1;
+    m.marking = index;
+    m.normal = d > 1e-9 ? Eigen::Vector2d((w - e) / d) : Eigen::Vector2d(dc / r);
+    m.residual = d;
+  }
+}
+
+}  // namespace
+
+MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w) {
+  MarkingMatch m;
+  double best = kInf;
+  int index = 0;
+  for (const auto& s : field.segments) consider_segment(w, s.a, s.b, index++, best, m);
+  for (const auto& a : field.arcs) consider_arc(w, a, index++, best, m);
+  // A painted spot is a disc: a point on it has no normal, so it measures nothing the bound can use.
+  for (const auto& s : field.spots) {
+    const double d = std::max(0.0, (w - s.centre).norm() - s.radius);
+    if (d < best) {
+      best = d;
+      m.kind = 2;
+      m.marking = -1;
+      m.residual = d;
+    }
+  }
+  return m;
+}
+
+Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h) {
+  // A floor point p is seen along the ray (p, -h) from the mirror's viewpoint. Turning the camera
+  // by small angles (wx about x, wy about y) turns the ray by w x ray, and the floor point moves by
+  // h (-wy, wx) sideways plus p (wx py - wy px) / h along its range: (r^2 + h^2) / h per radian for a
+  // tilt towards the point, h for one across it.
+  Eigen::Matrix2d M;
+  M << p.x() * p.y() / h, -h - p.x() * p.x() / h,  //
+      h + p.y() * p.y() / h, -p.x() * p.y() / h;
+  return M;
+}
+
+Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen::Matrix2d& tilt_cov, double line_corr, Eigen::Vector3d* score) {
+  // J = H^T R^-1 H with R = D + A C A^T; Woodbury: R^-1 = D^-1 - D^-1 A (C^-1 + A^T D^-1 A)^-1 A^T D^-1.
+  // The nuisances: the tilt (2) and, with line_corr > 0, one offset per marking.
+  // At most kMaxLines markings get an offset of their own (a frame sees about ten); the points of
+  // any further one are taken as independent. Bounded sizes keep the matrices off the heap.
+  constexpr int kMaxLines = 30;
+  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 2 + kMaxLines, 2 + kMaxLines>;
+  using Row3 = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 2 + kMaxLines>;
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 2 + kMaxLines, 1>;
+  int lines = 0;
+  if (line_corr > 0)
+    for (const auto& r : rows) lines = std::max(lines, std::min(r.line + 1, kMaxLines));
+  const int m = 2 + lines;
+  Eigen::Matrix3d HDH = Eigen::Matrix3d::Zero();
+  Row3 HDA = Row3::Zero(3, m);
+  Mat ADA = Mat::Zero(m, m);
+  Eigen::Vector3d HDe = Eigen::Vector3d::Zero();
+  Vec ADe = Vec::Zero(m);
+  for (const auto& r : rows) {
+    const double w = 1.0 / r.var;
+    HDH.noalias() += w * r.h * r.h.transpose();
+    HDA.leftCols<2>().noalias() += w * r.h * r.a.transpose();
+    ADA.topLeftCorner<2, 2>().noalias() += w * r.a * r.a.transpose();
+    if (score) {
+      HDe += w * r.e * r.h;
+      ADe.head<2>() += w * r.e * r.a;
+    }
+    if (lines > 0 && r.line >= 0 && r.line < kMaxLines) {
+      const int c = 2 + r.line;
+      HDA.col(c) += w * r.load * r.h;
+      ADA(c, c) += w * r.load * r.load;
+      ADA.block(0, c, 2, 1) += w * r.load * r.a;
+      ADA.block(c, 0, 1, 2) += w * r.load * r.a.transpose();
+      if (score) ADe(c) += w * r.load * r.e;
+    }
+  }
+  Mat C = Mat::Zero(m, m);
+  C.topLeftCorner<2, 2>() = tilt_cov;
+  for (int c = 2; c < m; ++c) C(c, c) = line_corr;
+  if (C.isZero(0.0)) {
+    if (score) *score = HDe;
+    return HDH;
+  }
+  // (C^-1 + ADA)^-1 = C (I + ADA C)^-1: defined also for a singular C (one axis without vibration).
+  const Mat S = C * Mat(Mat::Identity(m, m) + ADA * C).partialPivLu().inverse();
+  if (score) *score = HDe - HDA * (S * ADe);
+  Eigen::Matrix3d J = HDH - HDA * S * HDA.transpose();
+  return 0.5 * (J + J.transpose());
+}
+
+CovarianceBound invert_information(const Eigen::Matrix3d& info) {
+  CovarianceBound b;
+  // Scaled to unit diagonal, so that metres and radians weigh alike in the conditioning test.
+  Eigen::Vector3d s;
+  for (int i = 0; i < 3; ++i) {
+    if (!(info(i, i) > 0) || !std::isfinite(info(i, i))) {
+      b.why = "ill-conditioned";
+      return b;
+    }
+    s(i) = 1.0 / std::sqrt(info(i, i));
+  }
+  const Eigen::Matrix3d n = s.asDiagonal() * info * s.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(n, Eigen::EigenvaluesOnly);
+  // 1e-9: a direction known a billion times worse than the best one (in variance) is not known.
+  if (!(es.eigenvalues()(0) > 1e-9 * es.eigenvalues()(2))) {
+    b.why = "ill-conditioned";
+    return b;
+  }
+  b.cov = s.asDiagonal() * n.inverse() * s.asDiagonal();
+  b.cov = 0.5 * (b.cov + b.cov.transpose());
+  b.finite = true;
+  return b;
+}
+
+namespace {
+template <class M>
+M posterior_step_impl(const M& P, const M& F, const M& Q, const M& Jz) {
+  const M Pp = F * P * F.transpose() + Q;
+  // (I + Pp Jz) is invertible for positive semi-definite Pp and Jz (its eigenvalues are 1 + those of
+  // Pp^1/2 Jz Pp^1/2 >= 1).
+  const M I = M::Identity(Pp.rows(), Pp.cols());
+  const M out = M(I + Pp * Jz).partialPivLu().solve(Pp);
+  return 0.5 * (out + out.transpose());
+}
+}  // namespace
+
+Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& F, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Jz) {
+  return posterior_step_impl<Eigen::MatrixXd>(P, F, Q, Jz);
+}
+
+BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h) {
+  BoundRow row;
+  const Eigen::Vector2d d = world - pose.translation();
+  row.h = Eigen::Vector3d(m.normal.x(), m.normal.y(), d.x() * m.normal.y() - d.y() * m.normal.x());
+  row.var = var;
+  row.a = tilt_jacobian(robot, h).transpose() * (pose.rotation().transpose() * m.normal);
+  row.e = m.residual;
+  return row;
+}
+
+namespace {
+
+// Whether a move without odometry (teleport, kidnap) at time `tm` falls between the frames at `ta`
+// and `tb`: the simulation applies an event at the first physics step at or after its time, so an
+// event at a frame's own time moves the robot after that frame.
+bool moved_between(double tm, double ta, double tb) { return tm >= ta - 1e-9 && tm < tb - 1e-9; }
+
+// A frame's line point matched at the exposure pose.
+// Kept small (64 bytes): the noise passes stream through every point of the run several times.
+struct PointRes {
+  double residual = 0.0;
+  Eigen::Vector3d h = Eigen::Vector3d::Zero();  // d(residual)/d(x, y, theta): (normal, lever)
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();  // d(residual)/d(tilt)
+  float offset = 0.0f;  // normal . world point: which of parallel lines it lies on
+  std::int16_t marking = -1;
+  std::uint8_t band = 0;  // range band and incidence class
+  bool near = false;      // within the wide first gate
+  bool inlier = false;    // and within its frame's gate once the tilt is out
+};
+
+struct FrameWork {
+  Pose2 pose;  // the pose the image was exposed at
+  std::vector<PointRes> pts;
+  std::size_t raw_points = 0, spot_points = 0, far_points = 0;
+  bool tilt_fitted = false;
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d tilt_var = Eigen::Matrix2d::Zero();
+};
+
+// d(residual)/d(tilt) of a point, computed once when it is matched (bound_row's a).
+const Eigen::Vector2d& tilt_row(const PointRes& q, const Pose2&, double) { return q.a; }
+
+// The pose each frame's image was exposed at: the truth `latency` before the frame, on the
+// simulation's step grid as the renderer picks it (harness/simulation.cpp camera_view),
+// interpolated between the recorded frames (never across a kidnap).
+std::vector<Pose2> exposure_poses(const RobotRecord& robot, const BoundSetup& setup) {
+  const auto& f = robot.frames;
+  std::vector<Pose2> out(f.size());
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    out[k] = f[k].truth;
+    if (!(setup.latency_s > 0)) continue;
+    const double te = std::floor((f[k].t - setup.latency_s + 1e-9) / setup.physics_dt) * setup.physics_dt;
+    if (te < 0 || k == 0) continue;  // before the first step the camera shows the present
+    std::size_t j = k;
+    while (j > 0 && f[j].t > te + 1e-12) --j;
+    if (f[j].t > te + 1e-12) continue;
+    const std::size_t j1 = std::min(j + 1, k);
+    std::optional<double> moved;
+    for (double tr : setup.resets)
+      if (moved_between(tr, f[j].t, f[j1].t)) moved = tr;
+    if (j1 == j || moved) {
+      // Across a move without odometry: the pose on the side of it the exposure lies.
+      out[k] = moved && te > *moved + 1e-9 ? f[j1].truth : f[j].truth;
+      continue;
+    }
+    const double u = (te - f[j].t) / (f[j1].t - f[j].t);
+    const Pose2& a = f[j].truth;
+    const Pose2& b = f[j1].truth;
+    out[k] = Pose2(a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * angle_diff(b.theta, a.theta));
+  }
+  return out;
+}
+
+// Fits each frame's tilt to its inliers' residuals (weights from `sigma`): generalized least
+// squares, its own variance beside it.
+void fit_tilts(std::vector<FrameWork>& work, const std::array<double, kClasses>& sigma, double h) {
+  for (auto& fw : work) {
+    fw.tilt_fitted = false;
+    Eigen::Matrix2d N = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d b = Eigen::Vector2d::Zero();
+    std::size_t n = 0;
+    for (const auto& q : fw.pts) {
+      if (!q.inlier) continue;
+      const Eigen::Vector2d a = tilt_row(q, fw.pose, h);
+      const double w = 1.0 / (sigma[static_cast<std::size_t>(q.band)] * sigma[static_cast<std::size_t>(q.band)]);
+      N.noalias() += w * a * a.transpose();
+      b += w * a * q.residual;
+      ++n;
+    }
+    if (n < kMinTiltPoints) continue;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(N, Eigen::EigenvaluesOnly);
+    if (!(es.eigenvalues()(0) > 1e-6 * es.eigenvalues()(1))) continue;  // points in one direction only
+    fw.tilt_var = N.inverse();
+    fw.tilt = fw.tilt_var * b;
+    fw.tilt_fitted = true;
+  }
+}
+
+// Each band's white sigma from the residuals less the frame's fitted tilt, each divided by
+// sqrt(1 - leverage) so that the two fitted unknowns do not shrink it.
+std::array<double, kClasses> white_sigmas(const std::vector<FrameWork>& work, const std::array<double, kClasses>& weights_sigma, double h,
+                                   std::array<std::size_t, kClasses>* counts, std::array<double, kClasses>* medians) {
+  std::array<std::vector<double>, kClasses> res;
+  for (const auto& fw : work) {
+    if (!fw.tilt_fitted) continue;
+    for (const auto& q : fw.pts) {
+      if (!q.inlier) continue;
+      const Eigen::Vector2d a = tilt_row(q, fw.pose, h);
+      const double s = weights_sigma[static_cast<std::size_t>(q.band)];
+      const double lev = std::clamp(a.dot(fw.tilt_var * a) / (s * s), 0.0, 0.9);
+      res[static_cast<std::size_t>(q.band)].push_back((q.residual - a.dot(fw.tilt)) / std::sqrt(1.0 - lev));
+    }
+  }
+  std::array<double, kClasses> out;
+  for (std::size_t b = 0; b < kClasses; ++b) {
+    if (counts) (*counts)[b] = res[b].size();
+    double m = 0;
+    out[b] = robust_sigma(std::move(res[b]), &m);
+    if (medians) (*medians)[b] = m;
+  }
+  return out;
+}
+
+// The correlation of two points' errors on one marking in one frame, by moments: for a marking's
+// n points with standardized errors z, Var(sum z) = n (1 + (n - 1) rho). The class medians (biases,
+// not in the bound) are taken out first.
+double line_correlation(const std::vector<FrameWork>& work, const std::array<double, kClasses>& sigma, const std::array<double, kClasses>& medians,
+                        double h) {
+  double num = 0, den = 0;
+  std::vector<std::pair<double, int>> groups;  // by marking index
+  for (const auto& fw : work) {
+    if (!fw.tilt_fitted) continue;
+    groups.clear();
+    for (const auto& q : fw.pts) {
+      if (!q.inlier) continue;
+      const std::size_t c = static_cast<std::size_t>(q.band);
+      const Eigen::Vector2d a = tilt_row(q, fw.pose, h);
+      const double lev = std::clamp(a.dot(fw.tilt_var * a) / (sigma[c] * sigma[c]), 0.0, 0.9);
+      const double med = std::isfinite(medians[c]) ? medians[c] : 0.0;
+      if (static_cast<std::size_t>(q.marking) >= groups.size()) groups.resize(static_cast<std::size_t>(q.marking) + 1, {0.0, 0});
+      auto& g = groups[static_cast<std::size_t>(q.marking)];
+      g.first += ((q.residual - a.dot(fw.tilt)) / std::sqrt(1.0 - lev) - med) / sigma[c];
+      ++g.second;
+    }
+    for (const auto& g : groups) {
+      const double n = g.second;
+      num += g.first * g.first - n;
+      den += n * (n - 1);
+    }
+  }
+  return den > 0 ? std::clamp(num / den, 0.0, 0.95) : 0.0;
+}
+
+// Why a frame's information has no inverse: a name a reader can act on.
+std::string singular_reason(const FrameWork& fw) {
+  const PointRes* first = nullptr;
+  bool parallel = true, collinear = true;
+  for (const auto& q : fw.pts) {
+    if (!q.inlier) continue;
+    if (!first) {
+      first = &q;
+      continue;
+    }
+    const double c = first->h.x() * q.h.y() - first->h.y() * q.h.x(), d = first->h.x() * q.h.x() + first->h.y() * q.h.y();
+    parallel = parallel && std::fabs(c) < 1e-6;
+    collinear = collinear && std::fabs((d < 0 ? -q.offset : q.offset) - first->offset) < 0.05f;
+  }
+  if (first && parallel) return collinear ? "points on one line" : "points on parallel lines";
+  return "ill-conditioned";
+}
+
+struct Series {
+  std::vector<double> pos, heading;
+};
+
+Json series_json(const Series& s, std::size_t scored) {
+  const auto rms = [](const std::vector<double>& v) {
+    if (v.empty()) return Json(nullptr);
+    double a = 0;
+    for (double x : v) a += x * x;
+    return Json(std::sqrt(a / static_cast<double>(v.size())));
+  };
+  return Json{{"position_rms_m", rms(s.pos)},
+              {"heading_rms_rad", rms(s.heading)},
+              {"position_median_m", s.pos.empty() ? Json(nullptr) : Json(median(s.pos))},
+              {"frames", s.pos.size()},
+              {"share", scored ? Json(static_cast<double>(s.pos.size()) / static_cast<double>(scored)) : Json(nullptr)}};
+}
+
+}  // namespace
+
+Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<double>>& pos_bound,
+                     const std::vector<std::optional<double>>& heading_bound, const std::string& against, const std::vector<Pose2>* exposure,
+                     const std::vector<std::pair<double, double>>* excluded) {
+  double se = 0, sb = 0, sth = 0, sbth = 0, sx = 0;
+  std::size_t n = 0, scored = 0;
+  for (std::size_t k = 0; k < robot.frames.size(); ++k) {
+    const FrameRecord& r = robot.frames[k];
+    bool out = false;
+    if (excluded)
+      for (const auto& [a, b] : *excluded) out = out || (r.t >= a && r.t < b);
+    if (out) continue;
+    ++scored;
+    if (!r.valid || !pos_bound[k] || !heading_bound[k]) continue;
+    const double ex = r.est.x - r.truth.x, ey = r.est.y - r.truth.y, eth = angle_diff(r.est.theta, r.truth.theta);
+    se += ex * ex + ey * ey;
+    sth += eth * eth;
+    sb += *pos_bound[k] * *pos_bound[k];
+    sbth += *heading_bound[k] * *heading_bound[k];
+    if (exposure) sx += std::pow(r.est.x - (*exposure)[k].x, 2) + std::pow(r.est.y - (*exposure)[k].y, 2);
+    ++n;
+  }
+  Json j{{"against", against}, {"frames", n}, {"share", scored ? Json(static_cast<double>(n) / static_cast<double>(scored)) : Json(nullptr)}};
+  if (n == 0) {
+    j["position"] = nullptr;
+    j["heading"] = nullptr;
+    j["why_null"] = "no frame has both an estimate and a finite bound";
+    return j;
+  }
+  const double N = static_cast<double>(n);
+  j["rmse_m"] = std::sqrt(se / N);
+  j["bound_rms_m"] = std::sqrt(sb / N);
+  j["heading_rmse_rad"] = std::sqrt(sth / N);
+  j["heading_bound_rms_rad"] = std::sqrt(sbth / N);
+  // The same estimates against the pose the images were exposed at: how much of the error is the
+  // camera's latency (a localizer that does not carry its estimate forward over it).
+  if (exposure) j["rmse_at_exposure_m"] = std::sqrt(sx / N);
+  // A bound of exactly 0 (a pose given and never disturbed) makes every error infinitely inefficient.
+  j["position"] = sb > 0 ? Json(std::sqrt(se / sb)) : Json(nullptr);
+  j["heading"] = sbth > 0 ? Json(std::sqrt(sth / sbth)) : Json(nullptr);
+  if (!(sb > 0) || !(sbth > 0)) j["why_null"] = "the bound is 0 over these frames (the pose was known exactly)";
+  return j;
+}
+
+namespace {
+
+// The markings near each 0.5 m cell of the floor, so that a point is compared with the few that can
+// be its nearest instead of all of them (the bound's cost is mostly this match). A point farther
+// than kMatchReach from every marking matches none: a false detection whatever the noise (4 sigma of
+// the widest band measured on the tracking path is 0.8 m).
+constexpr double kMatchReach = 1.0;
+class MarkingIndex {
+ public:
+  explicit MarkingIndex(const Field& f) : f_(f) {
+    x0_ = -f.half_floor_x() - kMatchReach;
+    y0_ = -f.half_floor_y() - kMatchReach;
+    nx_ = static_cast<int>(std::ceil(2 * (f.half_floor_x() + kMatchReach) / kCell));
+    ny_ = static_cast<int>(std::ceil(2 * (f.half_floor_y() + kMatchReach) / kCell));
+    cells_.resize(static_cast<std::size_t>(nx_ * ny_));
+    const double reach = kMatchReach + kCell * std::sqrt(0.5);  // any point of the cell
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i) {
+        const Eigen::Vector2d c(x0_ + (i + 0.5) * kCell, y0_ + (j + 0.5) * kCell);
+        auto& cell = cells_[static_cast<std::size_t>(j * nx_ + i)];
+        for (std::size_t k = 0; k < f.segments.size(); ++k)
+          if (distance_to_segment(c, f.segments[k].a, f.segments[k].b) <= reach) cell.segments.push_back(static_cast<int>(k));
+        for (std::size_t k = 0; k < f.arcs.size(); ++k)
+          if (distance_to_arc(c, f.arcs[k]) <= reach) cell.arcs.push_back(static_cast<int>(k));
+        for (std::size_t k = 0; k < f.spots.size(); ++k)
+          if ((c - f.spots[k].centre).norm() - f.spots[k].radius <= reach) cell.spots.push_back(static_cast<int>(k));
+      }
+  }
+  /// As match_marking, for points within kMatchReach of a marking (kind 0 beyond).
+  MarkingMatch match(const Eigen::Vector2d& w) const {
+    MarkingMatch m;
+    const int i = static_cast<int>(std::floor((w.x() - x0_) / kCell)), j = static_cast<int>(std::floor((w.y() - y0_) / kCell));
+    if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return m;
+    const Cell& cell = cells_[static_cast<std::size_t>(j * nx_ + i)];
+    double best = kMatchReach;
+    const int nseg = static_cast<int>(f_.segments.size());
+    for (int k : cell.segments) consider_segment(w, f_.segments[static_cast<std::size_t>(k)].a, f_.segments[static_cast<std::size_t>(k)].b, k, best, m);
+    for (int k : cell.arcs) consider_arc(w, f_.arcs[static_cast<std::size_t>(k)], nseg + k, best, m);
+    for (int k : cell.spots) {
+      const auto& s = f_.spots[static_cast<std::size_t>(k)];
+      const double d = std::max(0.0, (w - s.centre).norm() - s.radius);
+      if (d < best) {
+        best = d;
+        m.kind = 2;
+        m.marking = -1;
+        m.residual = d;
+      }
+    }
+    return m;
+  }
+
+ private:
+  static constexpr double kCell = 0.5;
+  struct Cell {
+    std::vector<int> segments, arcs, spots;
+  };
+  const Field& f_;
+  double x0_ = 0, y0_ = 0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<Cell> cells_;
+};
+
+}  // namespace
+
+RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
+  RobotBound out;
+  const auto& frames = robot.frames;
+  const std::size_t nf = frames.size();
+  out.frames.resize(nf);
+  const double h = setup.mount_height;
+  const Field& field = *setup.field;
+
+  // Pass 1: every point mapped at the exposure pose and matched to its nearest marking.
+  const std::vector<Pose2> poses = exposure_poses(robot, setup);
+  std::vector<FrameWork> work(nf);
+  std::array<std::vector<double>, kClasses> raw;
+  const MarkingIndex index(field);
+  for (std::size_t k = 0; k < nf; ++k) {
+    FrameWork& fw = work[k];
+    fw.pose = poses[k];
+    fw.raw_points = frames[k].line_points.size();
+    if (!frames[k].camera_ok) continue;
+    fw.pts.reserve(fw.raw_points);
+    const Eigen::Matrix2d rot = fw.pose.rotation();
+    for (const auto& pf : frames[k].line_points) {
+      const Eigen::Vector2d p(pf[0], pf[1]);
+      const Eigen::Vector2d w = rot * p + fw.pose.translation();
+      const MarkingMatch m = index.match(w);
+      if (m.kind == 2) {
+        ++fw.spot_points;
+        continue;
+      }
+      if (m.kind == 0) {
+        ++fw.far_points;
+        continue;
+      }
+      PointRes q;
+      const double r = p.norm();
+      const bool grazing = r > 0 && std::fabs(m.normal.dot(fw.pose.rotation() * p) / r) < kGrazing;
+      q.band = static_cast<std::uint8_t>(band_of(r) + (grazing ? static_cast<int>(kBands) : 0));
+      q.residual = m.residual;
+      const Eigen::Vector2d lever = w - fw.pose.translation();
+      q.h = Eigen::Vector3d(m.normal.x(), m.normal.y(), lever.x() * m.normal.y() - lever.y() * m.normal.x());
+      q.offset = static_cast<float>(m.normal.dot(w));
+      q.marking = static_cast<std::int16_t>(m.marking);
+      q.a = tilt_jacobian(p, h).transpose() * (rot.transpose() * m.normal);
+      raw[static_cast<std::size_t>(q.band)].push_back(q.residual);
+      fw.pts.push_back(q);
+    }
+  }
+  // The gate: kGateSigmas of each band's total spread (white and common together, as a false point
+  // is judged before any fit); a true point lies beyond it once in 16 000 for Gaussian errors.
+  std::array<double, kClasses> total{}, centre{};
+  std::array<std::size_t, kClasses> raw_count{};
+  for (std::size_t b = 0; b < kClasses; ++b) {
+    raw_count[b] = raw[b].size();
+    total[b] = std::max(kSigmaFloor, robust_sigma(std::move(raw[b]), &centre[b]));
+  }
+  std::size_t false_points = 0, spot_points = 0;
+  for (auto& fw : work) {
+    spot_points += fw.spot_points;
+    false_points += fw.far_points;
+    for (auto& q : fw.pts) {
+      const std::size_t b = static_cast<std::size_t>(q.band);
+      q.near = std::isfinite(total[b]) && std::fabs(q.residual - centre[b]) <= kGateSigmas * total[b];
+      q.inlier = q.near;
+    }
+  }
+
+  // Pass 2: the per-frame tilt and the white noise, twice (weights from the total spread first,
+  // then from the white sigmas they gave). The second time, a point is first judged against its
+  // own frame's tilt: farther than kGateSigmas white sigmas from its marking once the frame's tilt
+  // is taken out, it is not that marking's (a far point can be 30 cm off through the tilt alone, so
+  // the first gate must be wide; this one is not).
+  std::array<double, kClasses> sigma = total;
+  std::array<std::size_t, kClasses> counts{};
+  std::array<double, kClasses> medians{};
+  for (int it = 0; it < 2; ++it) {
+    if (it > 0)
+      for (auto& fw : work)
+        for (auto& q : fw.pts) {
+          if (!q.near || !fw.tilt_fitted) continue;
+          const double white = q.residual - tilt_row(q, fw.pose, h).dot(fw.tilt);
+          q.inlier = std::fabs(white) <= kGateSigmas * sigma[static_cast<std::size_t>(q.band)];
+        }
+    fit_tilts(work, sigma, h);
+    std::array<double, kClasses> white = white_sigmas(work, sigma, h, &counts, &medians);
+    for (std::size_t b = 0; b < kClasses; ++b) {
+      // Too few points for a class of its own: the larger of its band's two (the conservative side
+      // is the smaller information, a bound that cannot be beaten by a wrong noise figure).
+      if (counts[b] < kMinClassPoints) {
+        const double other = white[(b + kBands) % kClasses];
+        white[b] = counts[(b + kBands) % kClasses] >= kMinClassPoints ? std::max(other, std::isfinite(white[b]) ? white[b] : other) : std::nan("");
+      }
+      sigma[b] = std::isfinite(white[b]) ? std::max(kSigmaFloor, white[b]) : total[b];
+    }
+  }
+  for (const auto& fw : work)
+    for (const auto& q : fw.pts) false_points += !q.inlier;
+  fit_tilts(work, sigma, h);
+  // Points on one marking in one frame share part of their error (the line's image as a whole: its
+  // edges' blur and classification along its length), measured here and modelled as one offset per
+  // marking and frame; ignoring it made the bound about a third too optimistic on the tracking path.
+  const double line_corr = line_correlation(work, sigma, medians, h);
+  // The tilt's spread over frames, less the fits' own noise: the vibration the frames carried. Its
+  // median is a static tilt (a mirror mounted askew): a bias, reported, not in the bound.
+  std::vector<double> tx, ty, vx, vy;
+  for (const auto& fw : work)
+    if (fw.tilt_fitted) {
+      tx.push_back(fw.tilt.x());
+      ty.push_back(fw.tilt.y());
+      vx.push_back(fw.tilt_var(0, 0));
+      vy.push_back(fw.tilt_var(1, 1));
+    }
+  Eigen::Matrix2d tilt_cov = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d tilt_sigma(std::nan(""), std::nan(""));
+  if (tx.size() >= 10) {
+    const double sx = robust_sigma(tx), sy = robust_sigma(ty);
+    tilt_cov(0, 0) = std::max(0.0, sx * sx - median(vx));
+    tilt_cov(1, 1) = std::max(0.0, sy * sy - median(vy));
+    tilt_sigma = Eigen::Vector2d(std::sqrt(tilt_cov(0, 0)), std::sqrt(tilt_cov(1, 1)));
+  }
+
+  // The compass: its declared white noise in the bound; measured beside it from the readings'
+  // frame-to-frame differences (a slowly walking bias cancels in them) and its median offset.
+  std::vector<double> hd, hoff;
+  {
+    std::optional<double> last;
+    for (const auto& r : frames) {
+      if (!r.heading) continue;
+      const double e = angle_diff(*r.heading, r.truth.theta);
+      hoff.push_back(e);
+      if (last) hd.push_back(angle_diff(e, *last) / std::sqrt(2.0));
+      last = e;
+    }
+  }
+  const bool compass = setup.has_heading_sensor && !hoff.empty();
+  const double compass_sigma = std::max(kCompassFloor, setup.heading_sigma);
+
+  // Pass 3: each frame's information and single-frame bound.
+  std::vector<Eigen::Matrix3d> info(nf, Eigen::Matrix3d::Zero());
+  std::map<std::string, std::size_t> why;
+  Series single;
+  std::size_t used_points = 0;
+  double oracle_pos = 0, oracle_th = 0, oracle_bpos = 0, oracle_bth = 0;
+  std::vector<BoundRow> rows;
+  std::map<int, int> line_of;
+  for (std::size_t k = 0; k < nf; ++k) {
+    const FrameWork& fw = work[k];
+    rows.clear();
+    line_of.clear();
+    for (const auto& q : fw.pts) {
+      if (!q.inlier) continue;
+      const double s = sigma[static_cast<std::size_t>(q.band)];
+      BoundRow row;  // bound_row's, from what the match already computed
+      row.h = q.h;
+      row.var = (1.0 - line_corr) * s * s;
+      row.a = q.a;
+      row.e = q.residual;
+      row.line = line_of.try_emplace(q.marking, static_cast<int>(line_of.size())).first->second;
+      row.load = s;
+      rows.push_back(row);
+    }
+    used_points += rows.size();
+    Eigen::Vector3d score = Eigen::Vector3d::Zero();
+    if (frames[k].camera_ok) info[k] = frame_information(rows, tilt_cov, line_corr, &score);
+    const bool has_compass = compass && frames[k].heading.has_value();
+    if (has_compass) {
+      info[k](2, 2) += 1.0 / (compass_sigma * compass_sigma);
+      score(2) += angle_diff(*frames[k].heading, frames[k].truth.theta) / (compass_sigma * compass_sigma);
+    }
+    std::string reason;
+    if (!frames[k].camera_ok) reason = "camera not ok";
+    else if (fw.raw_points == 0) reason = "no points";
+    else if (rows.empty()) reason = "no point near a marking";
+    else if (rows.size() + (has_compass ? 1 : 0) < 3) reason = "fewer than 3 points";
+    if (reason.empty()) {
+      const CovarianceBound cb = invert_information(info[k]);
+      if (cb.finite) {
+        out.frames[k].pos = std::sqrt(cb.cov(0, 0) + cb.cov(1, 1));
+        out.frames[k].heading = std::sqrt(cb.cov(2, 2));
+        single.pos.push_back(*out.frames[k].pos);
+        single.heading.push_back(*out.frames[k].heading);
+        // The efficient estimator's error on this frame: one generalized least-squares step from
+        // the truth with the true association and the measured noise (its residual model is linear
+        // there, so one step is its solution to first order). The residual's sign is that of
+        // measured minus true, so the step is the estimate's error.
+        const Eigen::Vector3d err = -cb.cov * score;
+        oracle_pos += err.head<2>().squaredNorm();
+        oracle_th += err(2) * err(2);
+        oracle_bpos += cb.cov(0, 0) + cb.cov(1, 1);
+        oracle_bth += cb.cov(2, 2);
+        continue;
+      }
+      reason = singular_reason(fw);
+    }
+    ++why[reason];
+  }
+
+  // The posterior bound: pose and, with a wheel-scale error, the three scale factors (constant over
+  // the run, so their error is carried from frame to frame rather than drawn anew).
+  // Always six states: without a scale error their variance is 0 and they change nothing.
+  constexpr bool scales = true;
+  using M6 = Eigen::Matrix<double, 6, 6>;
+  const double fx = 2.0 * field.half_floor_x(), fy = 2.0 * field.half_floor_y();
+  // Without the start pose, and after a kidnap, the localizer knows only that the robot is on the
+  // floor: a prior with the variance of a uniform position on it and a uniform heading.
+  const Eigen::Vector3d uniform(fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0);
+  M6 P = M6::Zero();
+  if (!setup.start_pose_given) P.topLeftCorner<3, 3>() = uniform.asDiagonal();
+  if (scales) P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
+  Series post;
+  std::size_t reset_at = 0;
+  std::vector<double> resets = setup.resets;
+  std::sort(resets.begin(), resets.end());
+  M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
+  // The motion model x_b = x_a (+) (s * u) at the true poses and the true increment u: its Jacobian
+  // F and the odometry's noise Q over the increment.
+  const auto motion = [&](const Pose2& a, const Pose2& to, M6& Fm, M6& Qm) {
+    Fm.setIdentity();
+    Qm.setZero();
+    const Pose2 u = a.between(to);
+    const double c = std::cos(a.theta), s = std::sin(a.theta);
+    Fm(0, 2) = -s * u.x - c * u.y;
+    Fm(1, 2) = c * u.x - s * u.y;
+    if (scales) {
+      Fm(0, 3) = c * u.x;
+      Fm(0, 4) = -s * u.y;
+      Fm(1, 3) = s * u.x;
+      Fm(1, 4) = c * u.y;
+      Fm(2, 5) = u.theta;
+    }
+    // sim/sensors.cpp: per step N(0, trans_sigma^2 d) on each axis (isotropic, so the same in the
+    // world frame) and N(0, rot_sigma^2 |dtheta| + rot_per_trans^2 d) on the heading; summed over a
+    // frame's steps, the variances add along the path.
+    const double d = std::hypot(u.x, u.y), turn = std::fabs(u.theta);
+    Qm(0, 0) = Qm(1, 1) = setup.trans_sigma * setup.trans_sigma * d;
+    Qm(2, 2) = setup.rot_sigma * setup.rot_sigma * turn + setup.rot_per_trans * setup.rot_per_trans * d;
+  };
+  for (std::size_t k = 0; k < nf; ++k) {
+    F.setIdentity();
+    Q.setZero();
+    bool reset = false;
+    while (reset_at < resets.size() && k > 0 && resets[reset_at] < frames[k].t - 1e-9) {
+      reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
+      ++reset_at;
+    }
+    if (reset) {
+      P.topLeftCorner<3, 3>() = uniform.asDiagonal();
+      if (scales) {
+        P.topRightCorner<3, 3>().setZero();
+        P.bottomLeftCorner<3, 3>().setZero();
+      }
+    } else if (k > 0) {
+      motion(poses[k - 1], poses[k], F, Q);
+    }
+    Jz.setZero();
+    Jz.topLeftCorner<3, 3>() = info[k];
+    P = posterior_step_impl<M6>(P, F, Q, Jz);
+    // The recursion runs on the poses the images were exposed at; the pose scored is the frame's,
+    // the latency later: carried forward through the odometry over it (its noise included).
+    M6 Pf = P;
+    if (setup.latency_s > 0) {
+      motion(poses[k], frames[k].truth, F, Q);
+      Pf = F * P * F.transpose() + Q;
+    }
+    const double pp = std::max(0.0, Pf(0, 0) + Pf(1, 1)), ph = std::max(0.0, Pf(2, 2));
+    out.frames[k].ppos = std::sqrt(pp);
+    out.frames[k].pheading = std::sqrt(ph);
+    post.pos.push_back(*out.frames[k].ppos);
+    post.heading.push_back(*out.frames[k].pheading);
+  }
+
+  // The odometry's error per frame against the truth's increments, beside the model's prediction
+  // (the physics' wheel slip is not in the declared model and shows here).
+  std::vector<double> ox, oy, ot;
+  double px = 0, pt = 0;
+  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
+  // the frames carry odometry at all, which the setup says.
+  const bool odometry = setup.has_odometry;
+  for (std::size_t k = 1; k < nf; ++k) {
+    const FrameRecord& r = frames[k];
+    bool reset = false;
+    for (double tr : resets) reset = reset || moved_between(tr, frames[k - 1].t, r.t);
+    if (reset) continue;
+    const Pose2 u = frames[k - 1].truth.between(r.truth);
+    ox.push_back(r.odometry.x - u.x);
+    oy.push_back(r.odometry.y - u.y);
+    ot.push_back(angle_diff(r.odometry.theta, u.theta));
+    const double d = std::hypot(u.x, u.y);
+    px += setup.trans_sigma * setup.trans_sigma * d + std::pow(setup.scale_sigma * std::max(std::fabs(u.x), std::fabs(u.y)), 2);
+    pt += setup.rot_sigma * setup.rot_sigma * std::fabs(u.theta) + setup.rot_per_trans * setup.rot_per_trans * d +
+          std::pow(setup.scale_sigma * u.theta, 2);
+  }
+
+  // Latency: the shift between the pose the image shows and the pose scored, a bias of any
+  // localizer that does not carry its estimate forward by the odometry over the latency.
+  double lat_pos = 0, lat_th = 0;
+  for (std::size_t k = 0; k < nf; ++k) {
+    lat_pos += std::pow(frames[k].truth.x - poses[k].x, 2) + std::pow(frames[k].truth.y - poses[k].y, 2);
+    lat_th += std::pow(angle_diff(frames[k].truth.theta, poses[k].theta), 2);
+  }
+
+  const std::size_t scored = nf;
+  Json& b = out.bound;
+  b["single_frame"] = series_json(single, scored);
+  // The bound's own check on this run's data: the efficient estimator reaches the bound only if the
+  // noise model is right (ratio 1); a ratio above 1 is error the model does not have (correlation
+  // between points it takes as independent, a bias), and the bound is then optimistic by about it.
+  {
+    const double nn = static_cast<double>(single.pos.size());
+    Json c{{"estimator", "generalized least squares from the true pose, true association, the measured noise"}, {"frames", single.pos.size()}};
+    c["position_rms_m"] = nn > 0 ? Json(std::sqrt(oracle_pos / nn)) : Json(nullptr);
+    c["heading_rms_rad"] = nn > 0 ? Json(std::sqrt(oracle_th / nn)) : Json(nullptr);
+    c["position_ratio"] = oracle_bpos > 0 ? Json(std::sqrt(oracle_pos / oracle_bpos)) : Json(nullptr);
+    c["heading_ratio"] = oracle_bth > 0 ? Json(std::sqrt(oracle_th / oracle_bth)) : Json(nullptr);
+    b["single_frame"]["check"] = c;
+  }
+  b["posterior"] = series_json(post, scored);
+  b["posterior"]["prior"] = setup.start_pose_given ? "the true start pose (the localizer was given it)"
+                                                   : "uniform over the floor and heading (the localizer was not given its start)";
+  if (!setup.resets.empty()) b["posterior"]["restarts_at_s"] = setup.resets;
+  std::size_t no_bound = 0;
+  Json why_j = Json::object();
+  for (const auto& [k, v] : why) {
+    why_j[k] = v;
+    no_bound += v;
+  }
+  b["no_bound"] = {{"frames", no_bound}, {"why", why_j}};
+  Json bands = Json::array(), measured = Json::array(), grazing = Json::array(), declared = Json::array(), band_pts = Json::array(),
+       grazing_pts = Json::array(), band_med = Json::array(), band_total = Json::array();
+  for (std::size_t i = 0; i < kBands; ++i) {
+    const std::size_t g = i + kBands;
+    bands.push_back(kBoundBands[i]);
+    measured.push_back(counts[i] ? num_or_null(sigma[i]) : Json(nullptr));
+    grazing.push_back(counts[g] ? num_or_null(sigma[g]) : Json(nullptr));
+    declared.push_back(nullptr);
+    band_pts.push_back(counts[i]);
+    grazing_pts.push_back(counts[g]);
+    band_med.push_back(counts[i] ? num_or_null(medians[i]) : Json(nullptr));
+    band_total.push_back(raw_count[i] ? num_or_null(total[i]) : Json(nullptr));
+  }
+  b["noise"] = {{"bands_m", bands},
+                {"measured_sigma_m", measured},
+                {"declared_sigma_m", declared},
+                {"declared_why", "the profile declares pixel noise, not a line point's position noise (that comes from the image's sampling and edge "
+                                 "finding at each range): nothing to derive it from"},
+                {"band_points", band_pts},
+                {"grazing_sigma_m", grazing},
+                {"grazing_points", grazing_pts},
+                {"grazing_below", kGrazing},
+                {"band_median_m", band_med},
+                {"total_sigma_m", band_total},
+                {"points", used_points},
+                {"false_points", false_points},
+                {"spot_points", spot_points},
+                {"gate_sigmas", kGateSigmas},
+                {"line_correlation", line_corr},
+                {"estimator", "1.4826 x MAD of the residuals at the true exposure pose, less each frame's fitted tilt"}};
+  b["noise"]["common_mode"] = {{"model", "a per-frame tilt of the mirror (roll, pitch) shifts each point by about (r^2 + h^2) / h per radian along its range"},
+                               {"mount_height_m", h},
+                               {"measured_sigma_rad", tilt_sigma.allFinite() ? Json::array({tilt_sigma.x(), tilt_sigma.y()}) : Json(nullptr)},
+                               {"declared_sigma_rad", setup.vibration_std},
+                               {"declared_tilt_per_accel_rad_per_mps2", setup.tilt_per_accel},
+                               {"static_rad", tx.empty() ? Json(nullptr) : Json::array({median(tx), median(ty)})},
+                               {"frames", tx.size()}};
+  if (setup.has_heading_sensor) {
+    b["compass"] = {{"declared_sigma_rad", setup.heading_sigma},
+                    {"used_sigma_rad", compass_sigma},
+                    {"measured_sigma_rad", hd.size() >= 2 ? num_or_null(robust_sigma(hd)) : Json(nullptr)},
+                    {"measured_bias_rad", hoff.empty() ? Json(nullptr) : num_or_null(median(hoff))},
+                    {"readings", hoff.size()}};
+  }
+  const double no = static_cast<double>(ox.size());
+  b["odometry"] = {{"declared_sigma", ox.empty() ? Json(nullptr) : Json::array({std::sqrt(px / no), std::sqrt(px / no), std::sqrt(pt / no)})},
+                   {"measured_sigma", ox.size() >= 2 ? Json::array({robust_sigma(ox), robust_sigma(oy), robust_sigma(ot)}) : Json(nullptr)},
+                   {"units", "per frame: x, y (m, robot frame), theta (rad)"},
+                   {"frames", ox.size()}};
+  b["latency"] = {{"latency_s", setup.latency_s},
+                  {"position_shift_rms_m", nf ? Json(std::sqrt(lat_pos / static_cast<double>(nf))) : Json(nullptr)},
+                  {"heading_shift_rms_rad", nf ? Json(std::sqrt(lat_th / static_cast<double>(nf))) : Json(nullptr)},
+                  {"treatment", "a bias, not noise: the bound is on the pose the image was exposed at; the shift to the frame's pose is "
+                                "what a localizer that does not carry its estimate forward adds"}};
+  b["assumptions"] = "known association, measured Gaussian noise, unbiased estimator";
+
+  std::vector<std::optional<double>> sp(nf), sh(nf), pp(nf), ph(nf);
+  for (std::size_t k = 0; k < nf; ++k) {
+    sp[k] = out.frames[k].pos;
+    sh[k] = out.frames[k].heading;
+    pp[k] = out.frames[k].ppos;
+    ph[k] = out.frames[k].pheading;
+  }
+  const std::vector<Pose2>* exp = setup.latency_s > 0 ? &poses : nullptr;
+  out.efficiency_single = efficiency_json(robot, sp, sh, "single_frame", exp);
+  out.efficiency = odometry ? efficiency_json(robot, pp, ph, "posterior", exp) : out.efficiency_single;
+  if (!setup.excluded.empty()) {
+    // After a kidnap the posterior bound starts from a prior as wide as the floor: a bound on the
+    // average over where the robot may be put, which one run's error (the distance it was carried)
+    // can lie below while the robot is blind. Tracking is judged without those intervals.
+    out.efficiency_single["tracking_phase"] = efficiency_json(robot, sp, sh, "single_frame", exp, &setup.excluded);
+    out.efficiency["tracking_phase"] = efficiency_json(robot, odometry ? pp : sp, odometry ? ph : sh, odometry ? "posterior" : "single_frame", exp, &setup.excluded);
+  }
+  return out;
+}
+
+}  // namespace omniloc::harness

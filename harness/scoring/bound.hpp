@@ -1,0 +1,146 @@
+#pragma once
+// The accuracy limit beside every score: a Cramér–Rao lower bound on each frame's pose (x, y,
+// theta) from what that frame gave the localizer, and the posterior bound (Tichavský, Muravchik and
+// Nehorai 1998) that carries information from frame to frame through the odometry model.
+//
+// Scoring only: the bound is computed from the true pose, the field's markings and the run's own
+// residuals at the truth, so, like the truth, it never reaches a localizer.
+//
+// The measurement model, as the errors are made (docs/results.md "The limit"):
+// - each line point, mapped to the world at the true pose, is a measurement of the signed distance
+//   to its nearest marking (segment or arc) along that marking's normal; points farther than
+//   kGateSigmas band sigmas from every marking are false detections (excluded, counted);
+// - white noise per range band, measured from the run's residuals at the truth (1.4826 x MAD);
+// - camera vibration and body tilt move all of a frame's points together: a per-frame tilt of the
+//   mirror (two angles) shifts a floor point at range r by about (r^2 + h^2) / h times the tilt.
+//   It is a nuisance in each frame's measurement covariance, R = D + A Sigma_c A^T, its size
+//   measured from the per-frame fitted tilt's spread (the declared vibration beside it);
+// - camera latency is a bias, not noise: the geometry is evaluated at the pose the image was
+//   exposed at (the truth interpolated latency seconds before the frame), and the shift between
+//   the two poses is reported beside the bound, never folded into a sigma;
+// - a compass adds 1 / sigma^2 to the heading information (its declared white noise).
+// Assumptions: known association, the measured noise is Gaussian and is the truth, unbiased
+// estimators. A real localizer may legitimately differ: it does not know the association (the bound
+// is then optimistic), a biased estimator (a prior, a robust cost that shrinks) can go below it, and
+// the run's noise estimate has sampling error. Blobs (coloured goals, landmarks) are not in the
+// bound: a localizer that uses their bearings is not bounded by it.
+#include <array>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/field.hpp"
+#include "core/json_reader.hpp"
+#include "core/pose2.hpp"
+#include "harness/run_record.hpp"
+
+namespace omniloc::harness {
+
+/// The range bands (metres from the robot) the point noise is measured in: [0, 1.5), [1.5, 3), ...
+inline constexpr std::array<double, 5> kBoundBands = {0.0, 1.5, 3.0, 5.0, 7.5};
+/// A point farther than this many of its band's sigmas from every marking is a false detection.
+inline constexpr double kGateSigmas = 4.0;
+
+/// One scalar measurement of a frame: d(residual)/d(x, y, theta), its white variance and
+/// d(residual)/d(tilt) (the per-frame common component: roll, pitch of the mirror, radians).
+struct BoundRow {
+  Eigen::Vector3d h = Eigen::Vector3d::Zero();
+  double var = 1.0;
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();
+  double e = 0.0;  ///< the residual at the true pose (only for the score below)
+  int line = -1;     ///< which of the frame's markings the point lies on (0, 1, ...; -1: none shared)
+  double load = 0.0; ///< its loading on that marking's shared offset (the point's sigma)
+};
+
+/// Fisher information of (x, y, theta) from rows whose errors are white (var) plus a shared tilt
+/// with covariance `tilt_cov` and an offset per marking (R = D + A C A^T with A the n x (2 + lines)
+/// loadings, inverted by the Woodbury identity: O(n) in the points).
+/// `score`, when given, gets H^T R^-1 e: information^-1 times it is the step of the efficient
+/// (generalized least squares) estimator from the true pose, the bound's own check on real data.
+/// `line_corr`: the correlation of two points' errors on one marking in one frame (each marking
+/// adds an offset of variance line_corr x load_i x load_j shared by its points; `var` is then the
+/// rest, (1 - line_corr) sigma^2).
+Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen::Matrix2d& tilt_cov, double line_corr = 0.0,
+                                  Eigen::Vector3d* score = nullptr);
+
+/// The covariance bound of a Fisher information matrix, or the reason there is none:
+/// "points on one line" (the information has a null direction), "ill-conditioned".
+struct CovarianceBound {
+  bool finite = false;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  std::string why;  ///< when not finite
+};
+CovarianceBound invert_information(const Eigen::Matrix3d& info);
+
+/// One step of the posterior bound in covariance form: P+ = (I + P- J_z)^-1 P-, P- = F P F^T + Q.
+/// Exactly the information recursion J+ = (Q + F J^-1 F^T)^-1 + J_z where both are defined, and
+/// also when P or J_z is singular (a known start pose, a frame without points).
+Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& F, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Jz);
+
+/// d(floor point)/d(mirror tilt) for a robot-frame floor point `p` seen from a mirror at height `h`
+/// (roll about x, pitch about y, radians): the 2 x 2 map of a small tilt onto the point's position.
+Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h);
+
+/// A point mapped to the world and matched to its nearest marking: the signed distance along the
+/// marking's normal and that normal (world frame). `kind`: 0 none, 1 segment/arc, 2 spot.
+struct MarkingMatch {
+  double residual = 0.0;
+  Eigen::Vector2d normal = Eigen::Vector2d::UnitX();
+  int kind = 0;
+  int marking = -1;  ///< index among segments then arcs (spots: -1)
+};
+MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w);
+
+/// The measurement row of a robot-frame point `robot` seen from `pose`, mapped to `world` and matched
+/// as `m`: d(signed distance)/d(x, y, theta) = (n_x, n_y, (w - t) x n), its tilt loading and residual.
+BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h);
+
+/// What the scenario declares (the bound's "declared" figures and the odometry model's noise).
+struct BoundSetup {
+  const Field* field = nullptr;
+  double mount_height = 0.75;      ///< mirror viewpoint above the floor, metres
+  double latency_s = 0.0;          ///< the image shows the world this long before the frame
+  double physics_dt = 0.005;       ///< the simulation's step (the exposure time lies on it)
+  double camera_rate = 30.0;
+  double vibration_std = 0.0;      ///< declared per-frame roll / pitch std, radians
+  double tilt_per_accel = 0.0;     ///< declared body tilt per m/s^2 (not modelled as noise: said beside)
+  double trans_sigma = 0.0, rot_sigma = 0.0, rot_per_trans = 0.0, scale_sigma = 0.0;  ///< odometry (sim/sensors.hpp)
+  bool has_heading_sensor = false;
+  double heading_sigma = 0.0;      ///< declared white noise of the compass, radians
+  bool start_pose_given = false;   ///< the localizer was reset with the true start pose
+  /// Frames carry odometry (simulated robots and recordings of them always do): the efficiency is
+  /// then against the posterior bound, else against the single-frame one.
+  bool has_odometry = true;
+  std::vector<double> resets;      ///< times this robot was kidnapped: the posterior starts again
+  /// With kidnaps or covers, the intervals (seconds) scoring leaves out of the tracking phase
+  /// (summary.json tracking_phase.excluded): the efficiency is also given without them.
+  std::vector<std::pair<double, double>> excluded;
+};
+
+/// The bound of one frame; empty where none is finite.
+struct FrameBound {
+  std::optional<double> pos, heading;    ///< single frame: sqrt(P_xx + P_yy), sqrt(P_thth)
+  std::optional<double> ppos, pheading;  ///< posterior
+};
+
+struct RobotBound {
+  std::vector<FrameBound> frames;     ///< one per FrameRecord
+  Json bound;                         ///< summary.json "bound"
+  Json efficiency, efficiency_single; ///< summary.json "efficiency", "efficiency_single_frame"
+};
+
+/// The bound of every frame of a robot with ground truth, its summary and the efficiency of its
+/// estimates (rmse / bound RMS over the frames that have both).
+RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup);
+
+/// rmse / bound RMS over the frames with a valid estimate and a finite bound (`against` names the
+/// bound); null with why_null where there are none or the bound is 0. `exposure`: the poses the
+/// images were exposed at (with camera latency), for rmse_at_exposure_m beside.
+Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<double>>& pos_bound,
+                     const std::vector<std::optional<double>>& heading_bound, const std::string& against,
+                     const std::vector<Pose2>* exposure = nullptr, const std::vector<std::pair<double, double>>* excluded = nullptr);
+
+}  // namespace omniloc::harness
