@@ -230,7 +230,9 @@ std::string parameter_reference() {
       "config.json of a run records every value it used, defaults included. `omniloc schema` prints\n"
       "the JSON Schema of scenario files for an editor (e.g. VS Code's `json.schemas` setting).\n\n"
       "## Localizers\n"
-      "Scenario key `localizer`: `{\"type\": NAME, ...parameters}`.\n";
+      "Scenario key `localizer`: `{\"type\": NAME, ...parameters}`. How far each built-in one is from\n"
+      "the accuracy limit on the same frames (its efficiency, RMSE / Cramér–Rao bound): docs/results.md,\n"
+      "\"Each built-in localizer against the limit\".\n";
   for (const auto& l : localizers()) table("`" + l.type + "`", l.description + ".", l.schema(), md);
   md += "\n## Vision front end\nScenario key `vision`.\n";
   const Json vision = scenario_schema()["properties"]["vision"]["properties"];
