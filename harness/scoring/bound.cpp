@@ -546,20 +546,15 @@ class MarkingIndex {
 
 }  // namespace
 
-RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
-  RobotBound out;
-  const auto& frames = robot.frames;
-  const std::size_t nf = frames.size();
-  out.frames.resize(nf);
-  const double h = setup.mount_height;
-  const Field& field = *setup.field;
+namespace {
 
-  // Pass 1: every point mapped at the exposure pose and matched to its nearest marking.
-  const std::vector<Pose2> poses = exposure_poses(robot, setup);
-  std::vector<FrameWork> work(nf);
-  std::array<std::vector<double>, kClasses> raw;
+// Pass 1: every point of every frame mapped to the world at the pose its image was exposed at and
+// matched to its nearest marking; the residuals per noise class in `raw` for the gate.
+std::vector<FrameWork> match_points(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const Field& field, double h,
+                                    std::array<std::vector<double>, kClasses>& raw) {
+  std::vector<FrameWork> work(frames.size());
   const MarkingIndex index(field);
-  for (std::size_t k = 0; k < nf; ++k) {
+  for (std::size_t k = 0; k < frames.size(); ++k) {
     FrameWork& fw = work[k];
     fw.pose = poses[k];
     fw.raw_points = frames[k].line_points.size();
@@ -592,101 +587,130 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
       fw.pts.push_back(q);
     }
   }
-  // The gate: kGateSigmas of each band's total spread (white and common together, as a false point
-  // is judged before any fit); a true point lies beyond it once in 16 000 for Gaussian errors.
-  std::array<double, kClasses> total{}, centre{};
+  return work;
+}
+
+// What the run's own residuals say about its errors (the noise the bound uses).
+struct NoiseModel {
+  std::array<double, kClasses> total{}, centre{};  // each class's total spread and its centre (the first gate)
   std::array<std::size_t, kClasses> raw_count{};
-  for (std::size_t b = 0; b < kClasses; ++b) {
-    raw_count[b] = raw[b].size();
-    total[b] = std::max(kSigmaFloor, robust_sigma(std::move(raw[b]), &centre[b]));
-  }
+  std::array<double, kClasses> sigma{};            // white noise per class, the tilt taken out
+  std::array<std::size_t, kClasses> counts{};
+  std::array<double, kClasses> medians{};
   std::size_t false_points = 0, spot_points = 0;
+  double line_corr = 0.0;
+  Eigen::Matrix2d tilt_cov = Eigen::Matrix2d::Zero();  // the vibration's covariance (roll, pitch)
+  Eigen::Vector2d tilt_sigma = Eigen::Vector2d(std::nan(""), std::nan(""));
+  std::vector<double> tx, ty;  // every fitted tilt: their median is a static tilt
+};
+
+// The first gate: kGateSigmas of each class's total spread (white and common together, as a false
+// point is judged before any fit); a true point lies beyond it once in 16 000 for Gaussian errors.
+void gate_points(std::vector<FrameWork>& work, std::array<std::vector<double>, kClasses>& raw, NoiseModel& nm) {
+  for (std::size_t b = 0; b < kClasses; ++b) {
+    nm.raw_count[b] = raw[b].size();
+    nm.total[b] = std::max(kSigmaFloor, robust_sigma(std::move(raw[b]), &nm.centre[b]));
+  }
   for (auto& fw : work) {
-    spot_points += fw.spot_points;
-    false_points += fw.far_points;
+    nm.spot_points += fw.spot_points;
+    nm.false_points += fw.far_points;
     for (auto& q : fw.pts) {
       const std::size_t b = static_cast<std::size_t>(q.band);
-      q.near = std::isfinite(total[b]) && std::fabs(q.residual - centre[b]) <= kGateSigmas * total[b];
+      q.near = std::isfinite(nm.total[b]) && std::fabs(q.residual - nm.centre[b]) <= kGateSigmas * nm.total[b];
       q.inlier = q.near;
     }
   }
+}
 
-  // Pass 2: the per-frame tilt and the white noise, twice (weights from the total spread first,
-  // then from the white sigmas they gave). The second time, a point is first judged against its
-  // own frame's tilt: farther than kGateSigmas white sigmas from its marking once the frame's tilt
-  // is taken out, it is not that marking's (a far point can be 30 cm off through the tilt alone, so
-  // the first gate must be wide; this one is not).
-  std::array<double, kClasses> sigma = total;
-  std::array<std::size_t, kClasses> counts{};
-  std::array<double, kClasses> medians{};
+// Pass 2: the per-frame tilt and the white noise, twice (weights from the total spread first,
+// then from the white sigmas they gave). The second time, a point is first judged against its
+// own frame's tilt: farther than kGateSigmas white sigmas from its marking once the frame's tilt
+// is taken out, it is not that marking's (a far point can be 30 cm off through the tilt alone, so
+// the first gate must be wide; this one is not).
+void estimate_white_noise(std::vector<FrameWork>& work, double h, NoiseModel& nm) {
+  nm.sigma = nm.total;
   for (int it = 0; it < 2; ++it) {
     if (it > 0)
       for (auto& fw : work)
         for (auto& q : fw.pts) {
           if (!q.near || !fw.tilt_fitted) continue;
           const double white = q.residual - tilt_row(q, fw.pose, h).dot(fw.tilt);
-          q.inlier = std::fabs(white) <= kGateSigmas * sigma[static_cast<std::size_t>(q.band)];
+          q.inlier = std::fabs(white) <= kGateSigmas * nm.sigma[static_cast<std::size_t>(q.band)];
         }
-    fit_tilts(work, sigma, h);
-    std::array<double, kClasses> white = white_sigmas(work, sigma, h, &counts, &medians);
+    fit_tilts(work, nm.sigma, h);
+    std::array<double, kClasses> white = white_sigmas(work, nm.sigma, h, &nm.counts, &nm.medians);
     for (std::size_t b = 0; b < kClasses; ++b) {
       // Too few points for a class of its own: the larger of its band's two (the conservative side
       // is the smaller information, a bound that cannot be beaten by a wrong noise figure).
-      if (counts[b] < kMinClassPoints) {
+      if (nm.counts[b] < kMinClassPoints) {
         const double other = white[(b + kBands) % kClasses];
-        white[b] = counts[(b + kBands) % kClasses] >= kMinClassPoints ? std::max(other, std::isfinite(white[b]) ? white[b] : other) : std::nan("");
+        white[b] = nm.counts[(b + kBands) % kClasses] >= kMinClassPoints ? std::max(other, std::isfinite(white[b]) ? white[b] : other) : std::nan("");
       }
-      sigma[b] = std::isfinite(white[b]) ? std::max(kSigmaFloor, white[b]) : total[b];
+      nm.sigma[b] = std::isfinite(white[b]) ? std::max(kSigmaFloor, white[b]) : nm.total[b];
     }
   }
   for (const auto& fw : work)
-    for (const auto& q : fw.pts) false_points += !q.inlier;
-  fit_tilts(work, sigma, h);
+    for (const auto& q : fw.pts) nm.false_points += !q.inlier;
+  fit_tilts(work, nm.sigma, h);
   // Points on one marking in one frame share part of their error (the line's image as a whole: its
   // edges' blur and classification along its length), measured here and modelled as one offset per
   // marking and frame; ignoring it made the bound about a third too optimistic on the tracking path.
-  const double line_corr = line_correlation(work, sigma, medians, h);
-  // The tilt's spread over frames, less the fits' own noise: the vibration the frames carried. Its
-  // median is a static tilt (a mirror mounted askew): a bias, reported, not in the bound.
-  std::vector<double> tx, ty, vx, vy;
+  nm.line_corr = line_correlation(work, nm.sigma, nm.medians, h);
+}
+
+// The tilt's spread over frames, less the fits' own noise: the vibration the frames carried. Its
+// median is a static tilt (a mirror mounted askew): a bias, reported, not in the bound.
+void estimate_tilt_spread(const std::vector<FrameWork>& work, NoiseModel& nm) {
+  std::vector<double> vx, vy;
   for (const auto& fw : work)
     if (fw.tilt_fitted) {
-      tx.push_back(fw.tilt.x());
-      ty.push_back(fw.tilt.y());
+      nm.tx.push_back(fw.tilt.x());
+      nm.ty.push_back(fw.tilt.y());
       vx.push_back(fw.tilt_var(0, 0));
       vy.push_back(fw.tilt_var(1, 1));
     }
-  Eigen::Matrix2d tilt_cov = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d tilt_sigma(std::nan(""), std::nan(""));
-  if (tx.size() >= 10) {
-    const double sx = robust_sigma(tx), sy = robust_sigma(ty);
-    tilt_cov(0, 0) = std::max(0.0, sx * sx - median(vx));
-    tilt_cov(1, 1) = std::max(0.0, sy * sy - median(vy));
-    tilt_sigma = Eigen::Vector2d(std::sqrt(tilt_cov(0, 0)), std::sqrt(tilt_cov(1, 1)));
+  if (nm.tx.size() >= 10) {
+    const double sx = robust_sigma(nm.tx), sy = robust_sigma(nm.ty);
+    nm.tilt_cov(0, 0) = std::max(0.0, sx * sx - median(vx));
+    nm.tilt_cov(1, 1) = std::max(0.0, sy * sy - median(vy));
+    nm.tilt_sigma = Eigen::Vector2d(std::sqrt(nm.tilt_cov(0, 0)), std::sqrt(nm.tilt_cov(1, 1)));
   }
+}
 
-  // The compass: its declared white noise in the bound; measured beside it from the readings'
-  // frame-to-frame differences (a slowly walking bias cancels in them) and its median offset.
-  std::vector<double> hd, hoff;
-  {
-    std::optional<double> last;
-    for (const auto& r : frames) {
-      if (!r.heading) continue;
-      const double e = angle_diff(*r.heading, r.truth.theta);
-      hoff.push_back(e);
-      if (last) hd.push_back(angle_diff(e, *last) / std::sqrt(2.0));
-      last = e;
-    }
+// The compass readings against the truth: frame-to-frame differences (a slowly walking bias cancels
+// in them) for its measured white noise, and the offsets for its median bias.
+struct CompassReadings {
+  std::vector<double> diffs, offsets;
+};
+CompassReadings compass_readings(const std::vector<FrameRecord>& frames) {
+  CompassReadings c;
+  std::optional<double> last;
+  for (const auto& r : frames) {
+    if (!r.heading) continue;
+    const double e = angle_diff(*r.heading, r.truth.theta);
+    c.offsets.push_back(e);
+    if (last) c.diffs.push_back(angle_diff(e, *last) / std::sqrt(2.0));
+    last = e;
   }
-  const bool compass = setup.has_heading_sensor && !hoff.empty();
-  const double compass_sigma = std::max(kCompassFloor, setup.heading_sigma);
+  return c;
+}
 
-  // Pass 3: each frame's information and single-frame bound.
-  std::vector<Eigen::Matrix3d> info(nf, Eigen::Matrix3d::Zero());
-  std::map<std::string, std::size_t> why;
-  Series single;
+// Pass 3's results: each frame's information, the single-frame bounds and the efficient
+// estimator's error beside them (the bound's own check).
+struct SingleFrame {
+  std::vector<Eigen::Matrix3d> info;
+  std::map<std::string, std::size_t> why;  // frames without a finite bound, by reason
+  Series series;
   std::size_t used_points = 0;
   double oracle_pos = 0, oracle_th = 0, oracle_bpos = 0, oracle_bth = 0;
+};
+
+// Pass 3: each frame's information and single-frame bound (into `out_frames`).
+SingleFrame single_frame_bounds(const std::vector<FrameRecord>& frames, const std::vector<FrameWork>& work, const NoiseModel& nm,
+                                bool compass, double compass_sigma, std::vector<FrameBound>& out_frames) {
+  const std::size_t nf = frames.size();
+  SingleFrame sf;
+  sf.info.assign(nf, Eigen::Matrix3d::Zero());
   std::vector<BoundRow> rows;
   std::map<int, int> line_of;
   for (std::size_t k = 0; k < nf; ++k) {
@@ -695,22 +719,22 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     line_of.clear();
     for (const auto& q : fw.pts) {
       if (!q.inlier) continue;
-      const double s = sigma[static_cast<std::size_t>(q.band)];
+      const double s = nm.sigma[static_cast<std::size_t>(q.band)];
       BoundRow row;  // bound_row's, from what the match already computed
       row.h = q.h;
-      row.var = (1.0 - line_corr) * s * s;
+      row.var = (1.0 - nm.line_corr) * s * s;
       row.a = q.a;
       row.e = q.residual;
       row.line = line_of.try_emplace(q.marking, static_cast<int>(line_of.size())).first->second;
       row.load = s;
       rows.push_back(row);
     }
-    used_points += rows.size();
+    sf.used_points += rows.size();
     Eigen::Vector3d score = Eigen::Vector3d::Zero();
-    if (frames[k].camera_ok) info[k] = frame_information(rows, tilt_cov, line_corr, &score);
+    if (frames[k].camera_ok) sf.info[k] = frame_information(rows, nm.tilt_cov, nm.line_corr, &score);
     const bool has_compass = compass && frames[k].heading.has_value();
     if (has_compass) {
-      info[k](2, 2) += 1.0 / (compass_sigma * compass_sigma);
+      sf.info[k](2, 2) += 1.0 / (compass_sigma * compass_sigma);
       score(2) += angle_diff(*frames[k].heading, frames[k].truth.theta) / (compass_sigma * compass_sigma);
     }
     std::string reason;
@@ -719,69 +743,71 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     else if (rows.empty()) reason = "no point near a marking";
     else if (rows.size() + (has_compass ? 1 : 0) < 3) reason = "fewer than 3 points";
     if (reason.empty()) {
-      const CovarianceBound cb = invert_information(info[k]);
+      const CovarianceBound cb = invert_information(sf.info[k]);
       if (cb.finite) {
-        out.frames[k].pos = std::sqrt(cb.cov(0, 0) + cb.cov(1, 1));
-        out.frames[k].heading = std::sqrt(cb.cov(2, 2));
-        single.pos.push_back(*out.frames[k].pos);
-        single.heading.push_back(*out.frames[k].heading);
+        out_frames[k].pos = std::sqrt(cb.cov(0, 0) + cb.cov(1, 1));
+        out_frames[k].heading = std::sqrt(cb.cov(2, 2));
+        sf.series.pos.push_back(*out_frames[k].pos);
+        sf.series.heading.push_back(*out_frames[k].heading);
         // The efficient estimator's error on this frame: one generalized least-squares step from
         // the truth with the true association and the measured noise (its residual model is linear
         // there, so one step is its solution to first order). The residual's sign is that of
         // measured minus true, so the step is the estimate's error.
         const Eigen::Vector3d err = -cb.cov * score;
-        oracle_pos += err.head<2>().squaredNorm();
-        oracle_th += err(2) * err(2);
-        oracle_bpos += cb.cov(0, 0) + cb.cov(1, 1);
-        oracle_bth += cb.cov(2, 2);
+        sf.oracle_pos += err.head<2>().squaredNorm();
+        sf.oracle_th += err(2) * err(2);
+        sf.oracle_bpos += cb.cov(0, 0) + cb.cov(1, 1);
+        sf.oracle_bth += cb.cov(2, 2);
         continue;
       }
       reason = singular_reason(fw);
     }
-    ++why[reason];
+    ++sf.why[reason];
   }
+  return sf;
+}
 
-  // The posterior bound: pose and, with a wheel-scale error, the three scale factors (constant over
-  // the run, so their error is carried from frame to frame rather than drawn anew).
-  // Always six states: without a scale error their variance is 0 and they change nothing.
-  constexpr bool scales = true;
-  using M6 = Eigen::Matrix<double, 6, 6>;
+// The posterior bound: pose and, with a wheel-scale error, the three scale factors (constant over
+// the run, so their error is carried from frame to frame rather than drawn anew). Always six
+// states: without a scale error their variance is 0 and they change nothing.
+using M6 = Eigen::Matrix<double, 6, 6>;
+
+// The motion model x_b = x_a (+) (s * u) at the true poses and the true increment u: its Jacobian
+// F and the odometry's noise Q over the increment.
+void motion_model(const Pose2& a, const Pose2& to, const BoundSetup& setup, M6& Fm, M6& Qm) {
+  Fm.setIdentity();
+  Qm.setZero();
+  const Pose2 u = a.between(to);
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  Fm(0, 2) = -s * u.x - c * u.y;
+  Fm(1, 2) = c * u.x - s * u.y;
+  Fm(0, 3) = c * u.x;
+  Fm(0, 4) = -s * u.y;
+  Fm(1, 3) = s * u.x;
+  Fm(1, 4) = c * u.y;
+  Fm(2, 5) = u.theta;
+  // sim/sensors.cpp: per step N(0, trans_sigma^2 d) on each axis (isotropic, so the same in the
+  // world frame) and N(0, rot_sigma^2 |dtheta| + rot_per_trans^2 d) on the heading; summed over a
+  // frame's steps, the variances add along the path.
+  const double d = std::hypot(u.x, u.y), turn = std::fabs(u.theta);
+  Qm(0, 0) = Qm(1, 1) = setup.trans_sigma * setup.trans_sigma * d;
+  Qm(2, 2) = setup.rot_sigma * setup.rot_sigma * turn + setup.rot_per_trans * setup.rot_per_trans * d;
+}
+
+// The posterior recursion over the frames (into `out_frames`); `resets` sorted.
+Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const std::vector<Eigen::Matrix3d>& info,
+                        const std::vector<double>& resets, const BoundSetup& setup, const Field& field, std::vector<FrameBound>& out_frames) {
   const double fx = 2.0 * field.half_floor_x(), fy = 2.0 * field.half_floor_y();
   // Without the start pose, and after a kidnap, the localizer knows only that the robot is on the
   // floor: a prior with the variance of a uniform position on it and a uniform heading.
   const Eigen::Vector3d uniform(fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0);
   M6 P = M6::Zero();
   if (!setup.start_pose_given) P.topLeftCorner<3, 3>() = uniform.asDiagonal();
-  if (scales) P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
+  P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
   Series post;
   std::size_t reset_at = 0;
-  std::vector<double> resets = setup.resets;
-  std::sort(resets.begin(), resets.end());
   M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
-  // The motion model x_b = x_a (+) (s * u) at the true poses and the true increment u: its Jacobian
-  // F and the odometry's noise Q over the increment.
-  const auto motion = [&](const Pose2& a, const Pose2& to, M6& Fm, M6& Qm) {
-    Fm.setIdentity();
-    Qm.setZero();
-    const Pose2 u = a.between(to);
-    const double c = std::cos(a.theta), s = std::sin(a.theta);
-    Fm(0, 2) = -s * u.x - c * u.y;
-    Fm(1, 2) = c * u.x - s * u.y;
-    if (scales) {
-      Fm(0, 3) = c * u.x;
-      Fm(0, 4) = -s * u.y;
-      Fm(1, 3) = s * u.x;
-      Fm(1, 4) = c * u.y;
-      Fm(2, 5) = u.theta;
-    }
-    // sim/sensors.cpp: per step N(0, trans_sigma^2 d) on each axis (isotropic, so the same in the
-    // world frame) and N(0, rot_sigma^2 |dtheta| + rot_per_trans^2 d) on the heading; summed over a
-    // frame's steps, the variances add along the path.
-    const double d = std::hypot(u.x, u.y), turn = std::fabs(u.theta);
-    Qm(0, 0) = Qm(1, 1) = setup.trans_sigma * setup.trans_sigma * d;
-    Qm(2, 2) = setup.rot_sigma * setup.rot_sigma * turn + setup.rot_per_trans * setup.rot_per_trans * d;
-  };
-  for (std::size_t k = 0; k < nf; ++k) {
+  for (std::size_t k = 0; k < frames.size(); ++k) {
     F.setIdentity();
     Q.setZero();
     bool reset = false;
@@ -791,12 +817,10 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     }
     if (reset) {
       P.topLeftCorner<3, 3>() = uniform.asDiagonal();
-      if (scales) {
-        P.topRightCorner<3, 3>().setZero();
-        P.bottomLeftCorner<3, 3>().setZero();
-      }
+      P.topRightCorner<3, 3>().setZero();
+      P.bottomLeftCorner<3, 3>().setZero();
     } else if (k > 0) {
-      motion(poses[k - 1], poses[k], F, Q);
+      motion_model(poses[k - 1], poses[k], setup, F, Q);
     }
     Jz.setZero();
     Jz.topLeftCorner<3, 3>() = info[k];
@@ -805,37 +829,127 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
     // the latency later: carried forward through the odometry over it (its noise included).
     M6 Pf = P;
     if (setup.latency_s > 0) {
-      motion(poses[k], frames[k].truth, F, Q);
+      motion_model(poses[k], frames[k].truth, setup, F, Q);
       Pf = F * P * F.transpose() + Q;
     }
     const double pp = std::max(0.0, Pf(0, 0) + Pf(1, 1)), ph = std::max(0.0, Pf(2, 2));
-    out.frames[k].ppos = std::sqrt(pp);
-    out.frames[k].pheading = std::sqrt(ph);
-    post.pos.push_back(*out.frames[k].ppos);
-    post.heading.push_back(*out.frames[k].pheading);
+    out_frames[k].ppos = std::sqrt(pp);
+    out_frames[k].pheading = std::sqrt(ph);
+    post.pos.push_back(*out_frames[k].ppos);
+    post.heading.push_back(*out_frames[k].pheading);
   }
+  return post;
+}
 
-  // The odometry's error per frame against the truth's increments, beside the model's prediction
-  // (the physics' wheel slip is not in the declared model and shows here).
+// The odometry's error per frame against the truth's increments, beside the model's prediction
+// (the physics' wheel slip is not in the declared model and shows here).
+struct OdometryError {
   std::vector<double> ox, oy, ot;
-  double px = 0, pt = 0;
-  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
-  // the frames carry odometry at all, which the setup says.
-  const bool odometry = setup.has_odometry;
-  for (std::size_t k = 1; k < nf; ++k) {
+  double px = 0, pt = 0;  // the declared model's variance, summed over the frames
+};
+OdometryError odometry_error(const std::vector<FrameRecord>& frames, const std::vector<double>& resets, const BoundSetup& setup) {
+  OdometryError o;
+  for (std::size_t k = 1; k < frames.size(); ++k) {
     const FrameRecord& r = frames[k];
     bool reset = false;
     for (double tr : resets) reset = reset || moved_between(tr, frames[k - 1].t, r.t);
     if (reset) continue;
     const Pose2 u = frames[k - 1].truth.between(r.truth);
-    ox.push_back(r.odometry.x - u.x);
-    oy.push_back(r.odometry.y - u.y);
-    ot.push_back(angle_diff(r.odometry.theta, u.theta));
+    o.ox.push_back(r.odometry.x - u.x);
+    o.oy.push_back(r.odometry.y - u.y);
+    o.ot.push_back(angle_diff(r.odometry.theta, u.theta));
     const double d = std::hypot(u.x, u.y);
-    px += setup.trans_sigma * setup.trans_sigma * d + std::pow(setup.scale_sigma * std::max(std::fabs(u.x), std::fabs(u.y)), 2);
-    pt += setup.rot_sigma * setup.rot_sigma * std::fabs(u.theta) + setup.rot_per_trans * setup.rot_per_trans * d +
-          std::pow(setup.scale_sigma * u.theta, 2);
+    o.px += setup.trans_sigma * setup.trans_sigma * d + std::pow(setup.scale_sigma * std::max(std::fabs(u.x), std::fabs(u.y)), 2);
+    o.pt += setup.rot_sigma * setup.rot_sigma * std::fabs(u.theta) + setup.rot_per_trans * setup.rot_per_trans * d +
+            std::pow(setup.scale_sigma * u.theta, 2);
   }
+  return o;
+}
+
+// The bound's own check on this run's data: the efficient estimator reaches the bound only if the
+// noise model is right (ratio 1); a ratio above 1 is error the model does not have (correlation
+// between points it takes as independent, a bias), and the bound is then optimistic by about it.
+Json check_json(const SingleFrame& sf) {
+  const double nn = static_cast<double>(sf.series.pos.size());
+  Json c{{"estimator", "generalized least squares from the true pose, true association, the measured noise"}, {"frames", sf.series.pos.size()}};
+  c["position_rms_m"] = nn > 0 ? Json(std::sqrt(sf.oracle_pos / nn)) : Json(nullptr);
+  c["heading_rms_rad"] = nn > 0 ? Json(std::sqrt(sf.oracle_th / nn)) : Json(nullptr);
+  c["position_ratio"] = sf.oracle_bpos > 0 ? Json(std::sqrt(sf.oracle_pos / sf.oracle_bpos)) : Json(nullptr);
+  c["heading_ratio"] = sf.oracle_bth > 0 ? Json(std::sqrt(sf.oracle_th / sf.oracle_bth)) : Json(nullptr);
+  return c;
+}
+
+// summary.json's bound.noise: the measured noise per class, the declared beside it.
+Json noise_json(const NoiseModel& nm, std::size_t used_points, double h, const BoundSetup& setup) {
+  Json bands = Json::array(), measured = Json::array(), grazing = Json::array(), declared = Json::array(), band_pts = Json::array(),
+       grazing_pts = Json::array(), band_med = Json::array(), band_total = Json::array();
+  for (std::size_t i = 0; i < kBands; ++i) {
+    const std::size_t g = i + kBands;
+    bands.push_back(kBoundBands[i]);
+    measured.push_back(nm.counts[i] ? num_or_null(nm.sigma[i]) : Json(nullptr));
+    grazing.push_back(nm.counts[g] ? num_or_null(nm.sigma[g]) : Json(nullptr));
+    declared.push_back(nullptr);
+    band_pts.push_back(nm.counts[i]);
+    grazing_pts.push_back(nm.counts[g]);
+    band_med.push_back(nm.counts[i] ? num_or_null(nm.medians[i]) : Json(nullptr));
+    band_total.push_back(nm.raw_count[i] ? num_or_null(nm.total[i]) : Json(nullptr));
+  }
+  Json n = {{"bands_m", bands},
+            {"measured_sigma_m", measured},
+            {"declared_sigma_m", declared},
+            {"declared_why", "the profile declares pixel noise, not a line point's position noise (that comes from the image's sampling and edge "
+                             "finding at each range): nothing to derive it from"},
+            {"band_points", band_pts},
+            {"grazing_sigma_m", grazing},
+            {"grazing_points", grazing_pts},
+            {"grazing_below", kGrazing},
+            {"band_median_m", band_med},
+            {"total_sigma_m", band_total},
+            {"points", used_points},
+            {"false_points", nm.false_points},
+            {"spot_points", nm.spot_points},
+            {"gate_sigmas", kGateSigmas},
+            {"line_correlation", nm.line_corr},
+            {"estimator", "1.4826 x MAD of the residuals at the true exposure pose, less each frame's fitted tilt"}};
+  n["common_mode"] = {{"model", "a per-frame tilt of the mirror (roll, pitch) shifts each point by about (r^2 + h^2) / h per radian along its range"},
+                      {"mount_height_m", h},
+                      {"measured_sigma_rad", nm.tilt_sigma.allFinite() ? Json::array({nm.tilt_sigma.x(), nm.tilt_sigma.y()}) : Json(nullptr)},
+                      {"declared_sigma_rad", setup.vibration_std},
+                      {"declared_tilt_per_accel_rad_per_mps2", setup.tilt_per_accel},
+                      {"static_rad", nm.tx.empty() ? Json(nullptr) : Json::array({median(nm.tx), median(nm.ty)})},
+                      {"frames", nm.tx.size()}};
+  return n;
+}
+
+}  // namespace
+
+RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
+  RobotBound out;
+  const auto& frames = robot.frames;
+  const std::size_t nf = frames.size();
+  out.frames.resize(nf);
+  const double h = setup.mount_height;
+  const Field& field = *setup.field;
+
+  const std::vector<Pose2> poses = exposure_poses(robot, setup);
+  std::array<std::vector<double>, kClasses> raw;
+  std::vector<FrameWork> work = match_points(frames, poses, field, h, raw);
+  NoiseModel nm;
+  gate_points(work, raw, nm);
+  estimate_white_noise(work, h, nm);
+  estimate_tilt_spread(work, nm);
+  // The compass: its declared white noise in the bound; measured beside it.
+  const CompassReadings cr = compass_readings(frames);
+  const bool compass = setup.has_heading_sensor && !cr.offsets.empty();
+  const double compass_sigma = std::max(kCompassFloor, setup.heading_sigma);
+  const SingleFrame sf = single_frame_bounds(frames, work, nm, compass, compass_sigma, out.frames);
+  std::vector<double> resets = setup.resets;
+  std::sort(resets.begin(), resets.end());
+  const Series post = posterior_bounds(frames, poses, sf.info, resets, setup, field, out.frames);
+  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
+  // the frames carry odometry at all, which the setup says.
+  const bool odometry = setup.has_odometry;
+  const OdometryError oe = odometry_error(frames, resets, setup);
 
   // Latency: the shift between the pose the image shows and the pose scored, a bias of any
   // localizer that does not carry its estimate forward by the odometry over the latency.
@@ -847,79 +961,32 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
 
   const std::size_t scored = nf;
   Json& b = out.bound;
-  b["single_frame"] = series_json(single, scored);
-  // The bound's own check on this run's data: the efficient estimator reaches the bound only if the
-  // noise model is right (ratio 1); a ratio above 1 is error the model does not have (correlation
-  // between points it takes as independent, a bias), and the bound is then optimistic by about it.
-  {
-    const double nn = static_cast<double>(single.pos.size());
-    Json c{{"estimator", "generalized least squares from the true pose, true association, the measured noise"}, {"frames", single.pos.size()}};
-    c["position_rms_m"] = nn > 0 ? Json(std::sqrt(oracle_pos / nn)) : Json(nullptr);
-    c["heading_rms_rad"] = nn > 0 ? Json(std::sqrt(oracle_th / nn)) : Json(nullptr);
-    c["position_ratio"] = oracle_bpos > 0 ? Json(std::sqrt(oracle_pos / oracle_bpos)) : Json(nullptr);
-    c["heading_ratio"] = oracle_bth > 0 ? Json(std::sqrt(oracle_th / oracle_bth)) : Json(nullptr);
-    b["single_frame"]["check"] = c;
-  }
+  b["single_frame"] = series_json(sf.series, scored);
+  b["single_frame"]["check"] = check_json(sf);
   b["posterior"] = series_json(post, scored);
   b["posterior"]["prior"] = setup.start_pose_given ? "the true start pose (the localizer was given it)"
                                                    : "uniform over the floor and heading (the localizer was not given its start)";
   if (!setup.resets.empty()) b["posterior"]["restarts_at_s"] = setup.resets;
   std::size_t no_bound = 0;
   Json why_j = Json::object();
-  for (const auto& [k, v] : why) {
+  for (const auto& [k, v] : sf.why) {
     why_j[k] = v;
     no_bound += v;
   }
   b["no_bound"] = {{"frames", no_bound}, {"why", why_j}};
-  Json bands = Json::array(), measured = Json::array(), grazing = Json::array(), declared = Json::array(), band_pts = Json::array(),
-       grazing_pts = Json::array(), band_med = Json::array(), band_total = Json::array();
-  for (std::size_t i = 0; i < kBands; ++i) {
-    const std::size_t g = i + kBands;
-    bands.push_back(kBoundBands[i]);
-    measured.push_back(counts[i] ? num_or_null(sigma[i]) : Json(nullptr));
-    grazing.push_back(counts[g] ? num_or_null(sigma[g]) : Json(nullptr));
-    declared.push_back(nullptr);
-    band_pts.push_back(counts[i]);
-    grazing_pts.push_back(counts[g]);
-    band_med.push_back(counts[i] ? num_or_null(medians[i]) : Json(nullptr));
-    band_total.push_back(raw_count[i] ? num_or_null(total[i]) : Json(nullptr));
-  }
-  b["noise"] = {{"bands_m", bands},
-                {"measured_sigma_m", measured},
-                {"declared_sigma_m", declared},
-                {"declared_why", "the profile declares pixel noise, not a line point's position noise (that comes from the image's sampling and edge "
-                                 "finding at each range): nothing to derive it from"},
-                {"band_points", band_pts},
-                {"grazing_sigma_m", grazing},
-                {"grazing_points", grazing_pts},
-                {"grazing_below", kGrazing},
-                {"band_median_m", band_med},
-                {"total_sigma_m", band_total},
-                {"points", used_points},
-                {"false_points", false_points},
-                {"spot_points", spot_points},
-                {"gate_sigmas", kGateSigmas},
-                {"line_correlation", line_corr},
-                {"estimator", "1.4826 x MAD of the residuals at the true exposure pose, less each frame's fitted tilt"}};
-  b["noise"]["common_mode"] = {{"model", "a per-frame tilt of the mirror (roll, pitch) shifts each point by about (r^2 + h^2) / h per radian along its range"},
-                               {"mount_height_m", h},
-                               {"measured_sigma_rad", tilt_sigma.allFinite() ? Json::array({tilt_sigma.x(), tilt_sigma.y()}) : Json(nullptr)},
-                               {"declared_sigma_rad", setup.vibration_std},
-                               {"declared_tilt_per_accel_rad_per_mps2", setup.tilt_per_accel},
-                               {"static_rad", tx.empty() ? Json(nullptr) : Json::array({median(tx), median(ty)})},
-                               {"frames", tx.size()}};
+  b["noise"] = noise_json(nm, sf.used_points, h, setup);
   if (setup.has_heading_sensor) {
     b["compass"] = {{"declared_sigma_rad", setup.heading_sigma},
                     {"used_sigma_rad", compass_sigma},
-                    {"measured_sigma_rad", hd.size() >= 2 ? num_or_null(robust_sigma(hd)) : Json(nullptr)},
-                    {"measured_bias_rad", hoff.empty() ? Json(nullptr) : num_or_null(median(hoff))},
-                    {"readings", hoff.size()}};
+                    {"measured_sigma_rad", cr.diffs.size() >= 2 ? num_or_null(robust_sigma(cr.diffs)) : Json(nullptr)},
+                    {"measured_bias_rad", cr.offsets.empty() ? Json(nullptr) : num_or_null(median(cr.offsets))},
+                    {"readings", cr.offsets.size()}};
   }
-  const double no = static_cast<double>(ox.size());
-  b["odometry"] = {{"declared_sigma", ox.empty() ? Json(nullptr) : Json::array({std::sqrt(px / no), std::sqrt(px / no), std::sqrt(pt / no)})},
-                   {"measured_sigma", ox.size() >= 2 ? Json::array({robust_sigma(ox), robust_sigma(oy), robust_sigma(ot)}) : Json(nullptr)},
+  const double no = static_cast<double>(oe.ox.size());
+  b["odometry"] = {{"declared_sigma", oe.ox.empty() ? Json(nullptr) : Json::array({std::sqrt(oe.px / no), std::sqrt(oe.px / no), std::sqrt(oe.pt / no)})},
+                   {"measured_sigma", oe.ox.size() >= 2 ? Json::array({robust_sigma(oe.ox), robust_sigma(oe.oy), robust_sigma(oe.ot)}) : Json(nullptr)},
                    {"units", "per frame: x, y (m, robot frame), theta (rad)"},
-                   {"frames", ox.size()}};
+                   {"frames", oe.ox.size()}};
   b["latency"] = {{"latency_s", setup.latency_s},
                   {"position_shift_rms_m", nf ? Json(std::sqrt(lat_pos / static_cast<double>(nf))) : Json(nullptr)},
                   {"heading_shift_rms_rad", nf ? Json(std::sqrt(lat_th / static_cast<double>(nf))) : Json(nullptr)},
