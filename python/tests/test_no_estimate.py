@@ -220,6 +220,9 @@ class NoEstimate(unittest.TestCase):
             self.assertIn("| `position_m/rmse` |", md)
             self.assertIn("no estimate in 1 of 1 runs (A and B)", md)
             dom = (tmp / "rep" / "report.html").read_text()
+            # The collapsed block of the sweep's runs (report.html only) names the sweep, not the
+            # localizer of its last row.
+            self.assertIn("<summary>Runs of sweep hw: 2 runs, tables and plots</summary>", dom)
             ok, detail = K.check_no_raw_keys(dom, K.reader_names() | {"hw"})
             self.assertTrue(ok, detail)
             self.assertEqual(K.negative_bounds(K.visible_text(dom)), [])

@@ -117,10 +117,7 @@ def report_sweep(rep: Writer, sweep: pathlib.Path, all_runs: list[Run], max_runs
     flagged = shown_flagged + seed_table(rep, rows_runs, caption_extra=" The sweep's aggregate.json and aggregate.csv hold the same intervals by the same rule (column interval: t95 or range).")
     # Per run: its tables always; plots for the first seed of each group (every condition shown
     # once, at most max_runs) and for every outlying seed, collapsed: a reader opens what they need.
-    # The title names the localizer row of the sweep's last run, not the sweep (as it always has: the
-    # same report byte for byte; naming the sweep is a change of its own).
-    last = runs[-1][2] if runs else name
-    rep.details(f"Runs of sweep {last}: {len(runs)} runs, tables and plots")
+    rep.details(f"Runs of sweep {name}: {len(runs)} runs, tables and plots")
     plotted = 0
     seen: set[tuple[Optional[str], Optional[str], str]] = set()
     for run, params, row_name in runs:
