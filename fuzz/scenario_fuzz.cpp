@@ -78,7 +78,7 @@ void replay_recording(const std::string& dir, std::size_t choice) {
   using namespace omniloc;
   harness::RecordingHeader header = harness::RecordingHeader::read(dir);
   const Json localizer = {{"type", kLocalizers[choice % std::size(kLocalizers)]}};
-  const harness::Scenario sc = harness::replay_scenario(header, localizer);
+  const harness::Scenario sc = harness::replay_scenario(header, harness::LocalizerSpec(localizer, "--localizer"));
   harness::RecordingSource source(std::move(header));
   harness::RunOptions o;
   o.out_dir = sweep_dir() + "/replay";
