@@ -38,7 +38,7 @@ from mutation_validate import mutate
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SEEDS = [ROOT / "data" / "recordings" / "ci_tracking" / "1", ROOT / "tests" / "data" / "handwritten_recording"]
-LOCALIZERS = ["matching", "grid_global", "mcl", "hybrid", "landmarks", "odometry_only"]
+LOCALIZERS = ["matching", "grid_global", "mcl", "hybrid", "landmarks", "odometry_only", "ukf_mh"]
 
 # Values at and past docs/recording.md's limits (50 m, 1000 rad, 3600 s, exposure 1e4 ms, gain 1e3),
 # and ones that overflow a localizer's arithmetic.
