@@ -74,7 +74,7 @@ void fuzz_olp_stream(std::string_view bytes) {
 // into a scratch run folder: its values (not only its structure) reach the localizers, as with
 // `omniloc replay` (a line point at -1e308 m once crashed matching and grid_global).
 void replay_recording(const std::string& dir, std::size_t choice) {
-  static const char* const kLocalizers[] = {"matching", "grid_global", "mcl", "hybrid", "landmarks", "odometry_only"};
+  static const char* const kLocalizers[] = {"matching", "grid_global", "mcl", "hybrid", "landmarks", "odometry_only", "ukf_mh"};
   using namespace omniloc;
   harness::RecordingHeader header = harness::RecordingHeader::read(dir);
   const Json localizer = {{"type", kLocalizers[choice % std::size(kLocalizers)]}};
