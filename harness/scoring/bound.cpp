@@ -126,6 +126,17 @@ void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, int index, do
   }
 }
 
+// A painted spot is a disc: a point on it has no normal, so it measures nothing the bound can use.
+void consider_spot(const Eigen::Vector2d& w, const SpotMarking& s, double& best, MarkingMatch& m) {
+  const double d = std::max(0.0, (w - s.centre).norm() - s.radius);
+  if (d < best) {
+    best = d;
+    m.kind = 2;
+    m.marking = -1;
+    m.residual = d;
+  }
+}
+
 }  // namespace
 
 MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w) {
@@ -134,16 +145,7 @@ MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w) {
   int index = 0;
   for (const auto& s : field.segments) consider_segment(w, s.a, s.b, index++, best, m);
   for (const auto& a : field.arcs) consider_arc(w, a, index++, best, m);
-  // A painted spot is a disc: a point on it has no normal, so it measures nothing the bound can use.
-  for (const auto& s : field.spots) {
-    const double d = std::max(0.0, (w - s.centre).norm() - s.radius);
-    if (d < best) {
-      best = d;
-      m.kind = 2;
-      m.marking = -1;
-      m.residual = d;
-    }
-  }
+  for (const auto& s : field.spots) consider_spot(w, s, best, m);
   return m;
 }
 
@@ -520,16 +522,7 @@ class MarkingIndex {
     const int nseg = static_cast<int>(f_.segments.size());
     for (int k : cell.segments) consider_segment(w, f_.segments[static_cast<std::size_t>(k)].a, f_.segments[static_cast<std::size_t>(k)].b, k, best, m);
     for (int k : cell.arcs) consider_arc(w, f_.arcs[static_cast<std::size_t>(k)], nseg + k, best, m);
-    for (int k : cell.spots) {
-      const auto& s = f_.spots[static_cast<std::size_t>(k)];
-      const double d = std::max(0.0, (w - s.centre).norm() - s.radius);
-      if (d < best) {
-        best = d;
-        m.kind = 2;
-        m.marking = -1;
-        m.residual = d;
-      }
-    }
+    for (int k : cell.spots) consider_spot(w, f_.spots[static_cast<std::size_t>(k)], best, m);
     return m;
   }
 

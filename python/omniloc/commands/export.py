@@ -13,8 +13,9 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import BinaryIO, Callable, List, NoReturn, Optional
+from typing import BinaryIO, Callable, List, Optional
 
+from omniloc.tools.cliargs import Parser, at_least
 from omniloc.core import pathcheck, rundir
 from omniloc.core.files import InputFileError
 from omniloc.core.recording import load_header
@@ -44,35 +45,18 @@ exit status: 0 written; 2 bad input (one line naming the file and what was expec
 written to a temporary name beside it and renamed into place, so none is ever half written."""
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: {message} (see {self.prog} --help)\n")
-
-
-def _at_least(low: int) -> Callable[[str], int]:
-    def read(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            v = low - 1
-        if v < low:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}")
-        return v
-    return read
-
-
 def parser(prog: str) -> argparse.ArgumentParser:
-    p = _Parser(prog=prog, description=DESCRIPTION, epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = Parser(prog=prog, description=DESCRIPTION, epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("input", metavar="INPUT", help="a run folder, a recording folder or a sweep folder")
     p.add_argument("-o", dest="output", metavar="OUT", required=True,
                    help="the MCAP file to write (replaced if it exists); for a sweep, the folder to write one file per run into")
     p.add_argument("--recording", metavar="DIR",
                    help="for a run: the recording of its scenario and seed, for line points and blobs when the run has no "
                         "view.jsonl, and for camera images when recorded with --images")
-    p.add_argument("--image-every", type=_at_least(1), default=1, metavar="N",
+    p.add_argument("--image-every", type=at_least(1), default=1, metavar="N",
                    help="every N-th frame's camera image (default 1: all the recording holds)")
     p.add_argument("--no-images", action="store_true", help="no camera images")
-    p.add_argument("--particles", type=_at_least(0), default=200, metavar="N",
+    p.add_argument("--particles", type=at_least(0), default=200, metavar="N",
                    help="at most N particles a frame, an even stride through the localizer's list (default 200: all "
                         "view.jsonl holds; 0: none)")
     p.add_argument("--quiet", action="store_true", help="print nothing when written")

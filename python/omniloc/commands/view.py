@@ -12,8 +12,9 @@ import os
 import sys
 import tempfile
 from pathlib import Path
-from typing import Callable, List, NoReturn, Optional
+from typing import List, Optional
 
+from omniloc.tools.cliargs import Parser, at_least
 from omniloc.core import pathcheck
 from omniloc.core.files import InputFileError
 from omniloc.view.load import load_run
@@ -46,30 +47,12 @@ exit status: 0 written; 2 bad input (one line naming the file and what was expec
 written). The output is written to a temporary file beside FILE and renamed into place."""
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: {message} (see {self.prog} --help)\n")
-
-
-def _at_least(low: int) -> Callable[[str], int]:
-    """An argparse type: an integer >= low."""
-    def read(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            v = low - 1
-        if v < low:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}")
-        return v
-    return read
-
-
-_positive = _at_least(1)
-_count = _at_least(0)
+_positive = at_least(1)
+_count = at_least(0)
 
 
 def parser(prog: str) -> argparse.ArgumentParser:
-    p = _Parser(prog=prog, description=DESCRIPTION, epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = Parser(prog=prog, description=DESCRIPTION, epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run_dir", metavar="RUN_DIR", help="a run folder (omniloc run / replay -o DIR)")
     p.add_argument("-o", dest="output", metavar="FILE", help="the page to write (default: RUN_DIR/view.html); replaced if it exists")
     p.add_argument("--recording", metavar="DIR",
