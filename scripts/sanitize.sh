@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The unit tests under AddressSanitizer + UndefinedBehaviorSanitizer with leak detection (README "Bad input").
 # Builds only the unit-test programs and omniloc (the CLI tests run it) in build-asan/, never the
-# slow end-to-end scenario tests or the benchmarks, then runs ctest -LE 'scenario|cluster|mutation'.
+# slow end-to-end scenario tests or the benchmarks, then runs ctest -LE 'scenario|cluster|mutation|python'
+# (label python: the checks of Python code, which the Release tree's run covers; tests/CMakeLists.txt).
 # Leaks inside Mesa (llvmpipe, OSMesa, LLVM) are suppressed by .ci/lsan-mesa.supp, nothing else.
 # Usage: scripts/sanitize.sh [ctest arguments]
 set -euo pipefail
@@ -39,5 +40,5 @@ cd build-asan
 # -E Regression.: the committed reference numbers are those of the GCC Release build; this clang
 # build gives slightly different floats (tracking_short: position rmse 0.0476 and 0.0484 m, with no
 # sanitizer report), so that byte-exact gate belongs to the Release stage. Not yet explained.
-ctest --output-on-failure -j"$(nproc)" --timeout 1800 -LE 'scenario|cluster|mutation' -E '_NOT_BUILT$|^Regression\.' "$@"
+ctest --output-on-failure -j"$(nproc)" --timeout 1800 -LE 'scenario|cluster|mutation|python' -E '_NOT_BUILT$|^Regression\.' "$@"
 echo "sanitize: build $((t1 - t0)) s, tests $(($(date +%s) - t1)) s"
