@@ -7,6 +7,9 @@
 
 #include "core/field.hpp"
 #include "core/rng.hpp"
+#include "harness/external_session.hpp"
+#include "harness/localizer_registry.hpp"
+#include "harness/scenario.hpp"
 #include "localization/field_map.hpp"
 #include "localization/modern/alternative_poses.hpp"
 #include "localization/modern/hypothesis_set.hpp"
@@ -283,4 +286,44 @@ TEST(UkfMh, GoalColourDecidesTheTwin) {
       EXPECT_LT(std::hypot(e.pose.x - want.x, e.pose.y - want.y), 0.05) << seed << " " << mirrored << ": " << e.pose.x << ", " << e.pose.y;
       EXPECT_LT(std::fabs(angle_diff(e.pose.theta, want.theta)), 0.05) << seed << " " << mirrored;
     }
+}
+
+// The camera's latency is declared by the scenario's camera (its noise profile's latency_ms): every
+// localizer may know it when built (LocalizerContext), an external one in hello.camera.latency_s, and
+// ukf_mh takes it as the default of `latency`; a number given in the parameters overrides it.
+TEST(UkfMh, LatencyDefaultsToTheCamerasDeclaredLatency) {
+  const auto scenario = [](const char* profile, const Json& camera) {
+    Json j = {{"duration", 1.0}, {"noise_profile", profile}, {"robots", Json::parse(R"([{"id": 0, "start": [0, -2, 0]}])")},
+              {"localizer", {{"type", "ukf_mh"}}}};
+    if (!camera.is_null()) j["camera"] = camera;
+    return harness::parse_scenario(j, "latency");
+  };
+  const harness::Scenario robot = scenario("robot", nullptr);
+  EXPECT_DOUBLE_EQ(harness::declared_camera_latency(robot), 0.033);  // data/noise_profiles.json: one frame at 30 Hz
+  EXPECT_DOUBLE_EQ(harness::declared_camera_latency(scenario("ideal", nullptr)), 0.0);
+  EXPECT_DOUBLE_EQ(harness::declared_camera_latency(scenario("robot", {{"latency_ms", 50.0}})), 0.05);
+
+  // hello.camera: the calibration object as given, plus the declared latency.
+  const Json camera = {{"width", 640}, {"height", 640}};
+  const external::Session s = harness::make_session(robot, 0, camera, false, 1, "");
+  EXPECT_EQ(s.camera.at("width"), 640);
+  EXPECT_DOUBLE_EQ(s.camera.at("latency_s").get<double>(), 0.033);
+  EXPECT_DOUBLE_EQ(harness::make_session(scenario("ideal", nullptr), 0, Json::object(), false, 1, "").camera.at("latency_s").get<double>(), 0.0);
+
+  harness::LocalizerContext ctx;
+  ctx.field = &robot.field;
+  ctx.camera_latency = 0.033;
+  const auto latency = [&](const Json& spec) {
+    Json eff;
+    harness::make_localizer(harness::LocalizerSpec(spec, "/localizer"), ctx, &eff);
+    return eff.at("latency").get<double>();
+  };
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}}), 0.033);
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}, {"latency", 0.0}}), 0.0);  // "unknown", said explicitly
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}, {"latency", 0.02}}), 0.02);
+  ctx.camera_latency = 0.0;
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}}), 0.0);
+  // Built without a context (tests, benchmarks): unknown.
+  JsonReader none(Json::object(), "/localizer");
+  EXPECT_DOUBLE_EQ(UkfMhParams::from_json(none).latency, 0.0);
 }

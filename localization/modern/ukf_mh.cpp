@@ -70,7 +70,7 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       positive_param("gate_sigmas", &P::gate_sigmas, 100.0, "", "innovation gate of a point in standard deviations"),
       positive_param("inlier_sigmas", &P::inlier_sigmas, 100.0, "", "a point fits (validity) when within this many standard deviations of its marking"),
       integer_param("iterations", &P::iterations, 1, 20, "iterated update: association and linearisation again at the new mean"),
-      number_param("latency", &P::latency, 0.0, 1.0, "s", "the image is this much older than the odometry; 0: unknown (the robot profile's camera: 0.033)"),
+      number_param("latency", &P::latency, 0.0, 1.0, "s", "the image is this much older than the odometry; 0: moved to no time (JSON default: the camera's declared latency, the robot profile's 0.033)"),
       positive_param("validity_time", &P::validity_time, 100.0, "s", "time constant of each hypothesis's validity filter"),
       number_param("valid_min", &P::valid_min, 0.0, 1.0, "", "validity from which the best hypothesis is reported valid"),
       number_param("hysteresis", &P::hysteresis, 0.0, 1.0, "", "another hypothesis must be this much more valid to take the lead"),
@@ -95,8 +95,12 @@ Json UkfMhParams::schema() {
   return s;
 }
 
-UkfMhParams UkfMhParams::from_json(JsonReader& r) {
+UkfMhParams UkfMhParams::from_json(JsonReader& r, double camera_latency) {
   UkfMhParams p;
+  // A team measures its camera's latency once and configures its localizer with it (B-Human
+  // timestamps each image and predicts the pose to the image's time): the declared value is the
+  // default, a number given here overrides it.
+  p.latency = camera_latency;
   read_params(r, p, params());
   read_params(r, p.motion, motion_params());
   read_params(r, p.set, set_params());

@@ -44,7 +44,7 @@ struct UkfMhParams {
   double gate_sigmas = 3.0;      ///< innovation gate in standard deviations
   double inlier_sigmas = 3.0;    ///< a point fits when within this many standard deviations of its marking
   int iterations = 2;            ///< iterated update: association and linearisation again at the new mean
-  double latency = 0.0;          ///< s: the image is this much older than the odometry (0: unknown)
+  double latency = 0.0;          ///< s: the image is this much older than the odometry (JSON default: the camera's declared latency)
   // Odometry.
   MotionNoise motion;
   // Hypotheses.
@@ -63,7 +63,8 @@ struct UkfMhParams {
   double alt_margin = 0.05;      ///< a proposal must beat the best hypothesis's score by this to enter
   double cell = 0.05;            ///< m: distance-map cell of the fit (Tribots: 50 mm)
 
-  static UkfMhParams from_json(JsonReader& r);
+  /// `camera_latency`: the camera's declared latency (LocalizerContext), the default of `latency`.
+  static UkfMhParams from_json(JsonReader& r, double camera_latency = 0.0);
   static const ParamList<UkfMhParams>& params();
   static Json schema();
 };
