@@ -74,6 +74,8 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       positive_param("validity_time", &P::validity_time, 100.0, "s", "time constant of each hypothesis's validity filter"),
       number_param("valid_min", &P::valid_min, 0.0, 1.0, "", "validity from which the best hypothesis is reported valid"),
       number_param("hysteresis", &P::hysteresis, 0.0, 1.0, "", "another hypothesis must be this much more valid to take the lead"),
+      integer_param("trust_frames", &P::trust_frames, 1, 1000, "a hypothesis whose last trust_frames updates fit trust_share of the points on average is valid at once"),
+      number_param("trust_share", &P::trust_share, 0.0, 1.1, "", "mean share of fitting points over trust_frames updates that makes a hypothesis valid at once (above 1: never)"),
       positive_param("compass_gate", &P::compass_gate, 3.2, "rad", "a hypothesis this far from the compass heading fits nothing that frame"),
       positive_param("new_sd_xy", &P::new_sd_xy, 10.0, "m", "a proposed pose's initial standard deviation in x and y"),
       positive_param("new_sd_theta", &P::new_sd_theta, 3.2, "rad", "a proposed pose's initial standard deviation in theta"),
@@ -230,6 +232,19 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   const double evidence = contradicted(q, heading, obs) ? 0.0 : h.inliers;
   const double alpha = 1.0 - std::exp(-std::max(dt, 0.0) / p_.validity_time);
   h.validity += alpha * (evidence - h.validity);
+  // Consistent evidence: a pose that explained nearly every point in each of its last few updates
+  // is right beyond reasonable doubt well before the low-pass filter says so. The best wrong poses
+  // of the field explain at most about three quarters of a frame's points, so a mean of trust_share
+  // over trust_frames frames is many standard deviations of that mean beyond them
+  // (docs/modern_localizer.md); the frame a proposal was fitted to is not among them (the best of
+  // many restarts on that frame's points flatters it).
+  h.recent.push_back(evidence);
+  if (static_cast<int>(h.recent.size()) > p_.trust_frames) h.recent.erase(h.recent.begin());
+  if (static_cast<int>(h.recent.size()) == p_.trust_frames) {
+    double sum = 0.0;
+    for (const double e : h.recent) sum += e;
+    if (sum >= p_.trust_share * p_.trust_frames) h.validity = std::max(h.validity, p_.valid_min);
+  }
 }
 
 void UkfMhLocalizer::search(const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, bool twins_equal, bool searching) {

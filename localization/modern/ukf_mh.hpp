@@ -52,6 +52,8 @@ struct UkfMhParams {
   double validity_time = 0.5;    ///< s: time constant of the validity's low-pass filter
   double valid_min = 0.75;       ///< validity at which a hypothesis is reported valid
   double hysteresis = 0.05;      ///< another hypothesis must be this much more valid to take the lead
+  int trust_frames = 5;          ///< frames whose mean evidence may make a hypothesis valid at once
+  double trust_share = 0.9;      ///< ... when at least this: validity is raised to valid_min
   double compass_gate = 0.5;     ///< rad: a hypothesis this far from the compass heading fits nothing
   double new_sd_xy = 0.1;        ///< m: a proposal's initial standard deviation
   double new_sd_theta = 0.05;    ///< rad
