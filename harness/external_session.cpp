@@ -2,6 +2,7 @@
 
 #include "core/version.hpp"
 #include "harness/localizer_registry.hpp"
+#include "sim/render/camera_config.hpp"
 
 namespace omniloc::harness {
 
@@ -33,6 +34,8 @@ Json camera_for_client(const CalibrationMap* map) {
             {"max_radius_px", map->max_radius()}}}};
 }
 
+double declared_camera_latency(const Scenario& sc) { return sim::CameraConfig::from_json(sc.camera, "/camera").latency; }
+
 external::Session make_session(const Scenario& sc, int robot, const Json& camera, bool blobs, std::uint64_t localizer_seed,
                                const std::string& log_dir) {
   external::Session s;
@@ -43,6 +46,10 @@ external::Session make_session(const Scenario& sc, int robot, const Json& camera
   s.duration_s = sc.duration;
   s.field = field_for_client(sc.field);
   s.camera = camera;
+  // Added to olp/1 after its first version (a field old clients ignore); a recording's header keeps
+  // hello.camera without it, and a replay takes it from the recorded scenario, as built-in
+  // localizers do (LocalizerContext::camera_latency).
+  s.camera["latency_s"] = declared_camera_latency(sc);
   s.blobs = blobs;
   s.log_dir = log_dir;
   s.seed = localizer_seed;

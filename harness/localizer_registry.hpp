@@ -15,11 +15,16 @@
 
 namespace omniloc::harness {
 
-/// What a localizer may know when it is built: the field (the map every team has) and a seed for
-/// its own random stream. Never the simulator.
+/// What a localizer may know when it is built: the field (the map every team has), the camera's
+/// declared latency (what a team measures once and configures) and a seed for its own random
+/// stream. Never the simulator.
 struct LocalizerContext {
   const Field* field = nullptr;
   std::uint64_t seed = 0;
+  /// s: how much older the image is than the odometry it is paired with, as the scenario's camera
+  /// declares it (its noise profile's `latency_ms`); 0 when nothing declares it (a log not made by
+  /// omniloc). Never measured from the run.
+  double camera_latency = 0.0;
   std::string cache_dir;  ///< where distance maps etc. may be cached
   /// What an external localizer's client is told in hello (robot, field, camera, log folder); null
   /// outside a run (validation, experiments), where an external localizer cannot be built.

@@ -372,6 +372,7 @@ void validate_deep(const Scenario& s) {
   LocalizerContext ctx;
   ctx.field = &s.field;
   ctx.seed = s.seed;
+  ctx.camera_latency = sim::CameraConfig::from_json(s.camera, "/camera").latency;
   check_localizer(s.localizer, ctx);
 }
 

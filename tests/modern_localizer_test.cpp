@@ -7,6 +7,9 @@
 
 #include "core/field.hpp"
 #include "core/rng.hpp"
+#include "harness/external_session.hpp"
+#include "harness/localizer_registry.hpp"
+#include "harness/scenario.hpp"
 #include "localization/field_map.hpp"
 #include "localization/modern/alternative_poses.hpp"
 #include "localization/modern/hypothesis_set.hpp"
@@ -181,17 +184,26 @@ struct ColdStart {
   double first_valid_s = -1;
   Estimate last;
 };
-ColdStart cold_start(const Pose2& truth, std::optional<double> heading, std::uint64_t seed) {
+// `outliers` of the 80 points lie more than 0.6 m from every marking (no pose near the truth can
+// explain them).
+ColdStart cold_start(const Pose2& truth, std::optional<double> heading, std::uint64_t seed, const UkfMhParams& p = {}, int outliers = 0) {
   const Field f = Field::preset("msl2012");
-  UkfMhLocalizer loc(f, UkfMhParams{}, seed, "");
+  UkfMhLocalizer loc(f, p, seed, "");
   const FieldMap prefilter(f, 0.05);
+  const MarkingAssociation assoc(f);
   loc.reset(std::nullopt);
   Rng rng(seed);
   ColdStart out;
   for (int k = 0; k < 60; ++k) {  // 2 s at 30 Hz
     Observations obs;
     obs.t = k / 30.0;
-    obs.line_points = scenes::line_points(f, truth, 80, rng, {.noise = 0.02, .prefilter = &prefilter});
+    obs.line_points = scenes::line_points(f, truth, 80 - outliers, rng, {.noise = 0.02, .prefilter = &prefilter});
+    while (static_cast<int>(obs.line_points.size()) < 80) {
+      const Eigen::Vector2d o(rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0));
+      const Eigen::Vector2d w = truth.transform(o);
+      if (o.norm() < 5.0 && std::fabs(w.x()) < f.half_floor_x() && std::fabs(w.y()) < f.half_floor_y() && assoc.associate(w).distance > 0.6)
+        obs.line_points.push_back(o);
+    }
     out.last = loc.update(obs, Odometry{obs.t, Pose2()}, heading);
     if (out.first_valid_s < 0 && out.last.valid) out.first_valid_s = obs.t;
   }
@@ -283,4 +295,69 @@ TEST(UkfMh, GoalColourDecidesTheTwin) {
       EXPECT_LT(std::hypot(e.pose.x - want.x, e.pose.y - want.y), 0.05) << seed << " " << mirrored << ": " << e.pose.x << ", " << e.pose.y;
       EXPECT_LT(std::fabs(angle_diff(e.pose.theta, want.theta)), 0.05) << seed << " " << mirrored;
     }
+}
+
+// Consistent evidence: a proposal that explains nearly every point in each of its first
+// trust_frames updates is valid after them (B-Human's validity filter alone takes about 0.35 s from
+// half credit); one that explains four fifths is not trusted so (the best wrong poses of the field
+// explain up to three quarters) and waits for the filter, which reaches valid_min after a second or
+// more at that share (0.8 - 0.4 e^(-t / 0.5 s) = 0.75 at 1.04 s; later when a few of the right
+// points miss too).
+TEST(UkfMh, ConsistentEvidenceTrustsAProposalEarly) {
+  const Pose2 truth(-2.0, 1.5, 0.4);
+  UkfMhParams off;
+  off.trust_share = 1.1;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const ColdStart trusted = cold_start(truth, truth.theta, seed);
+    ASSERT_TRUE(trusted.last.valid) << seed;
+    // The proposal enters on frame 0; trust_frames = 5 updates later it is valid (frame 5).
+    EXPECT_NEAR(trusted.first_valid_s, 5.0 / 30.0, 1.5 / 30.0) << seed;
+    const ColdStart filtered = cold_start(truth, truth.theta, seed, off);
+    EXPECT_GE(filtered.first_valid_s, 0.3) << seed;
+    EXPECT_LE(filtered.first_valid_s, 0.5) << seed;
+    const ColdStart four_fifths = cold_start(truth, truth.theta, seed, UkfMhParams{}, 16);
+    EXPECT_TRUE(four_fifths.first_valid_s < 0.0 || four_fifths.first_valid_s >= 0.8) << seed << ": " << four_fifths.first_valid_s;
+    const ColdStart three_fifths = cold_start(truth, truth.theta, seed, UkfMhParams{}, 32);
+    EXPECT_LT(three_fifths.first_valid_s, 0.0) << seed;  // never valid: 60 % is below valid_min
+  }
+}
+
+// The camera's latency is declared by the scenario's camera (its noise profile's latency_ms): every
+// localizer may know it when built (LocalizerContext), an external one in hello.camera.latency_s, and
+// ukf_mh takes it as the default of `latency`; a number given in the parameters overrides it.
+TEST(UkfMh, LatencyDefaultsToTheCamerasDeclaredLatency) {
+  const auto scenario = [](const char* profile, const Json& camera) {
+    Json j = {{"duration", 1.0}, {"noise_profile", profile}, {"robots", Json::parse(R"([{"id": 0, "start": [0, -2, 0]}])")},
+              {"localizer", {{"type", "ukf_mh"}}}};
+    if (!camera.is_null()) j["camera"] = camera;
+    return harness::parse_scenario(j, "latency");
+  };
+  const harness::Scenario robot = scenario("robot", nullptr);
+  EXPECT_DOUBLE_EQ(harness::declared_camera_latency(robot), 0.033);  // data/noise_profiles.json: one frame at 30 Hz
+  EXPECT_DOUBLE_EQ(harness::declared_camera_latency(scenario("ideal", nullptr)), 0.0);
+  EXPECT_DOUBLE_EQ(harness::declared_camera_latency(scenario("robot", {{"latency_ms", 50.0}})), 0.05);
+
+  // hello.camera: the calibration object as given, plus the declared latency.
+  const Json camera = {{"width", 640}, {"height", 640}};
+  const external::Session s = harness::make_session(robot, 0, camera, false, 1, "");
+  EXPECT_EQ(s.camera.at("width"), 640);
+  EXPECT_DOUBLE_EQ(s.camera.at("latency_s").get<double>(), 0.033);
+  EXPECT_DOUBLE_EQ(harness::make_session(scenario("ideal", nullptr), 0, Json::object(), false, 1, "").camera.at("latency_s").get<double>(), 0.0);
+
+  harness::LocalizerContext ctx;
+  ctx.field = &robot.field;
+  ctx.camera_latency = 0.033;
+  const auto latency = [&](const Json& spec) {
+    Json eff;
+    harness::make_localizer(harness::LocalizerSpec(spec, "/localizer"), ctx, &eff);
+    return eff.at("latency").get<double>();
+  };
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}}), 0.033);
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}, {"latency", 0.0}}), 0.0);  // "unknown", said explicitly
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}, {"latency", 0.02}}), 0.02);
+  ctx.camera_latency = 0.0;
+  EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}}), 0.0);
+  // Built without a context (tests, benchmarks): unknown.
+  JsonReader none(Json::object(), "/localizer");
+  EXPECT_DOUBLE_EQ(UkfMhParams::from_json(none).latency, 0.0);
 }

@@ -276,13 +276,15 @@ class Camera:
     channels: int = 3
     layout: str = "HWC"
     mirror_centre_px: Tuple[float, float] = (0.0, 0.0)  #: (cu, cv), pixels, image frame
+    latency_s: float = 0.0  #: the camera's declared latency: the image is this much older than the frame's odometry (0: not declared)
     raw: Dict[str, Any] = dataclass_field(default_factory=dict, repr=False)
 
     @classmethod
     def from_json(cls, j: Dict[str, Any]) -> "Camera":
         c = j.get("mirror_centre_px", [0.0, 0.0])
         return cls(width=int(j.get("width", 0)), height=int(j.get("height", 0)), channels=int(j.get("channels", 3)),
-                   layout=str(j.get("layout", "HWC")), mirror_centre_px=(float(c[0]), float(c[1])), raw=j)
+                   layout=str(j.get("layout", "HWC")), mirror_centre_px=(float(c[0]), float(c[1])),
+                   latency_s=float(j.get("latency_s", 0.0)), raw=j)
 
     def calibration(self) -> Calibration:
         """The pixel -> robot-frame floor map (raises ProtocolError when hello had none)."""

@@ -18,6 +18,7 @@ struct Hypothesis {
   double validity = 0.0;   ///< in [0, 1]: low-pass filtered share of points that fit
   double age = 0.0;        ///< seconds since it was created
   double inliers = 0.0;    ///< the last frame's share of points that fit
+  std::vector<double> recent;  ///< the evidence (share, 0 when contradicted) of its last frames, oldest first
   std::uint32_t id = 0;    ///< creation order: ties go to the older one
 };
 

@@ -70,10 +70,12 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       positive_param("gate_sigmas", &P::gate_sigmas, 100.0, "", "innovation gate of a point in standard deviations"),
       positive_param("inlier_sigmas", &P::inlier_sigmas, 100.0, "", "a point fits (validity) when within this many standard deviations of its marking"),
       integer_param("iterations", &P::iterations, 1, 20, "iterated update: association and linearisation again at the new mean"),
-      number_param("latency", &P::latency, 0.0, 1.0, "s", "the image is this much older than the odometry; 0: unknown (the robot profile's camera: 0.033)"),
+      number_param("latency", &P::latency, 0.0, 1.0, "s", "the image is this much older than the odometry; 0: moved to no time (JSON default: the camera's declared latency, the robot profile's 0.033)"),
       positive_param("validity_time", &P::validity_time, 100.0, "s", "time constant of each hypothesis's validity filter"),
       number_param("valid_min", &P::valid_min, 0.0, 1.0, "", "validity from which the best hypothesis is reported valid"),
       number_param("hysteresis", &P::hysteresis, 0.0, 1.0, "", "another hypothesis must be this much more valid to take the lead"),
+      integer_param("trust_frames", &P::trust_frames, 1, 1000, "a hypothesis whose last trust_frames updates fit trust_share of the points on average is valid at once"),
+      number_param("trust_share", &P::trust_share, 0.0, 1.1, "", "mean share of fitting points over trust_frames updates that makes a hypothesis valid at once (above 1: never)"),
       positive_param("compass_gate", &P::compass_gate, 3.2, "rad", "a hypothesis this far from the compass heading fits nothing that frame"),
       positive_param("new_sd_xy", &P::new_sd_xy, 10.0, "m", "a proposed pose's initial standard deviation in x and y"),
       positive_param("new_sd_theta", &P::new_sd_theta, 3.2, "rad", "a proposed pose's initial standard deviation in theta"),
@@ -95,8 +97,12 @@ Json UkfMhParams::schema() {
   return s;
 }
 
-UkfMhParams UkfMhParams::from_json(JsonReader& r) {
+UkfMhParams UkfMhParams::from_json(JsonReader& r, double camera_latency) {
   UkfMhParams p;
+  // A team measures its camera's latency once and configures its localizer with it (B-Human
+  // timestamps each image and predicts the pose to the image's time): the declared value is the
+  // default, a number given here overrides it.
+  p.latency = camera_latency;
   read_params(r, p, params());
   read_params(r, p.motion, motion_params());
   read_params(r, p.set, set_params());
@@ -226,6 +232,19 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   const double evidence = contradicted(q, heading, obs) ? 0.0 : h.inliers;
   const double alpha = 1.0 - std::exp(-std::max(dt, 0.0) / p_.validity_time);
   h.validity += alpha * (evidence - h.validity);
+  // Consistent evidence: a pose that explained nearly every point in each of its last few updates
+  // is right beyond reasonable doubt well before the low-pass filter says so. The best wrong poses
+  // of the field explain at most about three quarters of a frame's points, so a mean of trust_share
+  // over trust_frames frames is many standard deviations of that mean beyond them
+  // (docs/modern_localizer.md); the frame a proposal was fitted to is not among them (the best of
+  // many restarts on that frame's points flatters it).
+  h.recent.push_back(evidence);
+  if (static_cast<int>(h.recent.size()) > p_.trust_frames) h.recent.erase(h.recent.begin());
+  if (static_cast<int>(h.recent.size()) == p_.trust_frames) {
+    double sum = 0.0;
+    for (const double e : h.recent) sum += e;
+    if (sum >= p_.trust_share * p_.trust_frames) h.validity = std::max(h.validity, p_.valid_min);
+  }
 }
 
 void UkfMhLocalizer::search(const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, bool twins_equal, bool searching) {

@@ -44,7 +44,7 @@ struct UkfMhParams {
   double gate_sigmas = 3.0;      ///< innovation gate in standard deviations
   double inlier_sigmas = 3.0;    ///< a point fits when within this many standard deviations of its marking
   int iterations = 2;            ///< iterated update: association and linearisation again at the new mean
-  double latency = 0.0;          ///< s: the image is this much older than the odometry (0: unknown)
+  double latency = 0.0;          ///< s: the image is this much older than the odometry (JSON default: the camera's declared latency)
   // Odometry.
   MotionNoise motion;
   // Hypotheses.
@@ -52,6 +52,8 @@ struct UkfMhParams {
   double validity_time = 0.5;    ///< s: time constant of the validity's low-pass filter
   double valid_min = 0.75;       ///< validity at which a hypothesis is reported valid
   double hysteresis = 0.05;      ///< another hypothesis must be this much more valid to take the lead
+  int trust_frames = 5;          ///< frames whose mean evidence may make a hypothesis valid at once
+  double trust_share = 0.9;      ///< ... when at least this: validity is raised to valid_min
   double compass_gate = 0.5;     ///< rad: a hypothesis this far from the compass heading fits nothing
   double new_sd_xy = 0.1;        ///< m: a proposal's initial standard deviation
   double new_sd_theta = 0.05;    ///< rad
@@ -63,7 +65,8 @@ struct UkfMhParams {
   double alt_margin = 0.05;      ///< a proposal must beat the best hypothesis's score by this to enter
   double cell = 0.05;            ///< m: distance-map cell of the fit (Tribots: 50 mm)
 
-  static UkfMhParams from_json(JsonReader& r);
+  /// `camera_latency`: the camera's declared latency (LocalizerContext), the default of `latency`.
+  static UkfMhParams from_json(JsonReader& r, double camera_latency = 0.0);
   static const ParamList<UkfMhParams>& params();
   static Json schema();
 };
