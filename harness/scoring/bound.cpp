@@ -916,8 +916,8 @@ Json noise_json(const NoiseModel& nm, std::size_t used_points, double h, const B
 
 }  // namespace
 
-RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
-  RobotBound out;
+BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
+  BoundPart out;
   const auto& frames = robot.frames;
   const std::size_t nf = frames.size();
   out.frames.resize(nf);
@@ -939,9 +939,6 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   std::vector<double> resets = setup.resets;
   std::sort(resets.begin(), resets.end());
   const Series post = posterior_bounds(frames, poses, sf.info, resets, setup, field, out.frames);
-  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
-  // the frames carry odometry at all, which the setup says.
-  const bool odometry = setup.has_odometry;
   const OdometryError oe = odometry_error(frames, resets, setup);
 
   // Latency: the shift between the pose the image shows and the pose scored, a bias of any
@@ -986,7 +983,19 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
                   {"treatment", "a bias, not noise: the bound is on the pose the image was exposed at; the shift to the frame's pose is "
                                 "what a localizer that does not carry its estimate forward adds"}};
   b["assumptions"] = "known association, measured Gaussian noise, unbiased estimator";
+  return out;
+}
 
+RobotBound bound_from_part(const RobotRecord& robot, const BoundSetup& setup, BoundPart part) {
+  RobotBound out;
+  out.frames = std::move(part.frames);
+  out.bound = std::move(part.bound);
+  const std::size_t nf = robot.frames.size();
+  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
+  // the frames carry odometry at all, which the setup says.
+  const bool odometry = setup.has_odometry;
+  // Recomputed rather than kept: a pass over the frames, and what a cached part would otherwise carry.
+  const std::vector<Pose2> poses = setup.latency_s > 0 ? exposure_poses(robot, setup) : std::vector<Pose2>();
   std::vector<std::optional<double>> sp(nf), sh(nf), pp(nf), ph(nf);
   for (std::size_t k = 0; k < nf; ++k) {
     sp[k] = out.frames[k].pos;
@@ -1006,5 +1015,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   }
   return out;
 }
+
+RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) { return bound_from_part(robot, setup, bound_part(robot, setup)); }
 
 }  // namespace omniloc::harness
