@@ -54,6 +54,7 @@ bool get(const std::string& in, std::size_t& at, T& v) {
 BoundCacheOptions bound_cache_from_env() {
   BoundCacheOptions o;
   o.dir = build_cache_dir("bounds");
+  o.prune_root = cache::dir("bounds");
   o.log = &std::cerr;
   return o;
 }
@@ -242,7 +243,7 @@ void BoundCache::store(const std::string& key, const BoundPart& part) const {
 void BoundCache::prune() const {
   if (o_.max_bytes == 0) return;
   // Every build's folder under bounds/: an older build's entries are the likeliest to go.
-  const fs::path root = fs::path(o_.dir).parent_path();
+  const fs::path root = o_.prune_root.empty() ? fs::path(o_.dir) : fs::path(o_.prune_root);
   struct Entry {
     fs::path path;
     fs::file_time_type used;

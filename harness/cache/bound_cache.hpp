@@ -27,11 +27,13 @@ namespace omniloc::harness {
 
 struct BoundCacheOptions {
   std::string dir;                         ///< the entries' folder; empty: no cache
+  std::string prune_root;                  ///< the folder pruned (every build's entries); empty: `dir`
   std::uint64_t max_bytes = 512ULL << 20;  ///< prune least recently used entries past this (all builds' folders)
   std::ostream* log = nullptr;             ///< damaged entries, one line each
 };
 
-/// build_cache_dir("bounds") (empty when caching is off), 512 MiB, damaged entries said on stderr.
+/// build_cache_dir("bounds") (empty when caching is off), pruned over every build's folder under
+/// bounds/ to 512 MiB, damaged entries said on stderr.
 BoundCacheOptions bound_cache_from_env();
 
 /// Lower-case hex SHA-256 of everything bound_part(robot, setup) reads.
