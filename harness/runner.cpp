@@ -100,6 +100,7 @@ Estimate robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOp
     row.extra["exposure_ms"] = rf.settings->exposure_ms;
     row.extra["gain"] = rf.settings->gain;
   }
+  // What the bound reads, converted as bound_frame() (harness/cache/bound_cache.hpp) does for a recording.
   row.line_points.reserve(rf.obs.line_points.size());
   for (const auto& p : rf.obs.line_points) row.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
   tr.record.frames.push_back(std::move(row));
@@ -139,33 +140,6 @@ std::string view_line(const Tracked& tr, const RobotFrame& rf, long long k, cons
     j["points"] = std::move(ps);
   }
   return j.dump() + "\n";
-}
-
-// What the accuracy bound of robot `id` takes from the scenario: the field, the camera's geometry,
-// latency and vibration, the declared odometry and compass noise, and when the robot was moved
-// without odometry (teleport, kidnap: the posterior bound starts again).
-BoundSetup bound_setup(const Scenario& sc, int id, bool start_pose_given) {
-  BoundSetup b;
-  b.field = &sc.field;
-  const sim::CameraConfig cam = sim::CameraConfig::from_json(sc.camera, "/camera");
-  b.mount_height = cam.mount_height;
-  b.latency_s = cam.latency;
-  b.vibration_std = cam.vibration_std;
-  b.tilt_per_accel = cam.tilt_per_accel;
-  b.physics_dt = 1.0 / sc.physics_rate;
-  b.camera_rate = sc.camera_rate;
-  if (const RobotConfig* rc = sc.robot(id)) {
-    b.trans_sigma = rc->odometry.trans_sigma;
-    b.rot_sigma = rc->odometry.rot_sigma;
-    b.rot_per_trans = rc->odometry.rot_per_trans;
-    b.scale_sigma = rc->odometry.scale_sigma;
-    b.has_heading_sensor = rc->has_heading_sensor;
-    b.heading_sigma = rc->heading.noise_sigma;
-  }
-  b.start_pose_given = start_pose_given;
-  for (const auto& e : sc.events)
-    if (e.robot == id && (e.as<Kidnap>() || e.as<Teleport>())) b.resets.push_back(e.t);
-  return b;
 }
 
 // Scores every robot and writes the result files; the table rows go to `result`.

@@ -110,7 +110,8 @@ class CacheRoot(unittest.TestCase):
         self.assertEqual(len(list((root / "fieldmaps").glob("*/fieldmap_*.bin"))), 1, files_under(root))
         self.assertEqual(len(list((root / "vision").glob("*/calibration_v2_*.json"))), 1, files_under(root))
         self.assertEqual(len(list((root / "vision").glob("*/colour_v2_*.lut"))), 1, files_under(root))
-        self.assertEqual(len(list((root / "bounds").glob("*/*.bound"))), 1, files_under(root))
+        # The world's bounds, computed when it was drawn: for a localizer given its start pose and one not.
+        self.assertEqual(len(list((root / "bounds").glob("*/*.bound"))), 2, files_under(root))
 
     def test_default_root_is_the_users_cache_and_the_working_directory_stays_empty(self):
         home, cwd, out = self.fresh("home"), self.fresh("cwd"), self.fresh("out")
@@ -131,8 +132,8 @@ class CacheRoot(unittest.TestCase):
         self.assertEqual(files_under(cwd), [])
         self.assertEqual(files_under(other), [])
 
-        # omniloc cache: every kind, then pruned empty. Two bounds: matching was given its start pose,
-        # mcl was not (the posterior bound's prior differs).
+        # omniloc cache: every kind, then pruned empty. Two bounds (the world's, drawn with it): matching
+        # read the one with its start pose given, mcl the other.
         r = self.omniloc("cache", "list", env=env, cwd=cwd)
         kinds = [line.split()[0] for line in r.stdout.splitlines()[1:-1]]
         self.assertEqual(sorted(kinds), ["bound", "bound", "calibration", "colour", "fieldmap", "world"], r.stdout)

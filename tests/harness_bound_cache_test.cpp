@@ -21,6 +21,7 @@
 #include "core/install_paths.hpp"
 #include "harness/cache/bound_cache.hpp"
 #include "harness/recording/recording_source.hpp"
+#include "harness/recording/recording_writer.hpp"
 #include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scoring/bound.hpp"
@@ -285,4 +286,39 @@ TEST(BoundCache, PruningKeepsTheMostRecentlyUsed) {
   EXPECT_FALSE(fs::exists(cache.entry_path(keys[1])));
   EXPECT_TRUE(fs::exists(cache.entry_path(keys[2])));
   fs::remove_all(dir);
+}
+
+TEST(BoundCache, ARecordingKeepsTheBoundsItsReplaysRead) {
+  // A recording computes its robots' bounds (start pose given and not); its first replay reads one
+  // of them: each entry is marked after the recording, and the replay's summary carries the mark.
+  const fs::path root = fresh_dir("record");
+  ::setenv("OMNILOC_CACHE", (root / "cache").c_str(), 1);
+  Json j = Json::parse(std::ifstream((omniloc::source_dir() / "scenarios/paper/tracking.json").string()));
+  j["duration"] = 2.0;
+  const Scenario live = parse_scenario(j, "bound_cache_record");
+  RecordOptions ro;
+  ro.out_dir = (root / "rec").string();
+  const RecordResult rr = record_scenario(live, ro);
+  const auto entries = [&] {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::recursive_directory_iterator(root / "cache" / "bounds"))
+      if (e.path().extension() == ".bound") out.push_back(e.path());
+    return out;
+  };
+  ASSERT_EQ(entries().size(), 2u);
+  for (const auto& e : entries()) {
+    auto part = decode_bound_part(read_file(e.string()), static_cast<std::size_t>(rr.frames));
+    ASSERT_TRUE(part) << e;
+    part->bound["marker"] = e.filename().string();
+    write_file_atomic(e.string(), encode_bound_part(*part));
+  }
+  const RecordingHeader head = RecordingHeader::read(ro.out_dir);
+  RunOptions o;
+  o.out_dir = (root / "replay").string();
+  o.replay = true;
+  RecordingSource source(RecordingHeader::read(ro.out_dir));
+  const RunResult r = run_frames(replay_scenario(head, LocalizerSpec({{"type", "matching"}}, "/localizer")), head.seed, source, o, Json::object());
+  EXPECT_TRUE(r.summary["robots"][0]["bound"].contains("marker")) << r.summary["robots"][0]["bound"].dump();
+  EXPECT_EQ(entries().size(), 2u);
+  fs::remove_all(root);
 }

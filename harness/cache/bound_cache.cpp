@@ -20,6 +20,7 @@
 #include "core/cache_root.hpp"
 #include "external/sha256.hpp"
 #include "harness/cache/cache_dirs.hpp"
+#include "sim/render/camera_config.hpp"
 
 namespace omniloc::harness {
 
@@ -278,6 +279,53 @@ RobotBound bound_robot_cached(const RobotRecord& robot, const BoundSetup& setup,
   BoundPart part = bound_part(robot, setup);
   cache.store(key, part);
   return bound_from_part(robot, setup, std::move(part));
+}
+
+BoundSetup bound_setup(const Scenario& sc, int id, bool start_pose_given) {
+  BoundSetup b;
+  b.field = &sc.field;
+  const sim::CameraConfig cam = sim::CameraConfig::from_json(sc.camera, "/camera");
+  b.mount_height = cam.mount_height;
+  b.latency_s = cam.latency;
+  b.vibration_std = cam.vibration_std;
+  b.tilt_per_accel = cam.tilt_per_accel;
+  b.physics_dt = 1.0 / sc.physics_rate;
+  b.camera_rate = sc.camera_rate;
+  if (const RobotConfig* rc = sc.robot(id)) {
+    b.trans_sigma = rc->odometry.trans_sigma;
+    b.rot_sigma = rc->odometry.rot_sigma;
+    b.rot_per_trans = rc->odometry.rot_per_trans;
+    b.scale_sigma = rc->odometry.scale_sigma;
+    b.has_heading_sensor = rc->has_heading_sensor;
+    b.heading_sigma = rc->heading.noise_sigma;
+  }
+  b.start_pose_given = start_pose_given;
+  // A move without odometry restarts the posterior bound.
+  for (const auto& e : sc.events)
+    if (e.robot == id && (e.as<Kidnap>() || e.as<Teleport>())) b.resets.push_back(e.t);
+  return b;
+}
+
+FrameRecord bound_frame(const RobotFrame& rf) {
+  FrameRecord r;
+  r.t = rf.obs.t;
+  r.truth = rf.truth.value_or(Pose2());
+  r.camera_ok = rf.obs.camera_ok;
+  r.odometry = rf.odometry.delta;
+  r.heading = rf.heading;
+  r.line_points.reserve(rf.obs.line_points.size());
+  for (const auto& p : rf.obs.line_points) r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
+  return r;
+}
+
+void prepare_bounds(const Scenario& sc, const std::vector<RobotRecord>& robots, const BoundCache& cache) {
+  if (cache.options().dir.empty()) return;
+  for (const RobotRecord& rec : robots)
+    for (const bool given : {true, false}) {
+      const BoundSetup setup = bound_setup(sc, rec.id, given);
+      const std::string key = bound_key(rec, setup);
+      if (!cache.find(key, rec.frames.size())) cache.store(key, bound_part(rec, setup));
+    }
 }
 
 }  // namespace omniloc::harness
