@@ -77,7 +77,7 @@ struct Entry {
 const char* folder_of(const std::string& kind) { return kind == "fieldmap" ? "fieldmaps" : kind == "bound" ? "bounds" : "vision"; }
 
 // The files of the root's fieldmaps/<build>/, vision/<build>/ and bounds/<build>/ folders
-// (harness/cache/cache_dirs.hpp, harness/cache/bound_cache.hpp), named "<build>/<file>". A file being
+// (harness/cache/cache_dirs.hpp, harness/bound_cache.hpp), named "<build>/<file>". A file being
 // written (name.tmp.<pid>...) is not an entry yet.
 std::vector<Entry> file_entries(const std::string& root) {
   std::vector<Entry> out;

@@ -11,7 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/version.hpp"
 #include "external/external_localizer.hpp"
-#include "harness/cache/bound_cache.hpp"
+#include "harness/bound_cache.hpp"
 #include "harness/cache/cache_dirs.hpp"
 #include "harness/external_session.hpp"
 #include "harness/frame_source.hpp"
@@ -100,7 +100,7 @@ Estimate robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOp
     row.extra["exposure_ms"] = rf.settings->exposure_ms;
     row.extra["gain"] = rf.settings->gain;
   }
-  // What the bound reads, converted as bound_frame() (harness/cache/bound_cache.hpp) does for a recording.
+  // What the bound reads, converted as bound_frame() (harness/bound_cache.hpp) does for a recording.
   row.line_points.reserve(rf.obs.line_points.size());
   for (const auto& p : rf.obs.line_points) row.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
   tr.record.frames.push_back(std::move(row));

@@ -1,4 +1,4 @@
-// The bound cache (harness/cache/bound_cache.hpp): a result through it is byte for byte the bound
+// The bound cache (harness/bound_cache.hpp): a result through it is byte for byte the bound
 // computed afresh, cold or warm; a warm lookup really serves the entry; a damaged entry is said,
 // removed and computed again; no cache and an unwritable cache change nothing but a warning; and a
 // replay's run folder is the same bytes with the cache cold, warm and off.
@@ -19,9 +19,9 @@
 
 #include "core/atomic_file.hpp"
 #include "core/install_paths.hpp"
-#include "harness/cache/bound_cache.hpp"
+#include "harness/bound_cache.hpp"
 #include "harness/recording/recording_source.hpp"
-#include "harness/recording/recording_writer.hpp"
+#include "harness/cache/world_cache.hpp"
 #include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scoring/bound.hpp"
@@ -288,35 +288,38 @@ TEST(BoundCache, PruningKeepsTheMostRecentlyUsed) {
   fs::remove_all(dir);
 }
 
-TEST(BoundCache, ARecordingKeepsTheBoundsItsReplaysRead) {
-  // A recording computes its robots' bounds (start pose given and not); its first replay reads one
-  // of them: each entry is marked after the recording, and the replay's summary carries the mark.
+TEST(BoundCache, AWorldDrawnKeepsTheBoundsItsReplaysRead) {
+  // Drawing a world into the world cache computes its robots' bounds (start pose given and not);
+  // its first replay reads one of them: each entry is marked after the draw, and the replay's
+  // summary carries the mark.
   const fs::path root = fresh_dir("record");
   ::setenv("OMNILOC_CACHE", (root / "cache").c_str(), 1);
   Json j = Json::parse(std::ifstream((omniloc::source_dir() / "scenarios/paper/tracking.json").string()));
   j["duration"] = 2.0;
   const Scenario live = parse_scenario(j, "bound_cache_record");
-  RecordOptions ro;
-  ro.out_dir = (root / "rec").string();
-  const RecordResult rr = record_scenario(live, ro);
+  WorldCacheOptions wo;
+  wo.dir = (root / "cache" / "worlds").string();
+  WorldCache worlds(wo);
+  const WorldLease lease = worlds.get(live, 5, false);
+  ASSERT_TRUE(lease.drawn());
   const auto entries = [&] {
     std::vector<fs::path> out;
     for (const auto& e : fs::recursive_directory_iterator(root / "cache" / "bounds"))
       if (e.path().extension() == ".bound") out.push_back(e.path());
     return out;
   };
+  const RecordingHeader head = RecordingHeader::read(lease.dir());
   ASSERT_EQ(entries().size(), 2u);
   for (const auto& e : entries()) {
-    auto part = decode_bound_part(read_file(e.string()), static_cast<std::size_t>(rr.frames));
+    auto part = decode_bound_part(read_file(e.string()), static_cast<std::size_t>(head.frames));
     ASSERT_TRUE(part) << e;
     part->bound["marker"] = e.filename().string();
     write_file_atomic(e.string(), encode_bound_part(*part));
   }
-  const RecordingHeader head = RecordingHeader::read(ro.out_dir);
   RunOptions o;
   o.out_dir = (root / "replay").string();
   o.replay = true;
-  RecordingSource source(RecordingHeader::read(ro.out_dir));
+  RecordingSource source(RecordingHeader::read(lease.dir()));
   const RunResult r = run_frames(replay_scenario(head, LocalizerSpec({{"type", "matching"}}, "/localizer")), head.seed, source, o, Json::object());
   EXPECT_TRUE(r.summary["robots"][0]["bound"].contains("marker")) << r.summary["robots"][0]["bound"].dump();
   EXPECT_EQ(entries().size(), 2u);

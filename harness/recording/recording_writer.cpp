@@ -10,7 +10,6 @@
 #include "core/version.hpp"
 #include "external/external_localizer.hpp"
 #include "external/sha256.hpp"
-#include "harness/cache/bound_cache.hpp"
 #include "harness/external_session.hpp"
 #include "harness/frame_source.hpp"
 #include "harness/recording/format/frame_codec.hpp"
@@ -37,18 +36,9 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
   }
   std::string frames;
   std::string timing = "k,robot,render_ms,vision_ms\n";  // wall time: the one file that differs between recordings of a run
-  // The frames as scoring will read them back (the bound's inputs only), for prepare_bounds below.
-  const BoundCache bounds(bound_cache_from_env());
-  std::vector<RobotRecord> bound_inputs;
   while (auto f = source.next()) {
     frames += frame_to_json(*f).dump() + "\n";
-    if (!bounds.options().dir.empty()) {
-      bound_inputs.resize(f->robots.size());
-      for (std::size_t i = 0; i < f->robots.size(); ++i) {
-        bound_inputs[i].id = f->robots[i].id;
-        bound_inputs[i].frames.push_back(bound_frame(f->robots[i]));
-      }
-    }
+    if (opt.on_frame) opt.on_frame(*f);
     for (const auto& r : f->robots) {
       char row[128];
       std::snprintf(row, sizeof row, "%lld,%d,%.4f,%.4f\n", f->k, r.id, r.render_ms, r.vision_ms);
@@ -98,9 +88,6 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
   dir.write("recording.json", header.dump(2) + "\n");
   dir.commit();
   result.out_dir = dir.final_dir();
-  // Every replay of these frames scores them with the same bound: computed now, beside the rendering
-  // it is a small part of, it costs none of them (docs/results.md "Cost.").
-  prepare_bounds(sc, bound_inputs, bounds);
   return result;
 }
 

@@ -139,7 +139,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup);
 /// What of a robot's bound the localizer's estimates do not change: the bound of every frame and
 /// summary.json's "bound". It reads only what the frames gave the localizer (truth, line points,
 /// camera_ok, odometry, compass, times) and the setup less `excluded`: the part the bound cache
-/// (harness/cache/bound_cache.hpp) keeps, the costly one.
+/// (harness/bound_cache.hpp) keeps, the costly one.
 struct BoundPart {
   std::vector<FrameBound> frames;
   Json bound;

@@ -1,4 +1,5 @@
-#include "harness/cache/bound_cache.hpp"
+#include "harness/bound_cache.hpp"
+#include "harness/bound_prepare.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -318,14 +319,27 @@ FrameRecord bound_frame(const RobotFrame& rf) {
   return r;
 }
 
-void prepare_bounds(const Scenario& sc, const std::vector<RobotRecord>& robots, const BoundCache& cache) {
-  if (cache.options().dir.empty()) return;
-  for (const RobotRecord& rec : robots)
+BoundPreparer::BoundPreparer(const Scenario& sc) : sc_(sc), dir_(bound_cache_from_env().dir) {}
+
+void BoundPreparer::add(const FrameData& f) {
+  if (dir_.empty()) return;
+  robots_.resize(f.robots.size());
+  for (std::size_t i = 0; i < f.robots.size(); ++i) {
+    robots_[i].id = f.robots[i].id;
+    robots_[i].frames.push_back(bound_frame(f.robots[i]));
+  }
+}
+
+void BoundPreparer::finish() {
+  if (dir_.empty()) return;
+  const BoundCache cache(bound_cache_from_env());
+  for (const RobotRecord& rec : robots_)
     for (const bool given : {true, false}) {
-      const BoundSetup setup = bound_setup(sc, rec.id, given);
+      const BoundSetup setup = bound_setup(sc_, rec.id, given);
       const std::string key = bound_key(rec, setup);
       if (!cache.find(key, rec.frames.size())) cache.store(key, bound_part(rec, setup));
     }
+  robots_.clear();
 }
 
 }  // namespace omniloc::harness

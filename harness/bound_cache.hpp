@@ -68,13 +68,9 @@ RobotBound bound_robot_cached(const RobotRecord& robot, const BoundSetup& setup,
 BoundSetup bound_setup(const Scenario& sc, int id, bool start_pose_given);
 
 /// A frame as scoring records what the bound reads of it (harness/runner.cpp robot_frame: the same
-/// fields, the same conversions), so that a recording's frames give scoring's key.
+/// fields, the same conversions), so that a recording's frames give scoring's key
+/// (harness/bound_prepare.hpp).
 FrameRecord bound_frame(const RobotFrame& rf);
-
-/// Computes and keeps the bound of each of `robots` (frames of `sc`) for a localizer given its start
-/// pose and for one not given it, unless kept already: a recording does this once (a small part of
-/// its rendering), so that even the first replay of it finds its bound in the cache.
-void prepare_bounds(const Scenario& sc, const std::vector<RobotRecord>& robots, const BoundCache& cache);
 
 /// The serialized entry of `part` (for tests: what store() writes) and its reading back (nullopt
 /// with `why` set when it does not check).
