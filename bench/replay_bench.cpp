@@ -12,7 +12,7 @@
 #include <memory>
 #include <string>
 
-#include "harness/cache/bound_cache.hpp"
+#include "harness/bound_cache.hpp"
 #include "harness/cache/cache_dirs.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/recording/recording_writer.hpp"
@@ -50,7 +50,7 @@ const std::string& recording() {
 
 }  // namespace
 
-// `bound_cached`: the bound's part comes from the bound cache (harness/cache/bound_cache.hpp), as for
+// `bound_cached`: the bound's part comes from the bound cache (harness/bound_cache.hpp), as for
 // every replay of these frames after the first; else the cache's entries are removed before each
 // iteration (outside the timing), so the bound is computed and kept as on a first replay.
 static void replay_tracking_matching(benchmark::State& state, bool bound_cached) {
