@@ -1,16 +1,17 @@
 #pragma once
 // The bound cache (docs/results.md "The limit", "Cost."): the estimate-free part of a robot's accuracy
 // bound (harness/scoring/bound.hpp BoundPart), kept once per set of frames. In a sweep many
-// localizers replay one recorded world; the bound reads only what the frames gave them, so every
-// replay after the first pays a digest of its frames and a file read instead of the bound's passes
-// over every line point.
+// localizers replay one recorded world; the bound reads only what the frames gave them, so a replay
+// whose bound is kept pays a digest of its frames and a file read instead of the bound's passes over
+// every line point: every replay of a world drawn or recorded here (harness/bound_prepare.hpp
+// computes its bounds then), else every one after the first.
 //
 // An entry is one file, <cache root>/bounds/<build fingerprint>/<key>.bound (harness/cache/cache_dirs.hpp):
 // the key is the SHA-256 of everything bound_part reads (the frames' times, truth, camera_ok, line
 // points, odometry and compass; the setup less `excluded`; the field's geometry); the folder is
 // this build's fingerprint, which holds the bound's code, the compiler and the libraries. The file
 // carries the SHA-256 of its own content and the number of frames: one that does not check (cut,
-// changed, another build's) is said on one line, removed and computed again: never used. Written to
+// changed, an older layout) is said on one line, removed and computed again: never used. Written to
 // a temporary name and renamed, so a reader never sees half an entry. Hits refresh the file's
 // time; a write prunes the least recently used entries past max_bytes. A cache that cannot be
 // written never costs a run: one warning line per process (core/cache_root.hpp), the run goes on.
