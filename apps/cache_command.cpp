@@ -23,7 +23,8 @@ const cli::Command kCache{
     "cache", "list|size|prune", 1, 1,
     "Every cache omniloc keeps, under one root: recorded worlds (worlds/: each world a run or sweep drew,\n"
     "replayed into every later run of it with any localizer), distance maps (fieldmaps/), mirror\n"
-    "calibration maps and colour tables (vision/). Docs: docs/recording.md \"World cache\".\n"
+    "calibration maps and colour tables (vision/), accuracy bounds of replayed frames (bounds/).\n"
+    "Docs: docs/recording.md \"World cache\".\n"
     "Root: OMNILOC_CACHE (\"off\": none), else $XDG_CACHE_HOME/omniloc, else ~/.cache/omniloc.\n"
     "Size limit of worlds/ while runs fill it: 20G, or OMNILOC_CACHE_MAX_SIZE.\n"
     "  list   each entry: kind, key or file, what it is, size, last used (newest first)\n"
@@ -65,18 +66,22 @@ std::string when(std::time_t t) {
 // One entry of any kind: a world (a folder under worlds/) or a file (a distance map, a calibration
 // map, a colour table).
 struct Entry {
-  std::string kind;  ///< "world", "fieldmap", "calibration", "colour"
+  std::string kind;  ///< "world", "fieldmap", "calibration", "colour", "bound"
   std::string name;  ///< the world's key, or the file's name
   std::string what;  ///< scenario and seed of a world; empty for files (the name says it)
   std::uint64_t bytes = 0;
   std::time_t last_used = 0;
 };
 
-// The files of the root's fieldmaps/<build>/ and vision/<build>/ folders (harness/cache/cache_dirs.hpp),
-// named "<build>/<file>". A file being written (name.tmp.<pid>) is not an entry yet.
+// The folder of a kind of file entry.
+const char* folder_of(const std::string& kind) { return kind == "fieldmap" ? "fieldmaps" : kind == "bound" ? "bounds" : "vision"; }
+
+// The files of the root's fieldmaps/<build>/, vision/<build>/ and bounds/<build>/ folders
+// (harness/cache/cache_dirs.hpp, harness/bound_cache.hpp), named "<build>/<file>". A file being
+// written (name.tmp.<pid>...) is not an entry yet.
 std::vector<Entry> file_entries(const std::string& root) {
   std::vector<Entry> out;
-  for (const char* kind : {"fieldmaps", "vision"}) {
+  for (const char* kind : {"fieldmaps", "vision", "bounds"}) {
     std::error_code ec;
     for (fs::directory_iterator b(fs::path(root) / kind, ec), end; !ec && b != end; b.increment(ec)) {
       std::error_code e1;
@@ -88,7 +93,10 @@ std::vector<Entry> file_entries(const std::string& root) {
         struct stat st {};
         if (::stat(it->path().c_str(), &st) != 0) continue;
         Entry e;
-        e.kind = std::string(kind) == "fieldmaps" ? "fieldmap" : n.rfind("colour", 0) == 0 ? "colour" : "calibration";
+        e.kind = std::string(kind) == "fieldmaps" ? "fieldmap"
+                 : std::string(kind) == "bounds"  ? "bound"
+                 : n.rfind("colour", 0) == 0      ? "colour"
+                                                  : "calibration";
         e.name = b->path().filename().string() + "/" + n;
         e.bytes = static_cast<std::uint64_t>(st.st_size);
         e.last_used = std::max(st.st_mtime, st.st_atime);
@@ -147,7 +155,7 @@ int cmd_cache(const cli::Args& a) {
     const auto entries = all_entries(worlds, root);
     std::uint64_t total = 0;
     std::cout << root << ":\n";
-    for (const char* kind : {"world", "fieldmap", "calibration", "colour"}) {
+    for (const char* kind : {"world", "fieldmap", "calibration", "colour", "bound"}) {
       std::size_t n = 0;
       std::uint64_t bytes = 0;
       for (const auto& e : entries)
@@ -182,7 +190,7 @@ int cmd_cache(const cli::Args& a) {
         if (r == harness::WorldCache::Removal::kBusy) ++busy;
       } else {
         std::error_code ec;
-        const fs::path file = fs::path(root) / (e.kind == "fieldmap" ? "fieldmaps" : "vision") / e.name;
+        const fs::path file = fs::path(root) / folder_of(e.kind) / e.name;
         gone = fs::remove(file, ec) && !ec;
         if (gone && fs::is_empty(file.parent_path(), ec)) fs::remove(file.parent_path(), ec);  // the build's folder, once empty
       }

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "apps/command_support.hpp"
+#include "harness/bound_prepare.hpp"
 #include "harness/recording/recording_writer.hpp"
 #include "harness/scenario.hpp"
 
@@ -27,7 +28,10 @@ int cmd_record(const cli::Args& a) {
   check_output_target(a, true);
   o.images = a.has("--images");
   if (!a.has("--quiet")) o.log = &std::cerr;
+  harness::BoundPreparer bounds(s);  // its replays' bounds, kept in the cache (docs/results.md "Cost.")
+  o.on_frame = [&bounds](const harness::FrameData& f) { bounds.add(f); };
   const auto r = harness::record_scenario(s, o);
+  bounds.finish();
   const double minutes = std::max(1e-9, s.duration / 60.0);
   std::cout << "scenario " << s.name << ", seed " << r.seed << ": " << r.frames << " frames, frames.jsonl.gz " << r.frames_bytes / 1024
             << " KiB (" << static_cast<long long>(static_cast<double>(r.frames_bytes) / minutes / 1024) << " KiB per minute; "

@@ -9,8 +9,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 
+#include "harness/bound_cache.hpp"
 #include "harness/cache/cache_dirs.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/recording/recording_writer.hpp"
@@ -48,22 +50,35 @@ const std::string& recording() {
 
 }  // namespace
 
-static void BM_ReplayTrackingMatching(benchmark::State& state) {
+// `bound_cached`: the bound's part comes from the bound cache (harness/bound_cache.hpp), as for
+// every replay of these frames after the first; else the cache's entries are removed before each
+// iteration (outside the timing), so the bound is computed and kept as on a first replay.
+static void replay_tracking_matching(benchmark::State& state, bool bound_cached) {
   const std::string dir = recording();
   const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
   const harness::Scenario sc = harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer"));
   harness::RunOptions o;
   o.out_dir = tmp("replay_out").string();
   o.replay = true;
+  const std::string bounds = harness::bound_cache_from_env().dir;
   double frames = 0;
   for (auto _ : state) {
+    if (!bound_cached && !bounds.empty()) {
+      state.PauseTiming();
+      std::error_code ec;
+      fs::remove_all(bounds, ec);
+      state.ResumeTiming();
+    }
     harness::RecordingSource source(harness::RecordingHeader::read(dir));
     const auto r = harness::run_frames(sc, head.seed, source, o, Json::object());
     frames += static_cast<double>(r.robots.at(0).frames);
   }
   state.counters["frames_per_s"] = benchmark::Counter(frames, benchmark::Counter::kIsRate);
 }
+static void BM_ReplayTrackingMatching(benchmark::State& state) { replay_tracking_matching(state, false); }
 BENCHMARK(BM_ReplayTrackingMatching)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+static void BM_ReplayTrackingMatchingBoundCached(benchmark::State& state) { replay_tracking_matching(state, true); }
+BENCHMARK(BM_ReplayTrackingMatchingBoundCached)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 // Reading alone: decompressing, parsing and checking every frame.
 static void BM_ReadTrackingRecording(benchmark::State& state) {
@@ -120,12 +135,17 @@ BENCHMARK(BM_RecordTracking10s)->Unit(benchmark::kMillisecond)->MeasureProcessCP
 
 // The accuracy bound (harness/scoring/bound.hpp) alone on the same 1801 frames, as scoring computes
 // it after a replay: its cost beside BM_ReplayTrackingMatching's (it must stay under 5 % of it).
-static void BM_BoundOnTrackingFrames(benchmark::State& state) {
-  const std::string dir = recording();
-  const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
-  const harness::Scenario sc = harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer"));
+struct BoundInput {
+  harness::Scenario sc;
   harness::RobotRecord rec;
-  {
+  harness::BoundSetup setup;
+};
+// Read once per process; the setup points into the scenario beside it, so the whole stays in place.
+static const BoundInput& bound_input() {
+  static const std::unique_ptr<BoundInput> in = [] {
+    const std::string dir = recording();
+    const harness::RecordingHeader head = harness::RecordingHeader::read(dir);
+    auto b = std::make_unique<BoundInput>(BoundInput{harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer")), {}, {}});
     harness::RecordingSource source(harness::RecordingHeader::read(dir));
     while (auto f = source.next()) {
       const harness::RobotFrame& rf = f->robots.at(0);
@@ -138,29 +158,71 @@ static void BM_BoundOnTrackingFrames(benchmark::State& state) {
       for (const auto& p : rf.obs.line_points) r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
       r.odometry = rf.odometry.delta;
       r.heading = rf.heading;
-      rec.frames.push_back(std::move(r));
+      b->rec.frames.push_back(std::move(r));
     }
-  }
-  const sim::CameraConfig cam = sim::CameraConfig::from_json(sc.camera, "/camera");
-  harness::BoundSetup setup;
-  setup.field = &sc.field;
-  setup.mount_height = cam.mount_height;
-  setup.latency_s = cam.latency;
-  setup.vibration_std = cam.vibration_std;
-  setup.physics_dt = 1.0 / sc.physics_rate;
-  const harness::RobotConfig& rc = sc.robots.at(0);
-  setup.trans_sigma = rc.odometry.trans_sigma;
-  setup.rot_sigma = rc.odometry.rot_sigma;
-  setup.rot_per_trans = rc.odometry.rot_per_trans;
-  setup.scale_sigma = rc.odometry.scale_sigma;
-  setup.has_heading_sensor = rc.has_heading_sensor;
-  setup.heading_sigma = rc.heading.noise_sigma;
-  setup.start_pose_given = true;
+    const sim::CameraConfig cam = sim::CameraConfig::from_json(b->sc.camera, "/camera");
+    harness::BoundSetup& setup = b->setup;
+    setup.field = &b->sc.field;
+    setup.mount_height = cam.mount_height;
+    setup.latency_s = cam.latency;
+    setup.vibration_std = cam.vibration_std;
+    setup.physics_dt = 1.0 / b->sc.physics_rate;
+    const harness::RobotConfig& rc = b->sc.robots.at(0);
+    setup.trans_sigma = rc.odometry.trans_sigma;
+    setup.rot_sigma = rc.odometry.rot_sigma;
+    setup.rot_per_trans = rc.odometry.rot_per_trans;
+    setup.scale_sigma = rc.odometry.scale_sigma;
+    setup.has_heading_sensor = rc.has_heading_sensor;
+    setup.heading_sigma = rc.heading.noise_sigma;
+    setup.start_pose_given = true;
+    return b;
+  }();
+  return *in;
+}
+
+static void BM_BoundOnTrackingFrames(benchmark::State& state) {
+  const BoundInput& in = bound_input();
   double n = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(harness::bound_robot(rec, setup));
-    n += static_cast<double>(rec.frames.size());
+    benchmark::DoNotOptimize(harness::bound_robot(in.rec, in.setup));
+    n += static_cast<double>(in.rec.frames.size());
   }
   state.counters["frames_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_BoundOnTrackingFrames)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// Through the bound cache, in a folder of its own: a first replay of these frames (the entry removed
+// before each iteration, outside the timing: the bound computed, its digest and the entry written)
+// and every later one (the digest, the entry read and checked, the efficiency).
+static void bound_cached(benchmark::State& state, bool warm) {
+  const BoundInput& in = bound_input();
+  harness::BoundCacheOptions o;
+  o.dir = tmp("bound_cache").string();
+  const harness::BoundCache cache(o);
+  std::error_code ec;
+  fs::remove_all(o.dir, ec);
+  const std::string entry = cache.entry_path(harness::bound_key(in.rec, in.setup));
+  if (warm) benchmark::DoNotOptimize(harness::bound_robot_cached(in.rec, in.setup, cache));
+  double n = 0;
+  for (auto _ : state) {
+    if (!warm) {
+      state.PauseTiming();
+      fs::remove(entry, ec);
+      state.ResumeTiming();
+    }
+    benchmark::DoNotOptimize(harness::bound_robot_cached(in.rec, in.setup, cache));
+    n += static_cast<double>(in.rec.frames.size());
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+}
+static void BM_BoundCacheColdOnTrackingFrames(benchmark::State& state) { bound_cached(state, false); }
+BENCHMARK(BM_BoundCacheColdOnTrackingFrames)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+static void BM_BoundCacheWarmOnTrackingFrames(benchmark::State& state) { bound_cached(state, true); }
+BENCHMARK(BM_BoundCacheWarmOnTrackingFrames)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+// The warm lookup's first half: the SHA-256 of everything the bound reads (about 1.3 MB here).
+static void BM_BoundKeyOnTrackingFrames(benchmark::State& state) {
+  const BoundInput& in = bound_input();
+  for (auto _ : state) benchmark::DoNotOptimize(harness::bound_key(in.rec, in.setup));
+}
+BENCHMARK(BM_BoundKeyOnTrackingFrames)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();

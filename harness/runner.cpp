@@ -11,6 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/version.hpp"
 #include "external/external_localizer.hpp"
+#include "harness/bound_cache.hpp"
 #include "harness/cache/cache_dirs.hpp"
 #include "harness/external_session.hpp"
 #include "harness/frame_source.hpp"
@@ -100,6 +101,7 @@ Estimate robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOp
     row.extra["exposure_ms"] = rf.settings->exposure_ms;
     row.extra["gain"] = rf.settings->gain;
   }
+  // What the bound reads, converted as bound_frame() (harness/bound_cache.hpp) does for a recording.
   row.line_points.reserve(rf.obs.line_points.size());
   for (const auto& p : rf.obs.line_points) row.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
   tr.record.frames.push_back(std::move(row));
@@ -141,33 +143,6 @@ std::string view_line(const Tracked& tr, const RobotFrame& rf, long long k, cons
   return j.dump() + "\n";
 }
 
-// What the accuracy bound of robot `id` takes from the scenario: the field, the camera's geometry,
-// latency and vibration, the declared odometry and compass noise, and when the robot was moved
-// without odometry (teleport, kidnap: the posterior bound starts again).
-BoundSetup bound_setup(const Scenario& sc, int id, bool start_pose_given) {
-  BoundSetup b;
-  b.field = &sc.field;
-  const sim::CameraConfig cam = sim::CameraConfig::from_json(sc.camera, "/camera");
-  b.mount_height = cam.mount_height;
-  b.latency_s = cam.latency;
-  b.vibration_std = cam.vibration_std;
-  b.tilt_per_accel = cam.tilt_per_accel;
-  b.physics_dt = 1.0 / sc.physics_rate;
-  b.camera_rate = sc.camera_rate;
-  if (const RobotConfig* rc = sc.robot(id)) {
-    b.trans_sigma = rc->odometry.trans_sigma;
-    b.rot_sigma = rc->odometry.rot_sigma;
-    b.rot_per_trans = rc->odometry.rot_per_trans;
-    b.scale_sigma = rc->odometry.scale_sigma;
-    b.has_heading_sensor = rc->has_heading_sensor;
-    b.heading_sigma = rc->heading.noise_sigma;
-  }
-  b.start_pose_given = start_pose_given;
-  for (const auto& e : sc.events)
-    if (e.robot == id && (e.as<Kidnap>() || e.as<Teleport>())) b.resets.push_back(e.t);
-  return b;
-}
-
 // Scores every robot and writes the result files; the table rows go to `result`.
 // `localizer`: the name results carry; `external`: an external client's provenance (else null);
 // `start_pose_given`: whether the localizer was reset with the true start pose.
@@ -198,6 +173,8 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
   for (auto it = provenance.begin(); it != provenance.end(); ++it) summary["omniloc"][it.key()] = it.value();
   std::vector<TableRow> rows;
   std::vector<std::vector<FrameBound>> bounds(records.size());
+  // The bound's estimate-free part is the same for every localizer replaying these frames: kept once.
+  const BoundCache bound_cache(bound_cache_from_env());
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RobotRecord& rec = records[i];
     const std::string suffix = i == 0 ? "" : "_r" + std::to_string(rec.id);
@@ -220,7 +197,7 @@ void write_results(const Scenario& sc, std::uint64_t seed, const std::string& lo
     BoundSetup bs = bound_setup(sc, rec.id, start_pose_given);
     if (score.json.contains("tracking_phase"))
       for (const auto& iv : score.json["tracking_phase"]["excluded"]) bs.excluded.emplace_back(iv[0].get<double>(), iv[1].get<double>());
-    RobotBound rb = bound_robot(rec, bs);
+    RobotBound rb = bound_robot_cached(rec, bs, bound_cache);
     score.json["bound"] = std::move(rb.bound);
     score.json["efficiency"] = std::move(rb.efficiency);
     score.json["efficiency_single_frame"] = std::move(rb.efficiency_single);

@@ -1,6 +1,6 @@
 """Caches where users expect them (docs/recording.md section 9).
 
-- Every cache omniloc keeps (recorded worlds, distance tables, calibration maps, colour tables) lives
+- Every cache omniloc keeps (recorded worlds, distance tables, calibration maps, colour tables, bounds) lives
   under one root: $OMNILOC_CACHE, else $XDG_CACHE_HOME/omniloc (absolute only), else ~/.cache/omniloc;
   a run, a record and a replay write nothing into the working directory but what -o names.
 - `omniloc cache list | size | prune` covers every kind of entry under the root.
@@ -110,6 +110,8 @@ class CacheRoot(unittest.TestCase):
         self.assertEqual(len(list((root / "fieldmaps").glob("*/fieldmap_*.bin"))), 1, files_under(root))
         self.assertEqual(len(list((root / "vision").glob("*/calibration_v2_*.json"))), 1, files_under(root))
         self.assertEqual(len(list((root / "vision").glob("*/colour_v2_*.lut"))), 1, files_under(root))
+        # The world's bounds, computed when it was drawn: for a localizer given its start pose and one not.
+        self.assertEqual(len(list((root / "bounds").glob("*/*.bound"))), 2, files_under(root))
 
     def test_default_root_is_the_users_cache_and_the_working_directory_stays_empty(self):
         home, cwd, out = self.fresh("home"), self.fresh("cwd"), self.fresh("out")
@@ -130,18 +132,20 @@ class CacheRoot(unittest.TestCase):
         self.assertEqual(files_under(cwd), [])
         self.assertEqual(files_under(other), [])
 
-        # omniloc cache: every kind, then pruned empty.
+        # omniloc cache: every kind, then pruned empty. Two bounds (the world's, drawn with it): matching
+        # read the one with its start pose given, mcl the other.
         r = self.omniloc("cache", "list", env=env, cwd=cwd)
         kinds = [line.split()[0] for line in r.stdout.splitlines()[1:-1]]
-        self.assertEqual(sorted(kinds), ["calibration", "colour", "fieldmap", "world"], r.stdout)
+        self.assertEqual(sorted(kinds), ["bound", "bound", "calibration", "colour", "fieldmap", "world"], r.stdout)
         self.assertRegex(r.stdout, r"cache_root, seed 3, \d+ frames")
-        self.assertTrue(r.stdout.splitlines()[-1].startswith("4 entries, "), r.stdout)
+        self.assertTrue(r.stdout.splitlines()[-1].startswith("6 entries, "), r.stdout)
         r = self.omniloc("cache", "size", env=env, cwd=cwd)
-        for kind in ("world", "fieldmap", "calibration", "colour"):
-            self.assertRegex(r.stdout, rf"\n  {kind} +1 entries ")
+        for kind, n in (("world", 1), ("fieldmap", 1), ("calibration", 1), ("colour", 1), ("bound", 2)):
+            self.assertRegex(r.stdout, rf"\n  {kind} +{n} entries ")
         r = self.omniloc("cache", "prune", "--max-size", "0", env=env, cwd=cwd)
-        self.assertTrue(r.stdout.startswith("removed 4 entries"), r.stdout)
-        left = [f for f in files_under(home / ".cache" / "omniloc") if not f.startswith("worlds/.locks") and f not in ("worlds", "fieldmaps", "vision")]
+        self.assertTrue(r.stdout.startswith("removed 6 entries"), r.stdout)
+        left = [f for f in files_under(home / ".cache" / "omniloc")
+                if not f.startswith("worlds/.locks") and f not in ("worlds", "fieldmaps", "vision", "bounds")]
         self.assertEqual(left, [])
         self.assertEqual(files_under(cwd), [])
 

@@ -21,6 +21,7 @@
 #include "core/error.hpp"
 #include "core/json_parse.hpp"
 #include "external/sha256.hpp"
+#include "harness/bound_prepare.hpp"
 #include "harness/frame_source.hpp"
 #include "harness/localizer_registry.hpp"
 #include "harness/recording/recording_writer.hpp"
@@ -299,7 +300,10 @@ WorldLease WorldCache::get(const Scenario& sc, std::uint64_t seed, bool images) 
       ro.out_dir = dir.string();
       ro.images = images;
       if (o_.log) *o_.log << "  world cache: drawing " << sc.name << ", seed " << seed << (images ? " with images" : "") << " into " << dir.string() << "\n";
+      BoundPreparer bounds(world);  // the world's bounds too: then even its first replay reads them
+      ro.on_frame = [&bounds](const FrameData& f) { bounds.add(f); };
       const RecordResult rec = record_scenario(world, ro);
+      bounds.finish();
       long long n_images = 0;
       std::uint64_t image_bytes = 0;
       count_images(dir, n_images, image_bytes);

@@ -38,6 +38,7 @@ RecordResult record_scenario(const Scenario& sc, const RecordOptions& opt) {
   std::string timing = "k,robot,render_ms,vision_ms\n";  // wall time: the one file that differs between recordings of a run
   while (auto f = source.next()) {
     frames += frame_to_json(*f).dump() + "\n";
+    if (opt.on_frame) opt.on_frame(*f);
     for (const auto& r : f->robots) {
       char row[128];
       std::snprintf(row, sizeof row, "%lld,%d,%.4f,%.4f\n", f->k, r.id, r.render_ms, r.vision_ms);

@@ -5,10 +5,12 @@
 // leaves nothing that looks whole.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
 
+#include "harness/frame_data.hpp"
 #include "harness/scenario.hpp"
 
 namespace omniloc::harness {
@@ -18,6 +20,8 @@ struct RecordOptions {
   std::string out_dir;                ///< default: results/recordings/<scenario>/<seed>
   bool images = false;                ///< also write every frame's image (PNG, lossless)
   std::ostream* log = nullptr;        ///< progress (null: silent)
+  /// Every frame as it is recorded (the bound cache's BoundPreparer, harness/bound_prepare.hpp).
+  std::function<void(const FrameData&)> on_frame;
 };
 
 struct RecordResult {

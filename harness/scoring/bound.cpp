@@ -39,8 +39,8 @@ constexpr std::size_t kClasses = 2 * kBands;
 // A class measured from fewer points takes its band's pooled figure.
 constexpr std::size_t kMinClassPoints = 30;
 
-// By value: callers that no longer need their sample move it in (nth_element reorders it).
-double median(std::vector<double> v) {
+// Reorders `v` (nth_element): the value does not depend on the order it finds.
+double median_in_place(std::vector<double>& v) {
   if (v.empty()) return std::nan("");
   const std::size_t n = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n), v.end());
@@ -49,14 +49,18 @@ double median(std::vector<double> v) {
   return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)));
 }
 
+// By value: callers that no longer need their sample move it in.
+double median(std::vector<double> v) { return median_in_place(v); }
+
 // 1.4826 x the median absolute deviation from the median; NaN for an empty sample.
 double robust_sigma(std::vector<double> v, double* centre = nullptr) {
   if (centre) *centre = std::nan("");
   if (v.empty()) return std::nan("");
-  const double m = median(v);
+  // The deviations are taken in the order the first median left: the same values, so the same median.
+  const double m = median_in_place(v);
   if (centre) *centre = m;
   for (double& x : v) x = std::fabs(x - m);
-  return kMadToSigma * median(std::move(v));
+  return kMadToSigma * median_in_place(v);
 }
 
 int band_of(double r) {
@@ -92,14 +96,26 @@ void consider_segment(const Eigen::Vector2d& w, const Eigen::Vector2d& a, const 
   }
 }
 
-void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, int index, double& best, MarkingMatch& m) {
+// An arc's start and end directions and end points: the same for every point matched against it.
+struct ArcEnds {
+  Eigen::Vector2d e0, e1;
+  std::array<Eigen::Vector2d, 2> ends;
+  explicit ArcEnds(const ArcMarking& arc)
+      : e0(std::cos(arc.start), std::sin(arc.start)), e1(std::cos(arc.start + arc.sweep), std::sin(arc.start + arc.sweep)) {
+    int i = 0;
+    for (const double ang : {arc.start, arc.start + arc.sweep}) ends[static_cast<std::size_t>(i++)] = arc.centre + arc.radius * Eigen::Vector2d(std::cos(ang), std::sin(ang));
+  }
+};
+
+void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, const ArcEnds& ae, int index, double& best, MarkingMatch& m) {
   const Eigen::Vector2d dc = w - arc.centre;
   const double r = dc.norm();
   if (!(r > 1e-9)) return;
   bool inside = arc.sweep >= kTwoPi - 1e-12;
   if (!inside && arc.sweep <= kPi) {
     // Within the sweep: anticlockwise of its start direction and clockwise of its end (no atan2).
-    const Eigen::Vector2d e0(std::cos(arc.start), std::sin(arc.start)), e1(std::cos(arc.start + arc.sweep), std::sin(arc.start + arc.sweep));
+    const Eigen::Vector2d& e0 = ae.e0;
+    const Eigen::Vector2d& e1 = ae.e1;
     inside = e0.x() * dc.y() - e0.y() * dc.x() >= 0 && dc.x() * e1.y() - dc.y() * e1.x() >= 0;
   } else if (!inside) {
     inside = wrap_angle_positive(std::atan2(dc.y(), dc.x()) - arc.start) <= arc.sweep;
@@ -114,8 +130,7 @@ void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, int index, do
     m.residual = r - arc.radius;
     return;
   }
-  for (const double ang : {arc.start, arc.start + arc.sweep}) {
-    const Eigen::Vector2d e = arc.centre + arc.radius * Eigen::Vector2d(std::cos(ang), std::sin(ang));
+  for (const Eigen::Vector2d& e : ae.ends) {
     const double d = (w - e).norm();
     if (!(d < best)) continue;
     best = d;
@@ -144,7 +159,7 @@ MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w) {
   double best = kInf;
   int index = 0;
   for (const auto& s : field.segments) consider_segment(w, s.a, s.b, index++, best, m);
-  for (const auto& a : field.arcs) consider_arc(w, a, index++, best, m);
+  for (const auto& a : field.arcs) consider_arc(w, a, ArcEnds(a), index++, best, m);
   for (const auto& s : field.spots) consider_spot(w, s, best, m);
   return m;
 }
@@ -494,6 +509,7 @@ constexpr double kMatchReach = 1.0;
 class MarkingIndex {
  public:
   explicit MarkingIndex(const Field& f) : f_(f) {
+    for (const auto& a : f.arcs) arc_ends_.emplace_back(a);
     x0_ = -f.half_floor_x() - kMatchReach;
     y0_ = -f.half_floor_y() - kMatchReach;
     nx_ = static_cast<int>(std::ceil(2 * (f.half_floor_x() + kMatchReach) / kCell));
@@ -521,7 +537,7 @@ class MarkingIndex {
     double best = kMatchReach;
     const int nseg = static_cast<int>(f_.segments.size());
     for (int k : cell.segments) consider_segment(w, f_.segments[static_cast<std::size_t>(k)].a, f_.segments[static_cast<std::size_t>(k)].b, k, best, m);
-    for (int k : cell.arcs) consider_arc(w, f_.arcs[static_cast<std::size_t>(k)], nseg + k, best, m);
+    for (int k : cell.arcs) consider_arc(w, f_.arcs[static_cast<std::size_t>(k)], arc_ends_[static_cast<std::size_t>(k)], nseg + k, best, m);
     for (int k : cell.spots) consider_spot(w, f_.spots[static_cast<std::size_t>(k)], best, m);
     return m;
   }
@@ -532,6 +548,7 @@ class MarkingIndex {
     std::vector<int> segments, arcs, spots;
   };
   const Field& f_;
+  std::vector<ArcEnds> arc_ends_;  // one per arc: its cosines and sines, once
   double x0_ = 0, y0_ = 0;
   int nx_ = 0, ny_ = 0;
   std::vector<Cell> cells_;
@@ -568,7 +585,7 @@ std::vector<FrameWork> match_points(const std::vector<FrameRecord>& frames, cons
       }
       PointRes q;
       const double r = p.norm();
-      const bool grazing = r > 0 && std::fabs(m.normal.dot(fw.pose.rotation() * p) / r) < kGrazing;
+      const bool grazing = r > 0 && std::fabs(m.normal.dot(rot * p) / r) < kGrazing;
       q.band = static_cast<std::uint8_t>(band_of(r) + (grazing ? static_cast<int>(kBands) : 0));
       q.residual = m.residual;
       const Eigen::Vector2d lever = w - fw.pose.translation();
@@ -916,8 +933,8 @@ Json noise_json(const NoiseModel& nm, std::size_t used_points, double h, const B
 
 }  // namespace
 
-RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
-  RobotBound out;
+BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
+  BoundPart out;
   const auto& frames = robot.frames;
   const std::size_t nf = frames.size();
   out.frames.resize(nf);
@@ -939,9 +956,6 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   std::vector<double> resets = setup.resets;
   std::sort(resets.begin(), resets.end());
   const Series post = posterior_bounds(frames, poses, sf.info, resets, setup, field, out.frames);
-  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
-  // the frames carry odometry at all, which the setup says.
-  const bool odometry = setup.has_odometry;
   const OdometryError oe = odometry_error(frames, resets, setup);
 
   // Latency: the shift between the pose the image shows and the pose scored, a bias of any
@@ -986,7 +1000,19 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
                   {"treatment", "a bias, not noise: the bound is on the pose the image was exposed at; the shift to the frame's pose is "
                                 "what a localizer that does not carry its estimate forward adds"}};
   b["assumptions"] = "known association, measured Gaussian noise, unbiased estimator";
+  return out;
+}
 
+RobotBound bound_from_part(const RobotRecord& robot, const BoundSetup& setup, BoundPart part) {
+  RobotBound out;
+  out.frames = std::move(part.frames);
+  out.bound = std::move(part.bound);
+  const std::size_t nf = robot.frames.size();
+  // A robot standing still has odometry too (increments of zero tell it so): what decides is whether
+  // the frames carry odometry at all, which the setup says.
+  const bool odometry = setup.has_odometry;
+  // Recomputed rather than kept: a pass over the frames, and what a cached part would otherwise carry.
+  const std::vector<Pose2> poses = setup.latency_s > 0 ? exposure_poses(robot, setup) : std::vector<Pose2>();
   std::vector<std::optional<double>> sp(nf), sh(nf), pp(nf), ph(nf);
   for (std::size_t k = 0; k < nf; ++k) {
     sp[k] = out.frames[k].pos;
@@ -1006,5 +1032,7 @@ RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) {
   }
   return out;
 }
+
+RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup) { return bound_from_part(robot, setup, bound_part(robot, setup)); }
 
 }  // namespace omniloc::harness

@@ -136,6 +136,18 @@ struct RobotBound {
 /// estimates (rmse / bound RMS over the frames that have both).
 RobotBound bound_robot(const RobotRecord& robot, const BoundSetup& setup);
 
+/// What of a robot's bound the localizer's estimates do not change: the bound of every frame and
+/// summary.json's "bound". It reads only what the frames gave the localizer (truth, line points,
+/// camera_ok, odometry, compass, times) and the setup less `excluded`: the part the bound cache
+/// (harness/bound_cache.hpp) keeps, the costly one.
+struct BoundPart {
+  std::vector<FrameBound> frames;
+  Json bound;
+};
+BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup);
+/// The rest: the efficiency of the robot's estimates against `part` (bound_robot is the two in turn).
+RobotBound bound_from_part(const RobotRecord& robot, const BoundSetup& setup, BoundPart part);
+
 /// rmse / bound RMS over the frames with a valid estimate and a finite bound (`against` names the
 /// bound); null with why_null where there are none or the bound is 0. `exposure`: the poses the
 /// images were exposed at (with camera latency), for rmse_at_exposure_m beside.
