@@ -70,12 +70,46 @@ def test_texts():
         "5 frames without a bound: 4 points on one line, 1 no points"
 
 
-def test_tracking_phase_is_read_where_it_has_the_bound():
-    r = bounded(1.3, extra={"tracking_phase": dict(scored(robot(2.0)), **limit_blocks(0.02, 1.1))})
+def with_tracking_phase(r, rmse_m, eff):
+    """A robot block of a run with kidnaps as omniloc writes it (harness/scoring/bound.cpp): the
+    tracking phase's errors in tracking_phase, its efficiencies inside the run's efficiency blocks."""
+    phase = limit_blocks(rmse_m, eff)
+    r = dict(r, tracking_phase=scored(robot(rmse_m * 100)))
+    r["efficiency"] = dict(r["efficiency"], tracking_phase=phase["efficiency"])
+    r["efficiency_single_frame"] = dict(r["efficiency_single_frame"], tracking_phase=phase["efficiency_single_frame"])
+    return r
+
+
+def test_tracking_phase_is_read_where_omniloc_writes_it():
+    r = with_tracking_phase(bounded(1.3), 0.02, 1.1)
     rb = bound.robot_bound(r)
     assert rb is not None and rb.efficiency is not None and rb.efficiency.position == 1.1
+    assert rb.error_m == pytest.approx(0.02) and rb.limit_m == pytest.approx(0.02 / 1.1)
+    assert rb.efficiency_single_frame is not None and rb.efficiency_single_frame.position == pytest.approx(1.1 / 1.4)
+    assert rb.bound is not None and rb.bound.posterior is not None  # the run's bound figures
     all_frames = bound.robot_bound(r, phase="all")
     assert all_frames is not None and all_frames.efficiency is not None and all_frames.efficiency.position == 1.3
+    # a run without kidnaps: the whole run, for either phase
+    assert bound.robot_bound(bounded(1.3)).efficiency.position == 1.3
+
+
+def test_the_run_table_and_the_aggregate_read_the_tracking_phase(tmp_path):
+    write_run(tmp_path / "k", "kidnap_002", "hybrid", 1, {}, with_tracking_phase(bounded(30.0), 0.02, 1.1),
+              start_pose_given=False, scoring=SCORING)
+    run = discover([tmp_path / "k"])[0][0]
+    names = [row[0] for row in limit.robot_rows(run)]
+    assert names[0] == "r0 all frames" and names[1] == "r0 tracking phase"
+    assert [r[3] for r in limit.localizer_rows([run])] == ["1.10x"]
+    m = {"n": 3, "mean": 1.1, "ci95": [1.0, 1.2], "interval": "range", "no_value": 0}
+    g = AggregateGroup.from_json({"metrics": {"r0/efficiency/position": dict(m, mean=30.0),
+                                              "r0/efficiency/tracking_phase/position": m,
+                                              "r0/efficiency/tracking_phase/bound_rms_m": dict(m, mean=0.018),
+                                              "r0/efficiency/tracking_phase/share": dict(m, mean=0.9),
+                                              "r0/efficiency/share": dict(m, mean=0.97)}})
+    assert g.limit_metric("efficiency_position", phase=True).mean == 1.1
+    assert g.limit_metric("efficiency_position").mean == 30.0
+    assert g.limit_metric("bound_position_rms_m", phase=True).mean == 0.018
+    assert limit.aggregate_share_cell(g, True) == "90 %" and limit.aggregate_share_cell(g, False) == "97 %"
 
 
 def test_aggregate_group_limit_metric_under_either_name():

@@ -73,10 +73,13 @@ class AggregateGroup:
         bound) or "bound_position_rms_m" (the bound, m), under the name the aggregate gives it
         (batch/aggregate.cpp's key, or robot 0's summary.json path, posterior bound first); None
         for an aggregate of runs made before the bound (never 0)."""
-        base = "r0/tracking_phase/" if phase else "r0/"
+        # The tracking phase's (runs with kidnaps or covers) is kept inside the efficiency block:
+        # r0/efficiency/tracking_phase/position and .../bound_rms_m (the bound over its frames).
+        phased = {"efficiency_position": ["r0/efficiency/tracking_phase/position"],
+                  "bound_position_rms_m": ["r0/efficiency/tracking_phase/bound_rms_m"]}[which] if phase else []
         paths = {"efficiency_position": ["efficiency/position"],
                  "bound_position_rms_m": ["bound/posterior/position_rms_m", "bound/single_frame/position_rms_m"]}[which]
-        for name in [which, "r0/" + which] + [base + p for p in paths] + ["r0/" + p for p in paths]:
+        for name in phased + [which, "r0/" + which] + ["r0/" + p for p in paths]:
             if name in self.metrics:
                 return self.metrics[name]
         return None

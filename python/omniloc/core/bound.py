@@ -226,15 +226,30 @@ def read_robot_bound(block: JSONObject) -> Optional[RobotBound]:
                       rpe=Rpe.from_json(block.get("rpe")), rmse_m=number(obj(block.get("position_m")).get("rmse")))
 
 
+def tracking_phase_block(robot: JSONObject) -> Optional[JSONObject]:
+    """The robot block of a run with kidnaps or covers as its tracking phase sees the limit: omniloc
+    writes that phase's efficiencies inside the whole run's (efficiency.tracking_phase,
+    efficiency_single_frame.tracking_phase) and its errors in tracking_phase; the bound and the RPE
+    are the run's. None for a run without a tracking phase or without the bound."""
+    tp = robot.get("tracking_phase")
+    eff = robot.get("efficiency")
+    if not isinstance(tp, dict) or not isinstance(eff, dict) or not isinstance(eff.get("tracking_phase"), dict):
+        return None
+    single = robot.get("efficiency_single_frame")
+    block: JSONObject = {"bound": robot.get("bound"), "efficiency": eff["tracking_phase"], "rpe": robot.get("rpe"),
+                         "position_m": tp.get("position_m")}
+    if isinstance(single, dict) and isinstance(single.get("tracking_phase"), dict):
+        block["efficiency_single_frame"] = single["tracking_phase"]
+    return block
+
+
 def robot_bound(robot: Optional[JSONObject], phase: str = "tracking") -> Optional[RobotBound]:
-    """A robot block's bound, from its tracking-phase block where it has one with the bound (runs
-    with kidnaps or covers), as Run.lookup reads the other statistics."""
+    """A robot block's bound, over its tracking phase where it has one (runs with kidnaps or covers:
+    tracking_phase_block), as Run.lookup reads the other statistics."""
     if robot is None:
         return None
-    tp = robot.get("tracking_phase")
-    if phase == "tracking" and isinstance(tp, dict) and has_bound(tp):
-        return read_robot_bound(tp)
-    return read_robot_bound(robot)
+    tp = tracking_phase_block(robot) if phase == "tracking" else None
+    return read_robot_bound(tp if tp is not None else robot)
 
 
 def optional_numbers(v: JSON) -> list[Optional[float]]:

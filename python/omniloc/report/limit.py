@@ -121,8 +121,8 @@ def robot_rows(run: Run) -> list[list[Cell]]:
     rows: list[list[Cell]] = []
     for r in run.summary.robots:
         blocks = [(f"r{r.get('robot', 0)}" + (" all frames" if "tracking_phase" in r else ""), r)]
-        tp = r.get("tracking_phase")
-        if isinstance(tp, dict) and bound.has_bound(tp):
+        tp = bound.tracking_phase_block(r)
+        if tp is not None:
             blocks.append((f"r{r.get('robot', 0)} tracking phase", tp))
         for name, block in blocks:
             rb = read_robot_bound(block)
@@ -195,8 +195,7 @@ def no_value_note(m: Optional[AggregateMetric]) -> str:
 
 def aggregate_share_cell(g: AggregateGroup, phase: bool) -> str:
     """The mean share of frames the group's efficiency covers ('97 %'; '-' where it has none)."""
-    base = "r0/tracking_phase/" if phase else "r0/"
-    m = g.metrics.get(base + "efficiency/share") or g.metrics.get("r0/efficiency/share")
+    m = (g.metrics.get("r0/efficiency/tracking_phase/share") if phase else None) or g.metrics.get("r0/efficiency/share")
     return "-" if m is None or m.mean is None else f"{100.0 * m.mean:.0f} %"
 
 
