@@ -6,7 +6,8 @@ usage: limit_table.py RESULTS... [--accept-incomplete]
 RESULTS are run or sweep folders, or folders holding them (e.g. results/sweeps/paper_suite). Per
 localizer and scenario family (a scenario's name without its numbered suffix): the runs, the mean
 over runs of the position and heading RMSE over the Cramer-Rao bound of the same frames (summary.json
-efficiency: 1x is the limit; posterior bound where the runs track), the mean share of frames the bound
+efficiency: 1x is the limit; posterior bound where the runs track; the tracking phase of runs with
+kidnaps or covers) with the mean RMSE and bound they are of, the mean share of frames the bound
 covers, and the runs without a bound ("no bound" where none has one, never 0). docs/localizers.md's
 efficiency table of the built-in localizers on the paper suite is this table. Runs made before the
 bound are left out; exit 2 when no run carries it.

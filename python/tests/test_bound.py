@@ -99,7 +99,7 @@ def test_the_run_table_and_the_aggregate_read_the_tracking_phase(tmp_path):
     run = discover([tmp_path / "k"])[0][0]
     names = [row[0] for row in limit.robot_rows(run)]
     assert names[0] == "r0 all frames" and names[1] == "r0 tracking phase"
-    assert [r[3] for r in limit.localizer_rows([run])] == ["1.10x"]
+    assert [r[3] for r in limit.localizer_rows([run])] == ["1.10x"] and [r[5] for r in limit.localizer_rows([run])] == ["2 cm"]
     m = {"n": 3, "mean": 1.1, "ci95": [1.0, 1.2], "interval": "range", "no_value": 0}
     g = AggregateGroup.from_json({"metrics": {"r0/efficiency/position": dict(m, mean=30.0),
                                               "r0/efficiency/tracking_phase/position": m,
@@ -289,12 +289,13 @@ def test_seed_table_and_run_table_in_a_written_report(tmp_path):
 def test_localizer_rows_for_the_efficiency_table(tmp_path):
     runs = (write_side(tmp_path / "t", [1.2, 1.4], scenario="tracking") + write_side(tmp_path / "o", [None], scenario="occlusion_002")
             + write_side(tmp_path / "m", [3.0], scenario="tracking", localizer="mcl"))
-    assert limit.localizer_rows(runs) == [["matching", "occlusion", "1", "no bound", "no bound", "-", "1"],
-                                          ["matching", "tracking", "2", "1.30x", "1.10x", "97 %", "0"],
-                                          ["mcl", "tracking", "1", "3.00x", "1.10x", "97 %", "0"]]
+    # matching on tracking: RMSE 3.9 cm in both runs, bounds 3.9 / 1.2 and 3.9 / 1.4 cm (mean 3.02 cm)
+    assert limit.localizer_rows(runs) == [["matching", "occlusion", "1", "no bound", "no bound", "-", "no bound", "-", "1"],
+                                          ["matching", "tracking", "2", "1.30x", "1.10x", "3.9 cm", "3.02 cm", "97 %", "0"],
+                                          ["mcl", "tracking", "1", "3.00x", "1.10x", "3.9 cm", "1.3 cm", "97 %", "0"]]
     p = subprocess.run([PY, str(pathlib.Path(__file__).resolve().parents[2] / "scripts" / "limit_table.py"), str(tmp_path)],
                        capture_output=True, text=True, timeout=120)
-    assert p.returncode == 0 and "| matching | tracking | 2 | 1.30x | 1.10x | 97 % | 0 |" in p.stdout, p.stdout + p.stderr
+    assert p.returncode == 0 and "| matching | tracking | 2 | 1.30x | 1.10x | 3.9 cm | 3.02 cm | 97 % | 0 |" in p.stdout, p.stdout + p.stderr
 
 
 def test_viewer_says_no_bound_where_the_columns_are_empty(tmp_path):

@@ -204,7 +204,13 @@ def sweep_has_limit(groups: list[AggregateGroup]) -> bool:
 
 
 
-LOCALIZER_HEADER = ["localizer", "scenario family", "runs", "position RMSE / bound", "heading RMSE / bound", "frames with a bound", "runs without a bound"]
+def cm_cell(m: float) -> str:
+    """Metres as centimetres with three significant figures ('3.79 cm', '0.561 cm', '138 cm')."""
+    return f"{100.0 * m:.3g} cm"
+
+
+LOCALIZER_HEADER = ["localizer", "scenario family", "runs", "position RMSE / bound", "heading RMSE / bound", "position RMSE", "bound",
+                    "frames with a bound", "runs without a bound"]
 
 
 def localizer_rows(runs: list[Run]) -> list[list[str]]:
@@ -222,6 +228,11 @@ def localizer_rows(runs: list[Run]) -> list[list[str]]:
         pos = mean([e.position for e in effs if e.position is not None])
         head = mean([e.heading for e in effs if e.heading is not None])
         share = mean([e.share for e in effs if e.share is not None])
+        # The RMSE and the bound the ratio is of, over the same runs (means of the runs' figures over
+        # their frames with both an estimate and a bound), so a ratio is read beside its size.
+        err = mean([rb.error_m for rb in rbs if rb.efficiency is not None and rb.efficiency.position is not None and rb.error_m is not None])
+        lim = mean([rb.limit_m for rb in rbs if rb.efficiency is not None and rb.efficiency.position is not None and rb.limit_m is not None])
         rows.append([loc, fam, str(len(rbs)), "no bound" if pos is None else f"{pos:.2f}x", "no bound" if head is None else f"{head:.2f}x",
+                     "-" if err is None else cm_cell(err), "no bound" if lim is None else cm_cell(lim),
                      "-" if share is None else f"{math.floor(100.0 * share + 1e-9):d} %", str(len(rbs) - len(effs))])
     return rows
