@@ -21,7 +21,6 @@
 #include "harness/runner.hpp"
 #include "harness/scenario.hpp"
 #include "harness/scoring/bound.hpp"
-#include "sim/render/camera_config.hpp"
 #include "core/install_paths.hpp"
 
 using namespace omniloc;
@@ -148,33 +147,13 @@ static const BoundInput& bound_input() {
     auto b = std::make_unique<BoundInput>(BoundInput{harness::replay_scenario(head, harness::LocalizerSpec({{"type", "matching"}}, "/localizer")), {}, {}});
     harness::RecordingSource source(harness::RecordingHeader::read(dir));
     while (auto f = source.next()) {
-      const harness::RobotFrame& rf = f->robots.at(0);
-      harness::FrameRecord r;
-      r.t = rf.obs.t;
-      r.truth = rf.truth.value_or(Pose2());
+      harness::FrameRecord r = harness::bound_frame(f->robots.at(0));
       r.est = r.truth;
       r.valid = true;
-      r.camera_ok = rf.obs.camera_ok;
-      for (const auto& p : rf.obs.line_points) r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
-      r.odometry = rf.odometry.delta;
-      r.heading = rf.heading;
       b->rec.frames.push_back(std::move(r));
     }
-    const sim::CameraConfig cam = sim::CameraConfig::from_json(b->sc.camera, "/camera");
-    harness::BoundSetup& setup = b->setup;
-    setup.field = &b->sc.field;
-    setup.mount_height = cam.mount_height;
-    setup.latency_s = cam.latency;
-    setup.vibration_std = cam.vibration_std;
-    setup.physics_dt = 1.0 / b->sc.physics_rate;
-    const harness::RobotConfig& rc = b->sc.robots.at(0);
-    setup.trans_sigma = rc.odometry.trans_sigma;
-    setup.rot_sigma = rc.odometry.rot_sigma;
-    setup.rot_per_trans = rc.odometry.rot_per_trans;
-    setup.scale_sigma = rc.odometry.scale_sigma;
-    setup.has_heading_sensor = rc.has_heading_sensor;
-    setup.heading_sigma = rc.heading.noise_sigma;
-    setup.start_pose_given = true;
+    // The setup a run of this scenario scores with (harness/bound_cache.hpp).
+    b->setup = harness::bound_setup(b->sc, 0, true);
     return b;
   }();
   return *in;

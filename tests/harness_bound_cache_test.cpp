@@ -25,7 +25,6 @@
 #include "harness/recording/replay_scenario.hpp"
 #include "harness/runner.hpp"
 #include "harness/scoring/bound.hpp"
-#include "sim/render/camera_config.hpp"
 
 using namespace omniloc;
 using namespace omniloc::harness;
@@ -48,31 +47,12 @@ const Input& input() {
     auto b = std::make_unique<Input>(Input{replay_scenario(head, LocalizerSpec({{"type", "matching"}}, "/localizer")), {}, {}});
     RecordingSource source(RecordingHeader::read(ci_recording()));
     while (auto f = source.next()) {
-      const RobotFrame& rf = f->robots.at(0);
-      FrameRecord r;
-      r.t = rf.obs.t;
-      r.truth = rf.truth.value_or(Pose2());
+      FrameRecord r = bound_frame(f->robots.at(0));
       r.est = Pose2(r.truth.x + 0.02, r.truth.y - 0.01, r.truth.theta + 0.005);
       r.valid = true;
-      r.camera_ok = rf.obs.camera_ok;
-      for (const auto& p : rf.obs.line_points) r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
-      r.odometry = rf.odometry.delta;
-      r.heading = rf.heading;
       b->rec.frames.push_back(std::move(r));
     }
-    const sim::CameraConfig cam = sim::CameraConfig::from_json(b->sc.camera, "/camera");
-    b->setup.field = &b->sc.field;
-    b->setup.mount_height = cam.mount_height;
-    b->setup.latency_s = cam.latency;
-    b->setup.vibration_std = cam.vibration_std;
-    b->setup.physics_dt = 1.0 / b->sc.physics_rate;
-    const RobotConfig& rc = b->sc.robots.at(0);
-    b->setup.trans_sigma = rc.odometry.trans_sigma;
-    b->setup.rot_sigma = rc.odometry.rot_sigma;
-    b->setup.scale_sigma = rc.odometry.scale_sigma;
-    b->setup.has_heading_sensor = rc.has_heading_sensor;
-    b->setup.heading_sigma = rc.heading.noise_sigma;
-    b->setup.start_pose_given = true;
+    b->setup = bound_setup(b->sc, 0, true);
     b->setup.excluded = {{2.0, 3.5}};
     return b;
   }();

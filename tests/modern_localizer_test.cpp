@@ -358,6 +358,7 @@ TEST(UkfMh, LatencyDefaultsToTheCamerasDeclaredLatency) {
   ctx.camera_latency = 0.0;
   EXPECT_DOUBLE_EQ(latency({{"type", "ukf_mh"}}), 0.0);
   // Built without a context (tests, benchmarks): unknown.
-  JsonReader none(Json::object(), "/localizer");
+  const Json no_params = Json::object();  // the reader keeps a reference: the object must outlive it
+  JsonReader none(no_params, "/localizer");
   EXPECT_DOUBLE_EQ(UkfMhParams::from_json(none).latency, 0.0);
 }
