@@ -242,10 +242,15 @@ void BoundCache::store(const std::string& key, const BoundPart& part) const {
   prune();
 }
 
+// A writer's temporary (<entry>.tmp.<pid>...) lives for the milliseconds one entry takes to write;
+// one an hour old was left by a process that died mid-write and will never be renamed.
+constexpr auto kStaleTemporary = std::chrono::hours(1);
+
 void BoundCache::prune() const {
   if (o_.max_bytes == 0) return;
   // Every build's folder under bounds/: an older build's entries are the likeliest to go.
   const fs::path root = o_.prune_root.empty() ? fs::path(o_.dir) : fs::path(o_.prune_root);
+  const auto stale_before = fs::file_time_type::clock::now() - kStaleTemporary;
   struct Entry {
     fs::path path;
     fs::file_time_type used;
@@ -256,7 +261,13 @@ void BoundCache::prune() const {
   std::error_code ec;
   for (fs::recursive_directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
     std::error_code e2;
-    if (!it->is_regular_file(e2) || it->path().extension() != ".bound") continue;
+    if (!it->is_regular_file(e2)) continue;
+    if (it->path().filename().string().find(".bound.tmp.") != std::string::npos) {
+      const auto t = it->last_write_time(e2);
+      if (!e2 && t < stale_before) fs::remove(it->path(), e2);
+      continue;
+    }
+    if (it->path().extension() != ".bound") continue;
     const std::uint64_t b = it->file_size(e2);
     if (e2) continue;
     const auto t = it->last_write_time(e2);

@@ -13,7 +13,8 @@
 // carries the SHA-256 of its own content and the number of frames: one that does not check (cut,
 // changed, an older layout) is said on one line, removed and computed again: never used. Written to
 // a temporary name and renamed, so a reader never sees half an entry. Hits refresh the file's
-// time; a write prunes the least recently used entries past max_bytes. A cache that cannot be
+// time; a write prunes the least recently used entries past max_bytes, and removes a writer's
+// temporary an hour old (left by a process that died mid-write). A cache that cannot be
 // written never costs a run: one warning line per process (core/cache_root.hpp), the run goes on.
 // OMNILOC_CACHE=off: nothing is read or written.
 #include <cstdint>

@@ -268,6 +268,26 @@ TEST(BoundCache, PruningKeepsTheMostRecentlyUsed) {
   fs::remove_all(dir);
 }
 
+TEST(BoundCache, AWritersTemporaryLeftByACrashIsRemovedALiveOneIsNot) {
+  const Input& in = input();
+  const fs::path dir = fresh_dir("stale");
+  const BoundCache cache = cache_in(dir);
+  const std::string key = bound_key(in.rec, in.setup);
+  fs::create_directories(dir / "build");
+  fs::create_directories(dir / "older_build");
+  // Named as store() names its temporaries: <entry>.tmp.<pid>.<thread>.<n>.
+  const fs::path crashed = dir / "older_build" / "0123.bound.tmp.4242.7.0";
+  const fs::path live = fs::path(cache.entry_path(key) + ".tmp.4343.7.0");
+  std::ofstream(crashed) << "half an entry";
+  std::ofstream(live) << "being written";
+  fs::last_write_time(crashed, fs::file_time_type::clock::now() - std::chrono::hours(2));
+  cache.store(key, bound_part(in.rec, in.setup));
+  EXPECT_FALSE(fs::exists(crashed));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(cache.find(key, in.rec.frames.size()));
+  fs::remove_all(dir);
+}
+
 TEST(BoundCache, AWorldDrawnKeepsTheBoundsItsReplaysRead) {
   // Drawing a world into the world cache computes its robots' bounds (start pose given and not);
   // its first replay reads one of them: each entry is marked after the draw, and the replay's
