@@ -1,23 +1,17 @@
 #include "harness/bound_cache.hpp"
-#include "harness/bound_prepare.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <iostream>
 #include <iterator>
 #include <sstream>
 #include <system_error>
-#include <thread>
 #include <vector>
 
-#include <unistd.h>
-
+#include "core/atomic_file.hpp"
 #include "core/cache_root.hpp"
 #include "external/sha256.hpp"
 #include "harness/cache/cache_dirs.hpp"
@@ -207,36 +201,11 @@ std::optional<BoundPart> BoundCache::find(const std::string& key, std::size_t fr
 void BoundCache::store(const std::string& key, const BoundPart& part) const {
   const std::string path = entry_path(key);
   if (path.empty() || cache::unwritable()) return;
-  // A name of this process and thread alone: two runs keeping the same entry at once each rename a
-  // whole file over the other's (the same bytes).
-  static std::atomic<unsigned> counter{0};
-  std::ostringstream tmp_name;
-  tmp_name << path << ".tmp." << ::getpid() << "." << std::hash<std::thread::id>{}(std::this_thread::get_id()) << "." << counter++;
-  const std::string tmp = tmp_name.str();
-  std::error_code ec;
-  fs::create_directories(o_.dir, ec);
-  if (ec) {
-    cache::report_unwritable(o_.dir + ": " + ec.message());
-    return;
-  }
-  const std::string bytes = encode_bound_part(part);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      const std::string why = tmp + ": " + std::strerror(errno);
-      out.close();
-      fs::remove(tmp, ec);
-      cache::report_unwritable(why);
-      return;
-    }
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    const std::string why = path + ": " + ec.message();
-    fs::remove(tmp, ec);
-    cache::report_unwritable(why);
+  // Two runs keeping the same entry at once each rename a whole file (the same bytes) over the other's.
+  try {
+    write_file_atomic(path, encode_bound_part(part));
+  } catch (const std::exception& e) {
+    cache::report_unwritable(e.what());  // a full or read-only cache costs the computation next time
     return;
   }
   prune();
@@ -328,29 +297,6 @@ FrameRecord bound_frame(const RobotFrame& rf) {
   r.line_points.reserve(rf.obs.line_points.size());
   for (const auto& p : rf.obs.line_points) r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
   return r;
-}
-
-BoundPreparer::BoundPreparer(const Scenario& sc) : sc_(sc), dir_(bound_cache_from_env().dir) {}
-
-void BoundPreparer::add(const FrameData& f) {
-  if (dir_.empty()) return;
-  robots_.resize(f.robots.size());
-  for (std::size_t i = 0; i < f.robots.size(); ++i) {
-    robots_[i].id = f.robots[i].id;
-    robots_[i].frames.push_back(bound_frame(f.robots[i]));
-  }
-}
-
-void BoundPreparer::finish() {
-  if (dir_.empty()) return;
-  const BoundCache cache(bound_cache_from_env());
-  for (const RobotRecord& rec : robots_)
-    for (const bool given : {true, false}) {
-      const BoundSetup setup = bound_setup(sc_, rec.id, given);
-      const std::string key = bound_key(rec, setup);
-      if (!cache.find(key, rec.frames.size())) cache.store(key, bound_part(rec, setup));
-    }
-  robots_.clear();
 }
 
 }  // namespace omniloc::harness

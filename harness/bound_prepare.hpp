@@ -5,9 +5,9 @@
 // it is a small part of, and even the first replay reads it. Fed through RecordOptions::on_frame by
 // `omniloc record` and the world cache's draws; the recorder itself knows nothing of scoring.
 // Without a cache (OMNILOC_CACHE=off) it keeps nothing and holds nothing.
-#include <string>
 #include <vector>
 
+#include "harness/bound_cache.hpp"
 #include "harness/frame_data.hpp"
 #include "harness/run_record.hpp"
 #include "harness/scenario.hpp"
@@ -25,7 +25,7 @@ class BoundPreparer {
 
  private:
   const Scenario& sc_;
-  std::string dir_;
+  BoundCache cache_;  ///< no folder (OMNILOC_CACHE=off): nothing is held or kept
   std::vector<RobotRecord> robots_;
 };
 

@@ -2,7 +2,6 @@
 
 #include "core/version.hpp"
 #include "harness/localizer_registry.hpp"
-#include "sim/render/camera_config.hpp"
 
 namespace omniloc::harness {
 
@@ -33,8 +32,6 @@ Json camera_for_client(const CalibrationMap* map) {
             {"min_radius_px", map->min_radius()},
             {"max_radius_px", map->max_radius()}}}};
 }
-
-double declared_camera_latency(const Scenario& sc) { return sim::CameraConfig::from_json(sc.camera, "/camera").latency; }
 
 external::Session make_session(const Scenario& sc, int robot, const Json& camera, bool blobs, std::uint64_t localizer_seed,
                                const std::string& log_dir) {

@@ -17,10 +17,6 @@ Json field_for_client(const Field& field);
 /// `map` is null: nothing is rendered).
 Json camera_for_client(const CalibrationMap* map);
 
-/// The camera latency the scenario declares (its camera's `latency_ms`, in seconds; 0 when none):
-/// what LocalizerContext::camera_latency and hello.camera.latency_s carry.
-double declared_camera_latency(const Scenario& sc);
-
 /// The session of robot `robot`'s client: `camera` is hello.camera (camera_for_client), to which
 /// the scenario's declared latency is added as `latency_s`; `blobs` whether frames can carry blobs.
 external::Session make_session(const Scenario& sc, int robot, const Json& camera, bool blobs, std::uint64_t localizer_seed,

@@ -95,15 +95,25 @@ Estimate robot_frame(Tracked& tr, const RobotFrame& rf, long long k, const RunOp
   const Estimate est = tr.localizer->update(rf.obs, rf.odometry, rf.heading);
   const double loc_ms = ms_since(t0);
 
-  FrameRecord row{t, rf.truth.value_or(Pose2()), est.pose, est.valid, rf.obs.camera_ok, rf.contact, est.mode, est.mode_label,
-                  rf.obs.line_points.size(), est.match_error, est.extra, rf.render_ms, rf.vision_ms, loc_ms, est.compute_ms, {}, rf.odometry.delta, rf.heading};
+  // What the bound reads of the frame by the one conversion a recording's frames go through too, so
+  // that the bound cache's key of a run and of its recording agree (harness/bound_cache.hpp).
+  FrameRecord row = bound_frame(rf);
+  row.est = est.pose;
+  row.valid = est.valid;
+  row.contact = rf.contact;
+  row.mode = est.mode;
+  row.mode_label = est.mode_label;
+  row.points = rf.obs.line_points.size();
+  row.match_error = est.match_error;
+  row.extra = est.extra;
+  row.render_ms = rf.render_ms;
+  row.vision_ms = rf.vision_ms;
+  row.localize_ms = loc_ms;
+  row.compute_ms = est.compute_ms;
   if (rf.settings) {  // the camera settings the frame was taken with (exposure control, paper 002)
     row.extra["exposure_ms"] = rf.settings->exposure_ms;
     row.extra["gain"] = rf.settings->gain;
   }
-  // What the bound reads, converted as bound_frame() (harness/bound_cache.hpp) does for a recording.
-  row.line_points.reserve(rf.obs.line_points.size());
-  for (const auto& p : rf.obs.line_points) row.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
   tr.record.frames.push_back(std::move(row));
   const std::string mode = est.mode_label.empty() ? mode_name(est.mode) : est.mode_label;
   if (mode != tr.last_mode) {

@@ -372,7 +372,7 @@ void validate_deep(const Scenario& s) {
   LocalizerContext ctx;
   ctx.field = &s.field;
   ctx.seed = s.seed;
-  ctx.camera_latency = sim::CameraConfig::from_json(s.camera, "/camera").latency;
+  ctx.camera_latency = declared_camera_latency(s);
   check_localizer(s.localizer, ctx);
 }
 
@@ -380,5 +380,7 @@ Scenario load_scenario(const std::string& path) {
   const Json j = read_json_strict(path, path);
   return parse_scenario(j, std::filesystem::path(path).stem().string(), path);
 }
+
+double declared_camera_latency(const Scenario& sc) { return sim::CameraConfig::from_json(sc.camera, "/camera").latency; }
 
 }  // namespace omniloc::harness

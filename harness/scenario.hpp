@@ -82,4 +82,8 @@ Scenario load_scenario(const std::string& path);
 /// Builds everything the run would build (localizer, scripts) without running: full validation.
 void validate_deep(const Scenario& s);
 
+/// The camera latency the scenario declares (its camera's `latency_ms`, in seconds; 0 when none):
+/// what LocalizerContext::camera_latency and olp/1's hello.camera.latency_s carry.
+double declared_camera_latency(const Scenario& sc);
+
 }  // namespace omniloc::harness

@@ -101,10 +101,9 @@ struct ArcEnds {
   Eigen::Vector2d e0, e1;
   std::array<Eigen::Vector2d, 2> ends;
   explicit ArcEnds(const ArcMarking& arc)
-      : e0(std::cos(arc.start), std::sin(arc.start)), e1(std::cos(arc.start + arc.sweep), std::sin(arc.start + arc.sweep)) {
-    int i = 0;
-    for (const double ang : {arc.start, arc.start + arc.sweep}) ends[static_cast<std::size_t>(i++)] = arc.centre + arc.radius * Eigen::Vector2d(std::cos(ang), std::sin(ang));
-  }
+      : e0(std::cos(arc.start), std::sin(arc.start)),
+        e1(std::cos(arc.start + arc.sweep), std::sin(arc.start + arc.sweep)),
+        ends{arc.centre + arc.radius * e0, arc.centre + arc.radius * e1} {}
 };
 
 void consider_arc(const Eigen::Vector2d& w, const ArcMarking& arc, const ArcEnds& ae, int index, double& best, MarkingMatch& m) {
