@@ -41,7 +41,7 @@ std::string readable(const SweepRun& r, const std::string& name = "") {
          ", seed " + std::to_string(r.seed);
 }
 
-std::string fmt(double v) {
+std::string fmt_g6(double v) {
   char b[64];
   std::snprintf(b, sizeof b, "%.6g", v);
   return b;
@@ -329,7 +329,7 @@ class SweepWorkers {
                    << " failed " << failed_ << " ETA " << fmt_duration(eta) << "   " << std::flush;
     } else {
       *o_.progress << "[" << done_ << "/" << todo_.size() << "] " << readable(r, ok ? run_localizer_name(folder_.dir, r) : "")
-                   << (ok ? ": ok " : ": FAILED ") << fmt(secs) << " s" << (why.empty() ? "" : " (" + why + ")") << ", ETA "
+                   << (ok ? ": ok " : ": FAILED ") << fmt_g6(secs) << " s" << (why.empty() ? "" : " (" + why + ")") << ", ETA "
                    << fmt_duration(eta) << "\n";
     }
   }

@@ -19,7 +19,7 @@ using harness::RunDirectory;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
 Json posts_cm_json(const Field004& f) {
   Json a = Json::array();
@@ -78,7 +78,7 @@ Json report_maps(const LandmarkMapsConfig& cfg, const LandmarkMapsResult& r, Run
                          {"trials_diff_over_1mm", S[s].exact ? Json(m.diff_over_1mm[s]) : Json(nullptr)},
                          {"png", std::string("map_") + S[s].name + ".png"}});
     std::vector<double> capped(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) capped[i] = std::isfinite(v[i]) ? std::min(v[i], cap_cm) : kNaN;
+    for (std::size_t i = 0; i < v.size(); ++i) capped[i] = std::isfinite(v[i]) ? std::min(v[i], cap_cm) : kNoValue;
     const int cell_px = std::max(1, static_cast<int>(std::lround(600.0 / m.cols)));
     dir.write(std::string("map_") + S[s].name + ".png",
               png_bytes(heat_map(capped, m.cols, m.rows, 0.0, 100 * r.field.length, 0.0, 100 * r.field.width,
@@ -141,7 +141,7 @@ std::string table1_trend(const Table1& t, const Published& pub) {
   double d = 0;
   for (const auto& r : t.rows) d = std::max(d, std::fabs(r[kTwoCircle].mean_err - r[kThreePoint].mean_err));
   const auto published_ratio = [&](std::size_t i) {
-    return pub.found ? 0.5 * (pub.rows[2][i] + pub.rows[4][i]) / ((pub.rows[0][i] + pub.rows[1][i] + pub.rows[3][i]) / 3) : kNaN;
+    return pub.found ? 0.5 * (pub.rows[2][i] + pub.rows[4][i]) / ((pub.rows[0][i] + pub.rows[1][i] + pub.rows[3][i]) / 3) : kNoValue;
   };
   return strprintf("edge/centre mean-error ratio: two-circle %.2f, three-point %.2f (published: two-circle %.2f, three-point %.2f); "
                    "max |two-circle - three-point| mean error over the rows %.2e cm",
