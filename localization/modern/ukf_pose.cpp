@@ -45,7 +45,8 @@ SigmaPoints::Predicted SigmaPoints::predict(const std::array<double, 6>& h) cons
   return {mean, pzz / 6.0};
 }
 
-void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum) const {
+void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum,
+                      const Eigen::Vector2d* tilt) const {
   const Eigen::RowVector3d hr = regression(h);
   // H P H^T = sum_j d_j^2 (the regression explains exactly the antisymmetric part of h); what is
   // left of Pzz is the measurement's curvature over the spread: the regression error, added to r.
@@ -54,7 +55,31 @@ void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, dou
   const double w = 1.0 / (r + std::max(0.0, pred.var - explained));
   sum.info.noalias() += hr.transpose() * (w * hr);
   sum.grad.noalias() += hr.transpose() * (w * (z - pred.mean));
+  if (tilt) {
+    sum.info_tilt.noalias() += hr.transpose() * (w * tilt->transpose());
+    sum.tilt_info.noalias() += *tilt * (w * tilt->transpose());
+    sum.tilt_grad.noalias() += *tilt * (w * (z - pred.mean));
+  }
   ++sum.used;
+}
+
+void InformationSum::marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const {
+  j = info;
+  g = grad;
+  if (tilt_cov.isZero(0.0)) return;
+  // S = (T^-1 + A^T D^-1 A)^-1 = T (Id + A^T D^-1 A T)^-1: defined for a singular T as well.
+  const Eigen::Matrix2d s = tilt_cov * (Eigen::Matrix2d::Identity() + tilt_info * tilt_cov).inverse();
+  j.noalias() -= info_tilt * s * info_tilt.transpose();
+  g.noalias() -= info_tilt * (s * tilt_grad);
+  j = 0.5 * (j + j.transpose()).eval();
+}
+
+Eigen::Matrix2d floor_tilt_jacobian(const Eigen::Vector2d& p, double h) {
+  // Columns: the floor point's move per radian about the robot's x axis (roll) and y axis (pitch).
+  Eigen::Matrix2d m;
+  m << p.x() * p.y() / h, -h - p.x() * p.x() / h,  //
+      h + p.y() * p.y() / h, -p.x() * p.y() / h;
+  return m;
 }
 
 Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const MotionNoise& n) {
@@ -94,12 +119,16 @@ void UkfPose::predict(const Pose2& d, const Eigen::Matrix3d& q) {
   p_ = 0.5 * (p_ + p_.transpose()).eval();
 }
 
-Eigen::Vector3d UkfPose::step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out) const {
+Eigen::Vector3d UkfPose::step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out,
+                              const Eigen::Matrix2d& tilt_cov) const {
   const Eigen::Matrix3d id = Eigen::Matrix3d::Identity();
-  // (Id + I C)^-1: the frame-common error caps what any number of points can tell.
-  const Eigen::Matrix3d shrink = (id + sum.info * common).inverse();
-  const Eigen::Matrix3d w = shrink * sum.info;
-  const Eigen::Vector3d g = shrink * sum.grad;
+  Eigen::Matrix3d info;
+  Eigen::Vector3d grad;
+  sum.marginalise_tilt(tilt_cov, info, grad);
+  // (Id + J C)^-1: a frame-common pose error caps what any number of points can tell.
+  const Eigen::Matrix3d shrink = (id + info * common).inverse();
+  const Eigen::Matrix3d w = shrink * info;
+  const Eigen::Vector3d g = shrink * grad;
   const Eigen::Matrix3d p_inv = p_.inverse();
   Eigen::Matrix3d post_inv = p_inv + 0.5 * (w + w.transpose());
   Eigen::Vector3d prior_pull(x_.x() - at.x(), x_.y() - at.y(), angle_diff(x_.z(), at.z()));
