@@ -81,6 +81,10 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       integer_param("trust_frames", &P::trust_frames, 1, 1000, "a hypothesis whose last trust_frames updates fit trust_share of the points on average is valid at once"),
       number_param("trust_share", &P::trust_share, 0.0, 1.1, "", "mean share of fitting points over trust_frames updates that makes a hypothesis valid at once (above 1: never)"),
       positive_param("compass_gate", &P::compass_gate, 3.2, "rad", "a hypothesis this far from the compass heading fits nothing that frame"),
+      number_param("compass_sigma", &P::compass_sigma, 0.0, 1.0, "rad",
+                   "the compass's white noise: each reading is fused as theta + bias + this noise; 0: the compass only gates (compass_gate)"),
+      number_param("compass_bias_walk", &P::compass_bias_walk, 0.0, 1.0, "rad/sqrt(s)", "random walk of the compass's bias, estimated beside each hypothesis's pose"),
+      positive_param("compass_bias_sd", &P::compass_bias_sd, 3.2, "rad", "a new hypothesis's prior standard deviation of the compass bias"),
       positive_param("new_sd_xy", &P::new_sd_xy, 10.0, "m", "a proposed pose's initial standard deviation in x and y"),
       positive_param("new_sd_theta", &P::new_sd_theta, 3.2, "rad", "a proposed pose's initial standard deviation in theta"),
       integer_param("alt_points", &P::alt_points, 3, 100000, "alternative poses: line points of the fit"),
@@ -139,6 +143,7 @@ void UkfMhLocalizer::reset(const std::optional<Pose2>& start) {
   if (start) {
     Hypothesis h;
     h.ukf.reset(*start, Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.02 * 0.02).asDiagonal());
+    if (p_.compass_sigma > 0) h.ukf.start_bias(p_.compass_bias_sd * p_.compass_bias_sd);
     h.validity = 1.0;  // a given start is stood behind until the points say otherwise
     h.age = p_.set.prune_age;
     h.id = next_id_++;
@@ -307,6 +312,7 @@ void UkfMhLocalizer::search(const std::vector<Eigen::Vector2d>& pts, std::option
     Hypothesis h;
     h.ukf.reset(Pose2(cand.pose.x(), cand.pose.y(), cand.pose.z()),
                 Eigen::Vector3d(p_.new_sd_xy * p_.new_sd_xy, p_.new_sd_xy * p_.new_sd_xy, p_.new_sd_theta * p_.new_sd_theta).asDiagonal());
+    if (p_.compass_sigma > 0) h.ukf.start_bias(p_.compass_bias_sd * p_.compass_bias_sd);
     // Half credit for the frame it was fitted to: one frame alone does not make a pose valid, and a
     // pose that explains fewer points than valid_min / 0.5 of them starts below what it can reach.
     h.validity = 0.5 * inlier_share(cand.pose, pts);
@@ -333,9 +339,14 @@ Estimate UkfMhLocalizer::update(const Observations& obs, const Odometry& odo, st
   history_.push_back({last_t_.value_or(obs.t), obs.t, odo.delta});
   while (!history_.empty() && history_.front().t1 < obs.t - p_.latency - 1.0) history_.pop_front();
   last_t_ = obs.t;
+  const double bias_q = p_.compass_bias_walk * p_.compass_bias_walk * std::max(dt, 0.0);
   for (auto& h : set_) {
-    h.ukf.predict(odo.delta, motion_covariance(odo.delta, h.ukf.mean().z(), p_.motion));
+    h.ukf.predict(odo.delta, motion_covariance(odo.delta, h.ukf.mean().z(), p_.motion), bias_q);
     h.age += dt;
+    // The compass as a measurement of theta + bias; a hypothesis it contradicts (the twin, a wrong
+    // search result) is left to the gate, which takes its validity, rather than turned by it.
+    if (heading && p_.compass_sigma > 0 && std::fabs(angle_diff(h.ukf.mean().z(), *heading)) <= p_.compass_gate)
+      h.ukf.fuse_heading(*heading, p_.compass_sigma * p_.compass_sigma);
   }
   alt_.move(odo.delta);
   // Twins: without a compass and without goal colours nothing tells a pose from its point mirror.

@@ -65,6 +65,9 @@ struct UkfMhParams {
   int trust_frames = 5;          ///< frames whose mean evidence may make a hypothesis valid at once
   double trust_share = 0.9;      ///< ... when at least this: validity is raised to valid_min
   double compass_gate = 0.5;     ///< rad: a hypothesis this far from the compass heading fits nothing
+  double compass_sigma = 0.017453292519943295;  ///< rad: the compass's white noise (1 deg); 0: the compass only gates
+  double compass_bias_walk = 0.0017453292519943296;  ///< rad/sqrt(s): its bias's random walk (0.1 deg/sqrt(s))
+  double compass_bias_sd = 0.05; ///< rad: a new hypothesis's prior on the compass bias
   double new_sd_xy = 0.1;        ///< m: a proposal's initial standard deviation
   double new_sd_theta = 0.05;    ///< rad
   // Alternative poses.

@@ -100,12 +100,30 @@ struct MotionNoise {
 /// The increment's noise covariance in the world frame of a robot at heading `theta`.
 Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const MotionNoise& n);
 
+/// The pose filter, optionally with a compass's bias b beside the pose: a compass reads theta + b +
+/// white noise, and b walks at random (an MTi-class heading sensor: docs/scenario.md, the robot
+/// noise profile), so its readings are not independent of one another and cannot be fused as if they
+/// were. The bias enters no other measurement and no motion, so it is kept as a linear appendix to
+/// the unscented pose filter: its mean, variance and cross-covariance with the pose. A pose update
+/// that does not see the bias moves it by Gaussian conditioning (b given x: b + P_bx P_xx^-1 dx),
+/// the motion carries the cross-covariance through the sigma points' regression, and a compass
+/// reading is a linear Kalman update of the joint (x, b).
 class UkfPose {
  public:
+  /// Starts at `mean` with covariance `cov`; no bias state.
   void reset(const Pose2& mean, const Eigen::Matrix3d& cov);
+  /// Adds the compass bias state: mean 0, variance `var`, uncorrelated with the pose.
+  void start_bias(double var);
+  bool has_bias() const { return has_bias_; }
+  double bias() const { return b_; }
+  double bias_variance() const { return pbb_; }
+  const Eigen::Vector3d& bias_cross() const { return pxb_; }
   /// x <- x (+) delta through the sigma points (the heading's spread swings the increment), then
-  /// + Q (world frame).
-  void predict(const Pose2& delta, const Eigen::Matrix3d& q);
+  /// + Q (world frame); the bias's variance grows by `bias_q`.
+  void predict(const Pose2& delta, const Eigen::Matrix3d& q, double bias_q = 0.0);
+  /// A compass reading z of theta + bias (variance `var` of its white noise; without a bias state,
+  /// of theta): the Kalman update of (x, b). Returns the innovation (wrapped).
+  double fuse_heading(double z, double var);
   /// The iterated sensor update. `linearise(centre, sigma, sum)` adds the frame's measurements
   /// linearised at `centre` (sigma points around it with the prior covariance). `tilt_cov`: the
   /// frame's tilt prior (zero: none); `common`: any further frame-common pose error's covariance
@@ -122,8 +140,13 @@ class UkfPose {
                        const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero()) const;
 
  private:
+  /// After the pose moved from (x0, p0) to (x_, p_) on evidence that does not see the bias.
+  void condition_bias(const Eigen::Vector3d& x0, const Eigen::Matrix3d& p0);
   Eigen::Vector3d x_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d p_ = Eigen::Matrix3d::Identity();
+  bool has_bias_ = false;
+  double b_ = 0.0, pbb_ = 0.0;
+  Eigen::Vector3d pxb_ = Eigen::Vector3d::Zero();
 };
 
 template <class Linearise>
@@ -142,9 +165,12 @@ InformationSum UkfPose::update(Linearise&& linearise, int iterations, const Eige
     ++done;
   }
   if (done == 0) return sum;
+  const Eigen::Vector3d x0 = x_;
+  const Eigen::Matrix3d p0 = p_;
   x_ = at;
   x_.z() = wrap_angle(x_.z());
   p_ = 0.5 * (post + post.transpose());
+  if (has_bias_) condition_bias(x0, p0);
   return sum;
 }
 
