@@ -184,14 +184,13 @@ void UkfMhLocalizer::prepare_points(const std::vector<Eigen::Vector2d>& image, d
   for (const auto& q : image) tilt_.push_back(rot * floor_tilt_jacobian(q, p_.mount_height));
 }
 
-double UkfMhLocalizer::tilt_variance(std::size_t i, const Eigen::Vector2d& g, double theta, Eigen::Vector2d* a) const {
+double UkfMhLocalizer::tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const {
   if (tilt_.empty()) {
     if (a) a->setZero();
     return 0.0;
   }
   // The distance's change per radian of tilt: the point's move (robot frame) along the marking's
-  // normal turned into the robot frame.
-  const double c = std::cos(theta), s = std::sin(theta);
+  // normal turned into the robot frame (c, s: the heading's cosine and sine).
   const Eigen::Vector2d n_robot(c * g.x() + s * g.y(), -s * g.x() + c * g.y());
   const Eigen::Vector2d row = tilt_[i].transpose() * n_robot;
   if (a) *a = row;
@@ -230,7 +229,7 @@ double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q, const std::vector<
     const Eigen::Vector2d w(q.x() + c * o.x() - s * o.y(), q.y() + s * o.x() + c * o.y());
     const LocalMarking m = assoc_.associate(w);
     if (m.marking < 0) continue;
-    const double tilt_var = tilt_.size() == pts.size() ? tilt_variance(i, m.gradient(w), q.z(), nullptr) : 0.0;
+    const double tilt_var = tilt_.size() == pts.size() ? tilt_variance(i, m.gradient(w), c, s, nullptr) : 0.0;
     if (m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (point_variance(o) + common_var + tilt_var)) ++fit;
   }
   return static_cast<double>(fit) / static_cast<double>(pts.size());
@@ -259,7 +258,7 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
       }
       const SigmaPoints::Predicted pr = sp.predict(hv);
       Eigen::Vector2d a;
-      const double tilt_var = tilt_variance(i, m.gradient(w), at.z(), &a);
+      const double tilt_var = tilt_variance(i, m.gradient(w), c, s, &a);
       // The gate: the innovation against its whole spread (pose, point, tilt, frame-common error).
       const double spread = pr.var + var[i] + tilt_var + common_var;
       if (pr.mean * pr.mean > p_.gate_sigmas * p_.gate_sigmas * spread) continue;

@@ -106,8 +106,9 @@ class UkfMhLocalizer : public Localizer {
   /// Sets frame_ (the points in the robot frame of now) and tilt_ (each point's move per radian of
   /// tilt, in that frame) from the image's points.
   void prepare_points(const std::vector<Eigen::Vector2d>& image, double t);
-  /// Variance of point i's distance to the marking with gradient g (world) at heading theta, from the tilt.
-  double tilt_variance(std::size_t i, const Eigen::Vector2d& g, double theta, Eigen::Vector2d* a) const;
+  /// Variance of point i's distance to the marking with gradient g (world) from the tilt, at a heading
+  /// of cosine c and sine s; `a` (optional): the distance's change per radian of tilt.
+  double tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const;
   void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
   double point_variance(const Eigen::Vector2d& o) const;
   /// The share of the points within inlier_sigmas standard deviations of their marking at q.
