@@ -47,6 +47,9 @@ static void BM_UkfMhUpdate(benchmark::State& state) {
   const Field f = Field::preset("msl2012");
   modern::UkfMhParams p;
   if (state.range(1) == 0) p.alt_period = 1e9;
+  // As a run of the robot profile builds it: the camera's declared tilt and height, and a compass.
+  p.tilt_sd = 0.3 * kPi / 180.0;
+  p.mount_height = 0.75;
   modern::UkfMhLocalizer loc(f, p, 1, "");
   Rng rng(1);
   const Pose2 truth(-3.0, 1.0, 0.4);
@@ -62,7 +65,7 @@ static void BM_UkfMhUpdate(benchmark::State& state) {
     t += 1.0 / 30.0;
     obs.t = t;
     const Odometry odo{t, Pose2((k++ & 1) ? 0.03 : -0.03, 0.0, 0.0)};
-    const Estimate e = loc.update(obs, odo, std::nullopt);
+    const Estimate e = loc.update(obs, odo, truth.theta);
     hypotheses = e.extra.at("hypotheses");
     benchmark::DoNotOptimize(e.pose);
   }

@@ -47,6 +47,8 @@ external::Session make_session(const Scenario& sc, int robot, const Json& camera
   // hello.camera without it, and a replay takes it from the recorded scenario, as built-in
   // localizers do (LocalizerContext::camera_latency).
   s.camera["latency_s"] = declared_camera_latency(sc);
+  s.camera["mount_height_m"] = declared_camera_mount_height(sc);
+  s.camera["vibration_rad"] = declared_camera_vibration(sc);
   s.blobs = blobs;
   s.log_dir = log_dir;
   s.seed = localizer_seed;

@@ -47,7 +47,7 @@ const std::vector<LocalizerInfo>& localizers() {
        },
        &GridGlobalParams::schema},
       {"ukf_mh", "modern reference: a few unscented Kalman filter hypotheses on line points associated with the markings, validity-filtered, with Falcons-style simplex field fits as alternative poses (after B-Human's SelfLocator / UKFPose2D and the Falcons' localization; docs/modern_localizer.md)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, modern::UkfMhParams::from_json(r, ctx.camera_latency), ctx.seed, ctx.cache_dir); },
+       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, modern::UkfMhParams::from_json(r, {ctx.camera_latency, ctx.camera_mount_height, ctx.camera_vibration}), ctx.seed, ctx.cache_dir); },
        &modern::UkfMhParams::schema},
       {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },

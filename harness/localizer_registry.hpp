@@ -25,6 +25,12 @@ struct LocalizerContext {
   /// declares it (its noise profile's `latency_ms`); 0 when nothing declares it (a log not made by
   /// omniloc). Never measured from the run.
   double camera_latency = 0.0;
+  /// m: the mirror viewpoint's height above the floor as the scenario's camera declares it (its
+  /// `mount_height`); 0 when not declared.
+  double camera_mount_height = 0.0;
+  /// rad: the camera's per-frame tilt (roll and pitch, each) as the scenario's camera declares it
+  /// (its `vibration_deg`); 0 when none is declared.
+  double camera_vibration = 0.0;
   std::string cache_dir;  ///< where distance maps etc. may be cached
   /// What an external localizer's client is told in hello (robot, field, camera, log folder); null
   /// outside a run (validation, experiments), where an external localizer cannot be built.

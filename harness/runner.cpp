@@ -54,6 +54,8 @@ std::vector<Tracked> make_tracked(const Scenario& sc, std::uint64_t seed, const 
     ctx.seed = derive_seed(seed, "localizer/" + std::to_string(id));
     ctx.cache_dir = build_cache_dir("fieldmaps");
     ctx.camera_latency = declared_camera_latency(sc);
+    ctx.camera_mount_height = declared_camera_mount_height(sc);
+    ctx.camera_vibration = declared_camera_vibration(sc);
     external::Session session;
     if (info.type == "external") {
       session = make_session(sc, id, source.client_camera(id), source.detects_blobs(), ctx.seed, log_dir);

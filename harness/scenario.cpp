@@ -373,6 +373,8 @@ void validate_deep(const Scenario& s) {
   ctx.field = &s.field;
   ctx.seed = s.seed;
   ctx.camera_latency = declared_camera_latency(s);
+  ctx.camera_mount_height = declared_camera_mount_height(s);
+  ctx.camera_vibration = declared_camera_vibration(s);
   check_localizer(s.localizer, ctx);
 }
 
@@ -382,5 +384,7 @@ Scenario load_scenario(const std::string& path) {
 }
 
 double declared_camera_latency(const Scenario& sc) { return sim::CameraConfig::from_json(sc.camera, "/camera").latency; }
+double declared_camera_mount_height(const Scenario& sc) { return sim::CameraConfig::from_json(sc.camera, "/camera").mount_height; }
+double declared_camera_vibration(const Scenario& sc) { return sim::CameraConfig::from_json(sc.camera, "/camera").vibration_std; }
 
 }  // namespace omniloc::harness

@@ -85,5 +85,11 @@ void validate_deep(const Scenario& s);
 /// The camera latency the scenario declares (its camera's `latency_ms`, in seconds; 0 when none):
 /// what LocalizerContext::camera_latency and olp/1's hello.camera.latency_s carry.
 double declared_camera_latency(const Scenario& sc);
+/// The camera's mirror viewpoint height above the floor (its `mount_height`, metres) and per-frame
+/// vibration (its `vibration_deg`, in radians, each of roll and pitch; 0 when none, as for a log not
+/// made by omniloc): what LocalizerContext::camera_mount_height / camera_vibration and olp/1's
+/// hello.camera.mount_height_m / vibration_rad carry.
+double declared_camera_mount_height(const Scenario& sc);
+double declared_camera_vibration(const Scenario& sc);
 
 }  // namespace omniloc::harness

@@ -362,3 +362,260 @@ TEST(UkfMh, LatencyDefaultsToTheCamerasDeclaredLatency) {
   JsonReader none(no_params, "/localizer");
   EXPECT_DOUBLE_EQ(UkfMhParams::from_json(none).latency, 0.0);
 }
+
+// The camera's mirror height and vibration are declared by the scenario's camera as its latency is:
+// LocalizerContext, hello.camera.mount_height_m / vibration_rad, and ukf_mh's defaults of
+// `mount_height` and `tilt_sd`.
+TEST(UkfMh, TiltDefaultsToTheCamerasDeclaredGeometry) {
+  const auto scenario = [](const char* profile, const Json& camera) {
+    Json j = {{"duration", 1.0}, {"noise_profile", profile}, {"robots", Json::parse(R"([{"id": 0, "start": [0, -2, 0]}])")},
+              {"localizer", {{"type", "ukf_mh"}}}};
+    if (!camera.is_null()) j["camera"] = camera;
+    return harness::parse_scenario(j, "tilt");
+  };
+  const harness::Scenario robot = scenario("robot", nullptr);
+  EXPECT_DOUBLE_EQ(harness::declared_camera_mount_height(robot), 0.75);       // docs/camera.md
+  EXPECT_NEAR(harness::declared_camera_vibration(robot), 0.3 * kPi / 180.0, 1e-15);  // 0.3 deg, each axis
+  EXPECT_DOUBLE_EQ(harness::declared_camera_vibration(scenario("ideal", nullptr)), 0.0);
+  EXPECT_DOUBLE_EQ(harness::declared_camera_mount_height(scenario("robot", {{"mount_height", 0.9}})), 0.9);
+  const external::Session s = harness::make_session(robot, 0, Json::object(), false, 1, "");
+  EXPECT_DOUBLE_EQ(s.camera.at("mount_height_m").get<double>(), 0.75);
+  EXPECT_NEAR(s.camera.at("vibration_rad").get<double>(), 0.3 * kPi / 180.0, 1e-15);
+
+  harness::LocalizerContext ctx;
+  ctx.field = &robot.field;
+  ctx.camera_mount_height = 0.75;
+  ctx.camera_vibration = 0.005;
+  const auto effective = [&](const Json& spec) {
+    Json eff;
+    harness::make_localizer(harness::LocalizerSpec(spec, "/localizer"), ctx, &eff);
+    return eff;
+  };
+  const Json d = effective({{"type", "ukf_mh"}});
+  EXPECT_DOUBLE_EQ(d.at("mount_height").get<double>(), 0.75);
+  EXPECT_DOUBLE_EQ(d.at("tilt_sd").get<double>(), 0.005);
+  EXPECT_DOUBLE_EQ(effective({{"type", "ukf_mh"}, {"tilt_sd", 0.0}}).at("tilt_sd").get<double>(), 0.0);
+  const Json no_params = Json::object();
+  JsonReader none(no_params, "/localizer");
+  const UkfMhParams unknown = UkfMhParams::from_json(none);
+  EXPECT_FALSE(unknown.tilt_modelled());  // built without a context: no tilt model, the common covariance instead
+  EXPECT_DOUBLE_EQ(unknown.common_xy_var(), 0.03 * 0.03);
+  JsonReader none2(no_params, "/localizer");
+  const UkfMhParams declared = UkfMhParams::from_json(none2, {0.033, 0.75, 0.005});
+  EXPECT_TRUE(declared.tilt_modelled());
+  EXPECT_DOUBLE_EQ(declared.common_xy_var(), 0.0);  // the tilt is the frame-common error: not counted twice
+}
+
+// The floor geometry of a tilt against the exact ray: a floor point seen from h above the floor,
+// the camera turned by a small rotation about the robot's x or y axis, the turned ray met with the
+// floor again. The Jacobian is its first-order change (central differences, error O(eps^2)).
+TEST(UkfPose, FloorTiltJacobianIsTheTurnedRaysFloorPoint) {
+  const double h = 0.75, eps = 1e-6;
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(3.0, 0.0), Eigen::Vector2d(-1.0, 2.0), Eigen::Vector2d(0.4, -0.3)}) {
+    const Eigen::Vector3d ray(p.x(), p.y(), -h);
+    const Eigen::Matrix2d m = floor_tilt_jacobian(p, h);
+    for (int axis = 0; axis < 2; ++axis) {
+      const auto floor_point = [&](double angle) {
+        const Eigen::Vector3d r = Eigen::AngleAxisd(angle, axis == 0 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY()) * ray;
+        return Eigen::Vector2d(r.head<2>() * (h / -r.z()));
+      };
+      const Eigen::Vector2d d = (floor_point(eps) - floor_point(-eps)) / (2 * eps);
+      EXPECT_NEAR(m(0, axis), d.x(), 1e-6) << p.transpose() << " axis " << axis;
+      EXPECT_NEAR(m(1, axis), d.y(), 1e-6) << p.transpose() << " axis " << axis;
+    }
+  }
+  // Along the range: (r^2 + h^2) / h per radian; across it: h.
+  EXPECT_NEAR(floor_tilt_jacobian(Eigen::Vector2d(3.0, 0.0), h)(0, 1), -(9.0 + h * h) / h, 1e-12);
+  EXPECT_NEAR(floor_tilt_jacobian(Eigen::Vector2d(3.0, 0.0), h)(1, 0), h, 1e-12);
+}
+
+// Marginalising the tilt from the sums equals the dense generalized least squares with the points'
+// covariance D + A T A^T: J = H^T (D + A T A^T)^-1 H, g = H^T (D + A T A^T)^-1 e.
+TEST(UkfPose, TiltMarginalisationEqualsDenseGls) {
+  Rng rng(7);
+  const int m = 40;
+  Eigen::MatrixXd h(m, 3), a(m, 2);
+  Eigen::VectorXd d(m), e(m);
+  InformationSum sum;
+  for (int i = 0; i < m; ++i) {
+    h.row(i) << rng.normal(0, 1), rng.normal(0, 1), rng.normal(0, 3);
+    a.row(i) << rng.normal(0, 5), rng.normal(0, 5);
+    d(i) = 0.01 + 0.01 * rng.uniform(0, 1);
+    e(i) = rng.normal(0, 0.05);
+    const double w = 1.0 / d(i);
+    sum.info += h.row(i).transpose() * w * h.row(i);
+    sum.grad += h.row(i).transpose() * w * e(i);
+    sum.info_tilt += h.row(i).transpose() * w * a.row(i);
+    sum.tilt_info += a.row(i).transpose() * w * a.row(i);
+    sum.tilt_grad += a.row(i).transpose() * w * e(i);
+  }
+  const Eigen::Matrix2d t = Eigen::Vector2d(2.7e-5, 1.5e-5).asDiagonal();
+  const Eigen::MatrixXd r = Eigen::MatrixXd(d.asDiagonal()) + a * t * a.transpose();
+  const Eigen::MatrixXd ri = r.inverse();
+  const Eigen::Matrix3d j_dense = h.transpose() * ri * h;
+  const Eigen::Vector3d g_dense = h.transpose() * ri * e;
+  Eigen::Matrix3d j;
+  Eigen::Vector3d g;
+  sum.marginalise_tilt(t, j, g);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(g(i), g_dense(i), 1e-8 * std::max(1.0, std::fabs(g_dense(i)))) << i;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(j(i, k), j_dense(i, k), 1e-8 * j_dense.norm()) << i << "," << k;
+  }
+  // No tilt: the independent points' sums unchanged.
+  sum.marginalise_tilt(Eigen::Matrix2d::Zero(), j, g);
+  EXPECT_EQ(j, sum.info);
+  EXPECT_EQ(g, sum.grad);
+}
+
+namespace {
+
+// Noise-free line points of a robot at `truth` in a 4 x 3 m box of lines (x = +-2, y = +-1.5) whose
+// image was taken with the camera tilted by `tilt`: each point is where the tilted camera sees it.
+// The pose is then estimated from `start` with the tilt marginalised or with one pose covariance.
+Eigen::Vector3d estimate_under_tilt(const Eigen::Vector3d& truth, const Eigen::Vector2d& tilt, bool tilt_model) {
+  const double h = 0.75;
+  struct Line {
+    Eigen::Vector2d n;
+    double offset;
+  };
+  const std::vector<Line> lines = {{{1, 0}, 2.0}, {{-1, 0}, 2.0}, {{0, 1}, 1.5}, {{0, -1}, 1.5}};
+  std::vector<Eigen::Vector2d> seen;  // robot frame
+  std::vector<int> on;
+  const double c = std::cos(truth.z()), s = std::sin(truth.z());
+  for (int k = 0; k < 4; ++k)
+    for (double u = -1.4; u <= 1.41; u += 0.2) {
+      const Eigen::Vector2d w = lines[static_cast<std::size_t>(k)].n * lines[static_cast<std::size_t>(k)].offset +
+                                u * Eigen::Vector2d(-lines[static_cast<std::size_t>(k)].n.y(), lines[static_cast<std::size_t>(k)].n.x());
+      const Eigen::Vector2d d = w - truth.head<2>();
+      const Eigen::Vector2d o(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+      seen.push_back(o + floor_tilt_jacobian(o, h) * tilt);
+      on.push_back(k);
+    }
+  UkfPose ukf;
+  ukf.reset(Pose2(truth.x() + 0.02, truth.y() - 0.02, truth.z() + 0.01), Eigen::Vector3d(0.1 * 0.1, 0.1 * 0.1, 0.05 * 0.05).asDiagonal());
+  const double var = 0.02 * 0.02, sd = 0.3 * kPi / 180;
+  const auto linearise = [&](const Eigen::Vector3d& at, const SigmaPoints& sp, InformationSum& sum) {
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+      const Line& l = lines[static_cast<std::size_t>(on[i])];
+      std::array<double, 6> v{};
+      for (int q = 0; q < 6; ++q) {
+        const Eigen::Vector3d& x = sp[q];
+        const Eigen::Vector2d w(x.x() + std::cos(x.z()) * seen[i].x() - std::sin(x.z()) * seen[i].y(),
+                                x.y() + std::sin(x.z()) * seen[i].x() + std::cos(x.z()) * seen[i].y());
+        v[static_cast<std::size_t>(q)] = l.n.dot(w) - l.offset;
+      }
+      const Eigen::Vector2d n_robot(std::cos(at.z()) * l.n.x() + std::sin(at.z()) * l.n.y(), -std::sin(at.z()) * l.n.x() + std::cos(at.z()) * l.n.y());
+      const Eigen::Vector2d a = floor_tilt_jacobian(seen[i], h).transpose() * n_robot;
+      sp.add(v, sp.predict(v), 0.0, var, sum, &a);
+    }
+  };
+  const Eigen::Matrix2d t = tilt_model ? Eigen::Matrix2d(sd * sd * Eigen::Matrix2d::Identity()) : Eigen::Matrix2d::Zero();
+  const Eigen::Matrix3d common = tilt_model ? Eigen::Matrix3d::Zero() : Eigen::Matrix3d(Eigen::Vector3d(0.03 * 0.03, 0.03 * 0.03, 0.01 * 0.01).asDiagonal());
+  ukf.update(linearise, 3, common, t);
+  return ukf.mean() - truth;
+}
+
+}  // namespace
+
+// A tilt of two standard deviations (0.6 deg) moves the far points by centimetres. Marginalised with
+// its geometry it moves the pose by 3 mm (the near points pin the pose, the spread in range separates
+// the tilt; what is left is the prior's shrinkage of so large a tilt); one pose covariance takes the
+// far points' shift for a pose error of 7 cm.
+TEST(UkfPose, TiltMarginalisationKeepsThePoseWhereOneCovarianceDoesNot) {
+  const Eigen::Vector3d truth(0.8, 0.4, 0.3);
+  const Eigen::Vector2d tilt(0.6 * kPi / 180, -0.6 * kPi / 180);
+  // What the tilt does to each model's estimate (the same prior, the same points but for the tilt).
+  const Eigen::Vector3d with_tilt = estimate_under_tilt(truth, tilt, true) - estimate_under_tilt(truth, Eigen::Vector2d::Zero(), true);
+  const Eigen::Vector3d one_cov = estimate_under_tilt(truth, tilt, false) - estimate_under_tilt(truth, Eigen::Vector2d::Zero(), false);
+  EXPECT_LT(with_tilt.head<2>().norm(), 0.004) << with_tilt.transpose();
+  EXPECT_LT(std::fabs(with_tilt.z()), 0.001) << with_tilt.transpose();
+  EXPECT_GT(one_cov.head<2>().norm(), 0.05) << one_cov.transpose();
+  EXPECT_GT(std::fabs(one_cov.z()), 0.003) << one_cov.transpose();
+}
+
+// The compass reading theta + b + noise is a linear measurement of the joint (x, b): fuse_heading is
+// the Kalman update of the 4-D state exactly, and a pose update that does not see b moves b as the
+// 4-D Kalman filter does (Gaussian conditioning).
+TEST(UkfPose, CompassFusionEqualsTheJointKalmanFilter) {
+  const Eigen::Vector3d x0(1.0, -2.0, 0.3);
+  const Eigen::Matrix3d p0 = spd(0.04, 0.09, 0.01, 0.01, 0.002, -0.003);
+  UkfPose ukf;
+  ukf.reset(Pose2(x0.x(), x0.y(), x0.z()), p0);
+  ukf.start_bias(0.02 * 0.02);
+  // 1. A linear pose measurement (x + 2 theta) that does not see b: b gains a cross-covariance.
+  const Eigen::RowVector3d hx(1.0, 0.0, 2.0);
+  const double zx = 1.5, rx = 0.01;
+  ukf.update(
+      [&](const Eigen::Vector3d&, const SigmaPoints& sp, InformationSum& sum) {
+        std::array<double, 6> v{};
+        for (int s = 0; s < 6; ++s) v[static_cast<std::size_t>(s)] = hx.dot(sp[s]);
+        sp.add(v, sp.predict(v), zx, rx, sum);
+      },
+      1, Eigen::Matrix3d::Zero());
+  // The joint filter: (x, b), b uncorrelated at first; a measurement with H = [hx, 0] leaves b alone.
+  Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
+  p.topLeftCorner<3, 3>() = p0;
+  p(3, 3) = 0.02 * 0.02;
+  Eigen::Vector4d x;
+  x << x0, 0.0;
+  const auto kalman = [&](const Eigen::RowVector4d& hrow, double z, double r) {
+    const double s = hrow * p * hrow.transpose() + r;
+    const Eigen::Vector4d k = p * hrow.transpose() / s;
+    x += k * (z - hrow.dot(x));
+    p = (Eigen::Matrix4d::Identity() - k * hrow) * p;
+  };
+  kalman((Eigen::RowVector4d() << hx, 0.0).finished(), zx, rx);
+  EXPECT_NEAR(ukf.bias(), 0.0, 1e-12);  // uncorrelated at first: nothing to condition
+  // 2. A compass reading: H = [0 0 1 1].
+  const double zc = 0.33, rc = 0.0175 * 0.0175;
+  ukf.fuse_heading(zc, rc);
+  kalman((Eigen::RowVector4d() << 0, 0, 1, 1).finished(), zc, rc);
+  // 3. Another pose measurement: now b moves with the pose through their cross-covariance.
+  ukf.update(
+      [&](const Eigen::Vector3d&, const SigmaPoints& sp, InformationSum& sum) {
+        std::array<double, 6> v{};
+        for (int s = 0; s < 6; ++s) v[static_cast<std::size_t>(s)] = sp[s].z();
+        sp.add(v, sp.predict(v), 0.31, 1e-4, sum);
+      },
+      1, Eigen::Matrix3d::Zero());
+  kalman((Eigen::RowVector4d() << 0, 0, 1, 0).finished(), 0.31, 1e-4);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(ukf.mean()[i], x[i], 1e-9) << i;
+    EXPECT_NEAR(ukf.bias_cross()[i], p(i, 3), 1e-9) << i;
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(ukf.covariance()(i, j), p(i, j), 1e-9) << i << "," << j;
+  }
+  EXPECT_NEAR(ukf.bias(), x[3], 1e-9);
+  EXPECT_NEAR(ukf.bias_variance(), p(3, 3), 1e-12);
+  EXPECT_GT(std::fabs(ukf.bias()), 1e-4);  // the test moved the bias
+  // Without a bias state the compass is the scalar Kalman update of theta.
+  UkfPose plain;
+  plain.reset(Pose2(x0.x(), x0.y(), x0.z()), p0);
+  plain.fuse_heading(zc, rc);
+  const Eigen::Vector3d k = p0.col(2) / (p0(2, 2) + rc);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(plain.mean()[i], x0[i] + k[i] * (zc - x0.z()), 1e-12) << i;
+}
+
+// A merge keeps the lead as best() does: the reported hypothesis goes only to one more valid by the
+// hysteresis.
+TEST(HypothesisSet, MergeKeepsTheLeadWithinTheHysteresis) {
+  const HypothesisSetParams p;
+  const auto make = [](double x, double v, std::uint32_t id) {
+    Hypothesis h;
+    h.ukf.reset(Pose2(x, 0.0, 0.0), Eigen::Matrix3d::Identity() * 0.01);
+    h.validity = v;
+    h.id = id;
+    return h;
+  };
+  std::vector<Hypothesis> s = {make(0.0, 0.95, 0), make(0.2, 0.97, 1)};
+  merge(s, p, false, 0, 0.05);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].id, 0u);  // the lead stays: 0.97 is not 0.05 above 0.95
+  s = {make(0.0, 0.90, 0), make(0.2, 0.97, 1)};
+  merge(s, p, false, 0, 0.05);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].id, 1u);  // clearly more valid: it takes over
+  s = {make(0.0, 0.95, 0), make(0.2, 0.97, 1)};
+  merge(s, p, false);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].id, 1u);  // no lead given: the more valid stays
+}

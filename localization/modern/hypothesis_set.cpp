@@ -18,7 +18,12 @@ namespace {
 bool weaker(const Hypothesis& a, const Hypothesis& b) { return a.validity < b.validity || (a.validity == b.validity && a.id > b.id); }
 }  // namespace
 
-void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twins_equal) {
+void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twins_equal, std::int64_t lead, double hysteresis) {
+  const auto gives_way = [&](const Hypothesis& a, const Hypothesis& b) {
+    if (static_cast<std::int64_t>(a.id) == lead) return b.validity >= a.validity + hysteresis;
+    if (static_cast<std::int64_t>(b.id) == lead) return a.validity < b.validity + hysteresis;
+    return weaker(a, b);
+  };
   std::vector<bool> gone(set.size(), false);
   for (std::size_t i = 0; i < set.size(); ++i)
     for (std::size_t j = 0; j < set.size(); ++j) {
@@ -26,7 +31,7 @@ void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twin
       const Eigen::Vector3d& a = set[i].ukf.mean();
       const Eigen::Vector3d& b = set[j].ukf.mean();
       const bool close = same_basin(a, b, p.merge_xy, p.merge_theta) || (twins_equal && same_basin(a, twin(b), p.merge_xy, p.merge_theta));
-      if (close && weaker(set[i], set[j])) gone[i] = true;
+      if (close && gives_way(set[i], set[j])) gone[i] = true;
     }
   std::vector<Hypothesis> kept;
   for (std::size_t i = 0; i < set.size(); ++i)

@@ -43,7 +43,9 @@ Eigen::Vector3d twin(const Eigen::Vector3d& q);
 /// Merges hypotheses in one basin: of each such pair the less valid one goes (equal validity: the
 /// younger id). With `twins_equal` a hypothesis in the basin of another's twin goes as well (without
 /// a compass or goal colours nothing can tell them apart, and two of them would make the output jump).
-void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twins_equal);
+/// The hypothesis of id `lead` (the reported one; -1 none) goes only to one more valid by
+/// `hysteresis`, as it keeps the lead in best(): a merge must not hand the lead over on less.
+void merge(std::vector<Hypothesis>& set, const HypothesisSetParams& p, bool twins_equal, std::int64_t lead = -1, double hysteresis = 0.0);
 
 /// Removes hypotheses older than prune_age with validity below prune_validity or more than
 /// prune_gap below the most valid one; never the last one.

@@ -34,6 +34,13 @@ struct LocalMarking {
     if (circle) return sign * (std::hypot(x - centre.x(), y - centre.y()) - radius);
     return n.x() * x + n.y() * y - offset;
   }
+  /// d(value)/d(w): the unit normal of the marking at w (pointing to growing values).
+  Eigen::Vector2d gradient(const Eigen::Vector2d& w) const {
+    if (!circle) return n;
+    const Eigen::Vector2d d = w - centre;
+    const double r = d.norm();
+    return r > 1e-9 ? Eigen::Vector2d(sign * d / r) : Eigen::Vector2d(0.0, 0.0);
+  }
 };
 
 class MarkingAssociation {

@@ -64,8 +64,12 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       positive_param("point_sigma", &P::point_sigma, 2.0, "m", "a line point's own noise at range weight_ref"),
       positive_param("weight_d", &P::weight_d, 100.0, "m", "point noise grows as (weight_d^2 + r^2) with the range r (NuBot's range weights: 2.5 m)"),
       positive_param("weight_ref", &P::weight_ref, 100.0, "m", "the range whose points have noise point_sigma (NuBot: 1.5 m)"),
-      number_param("common_sd_xy", &P::common_sd_xy, 0.0, 2.0, "m", "frame-common error of the points' pose, which no number of points averages out (camera vibration)"),
-      number_param("common_sd_theta", &P::common_sd_theta, 0.0, 1.0, "rad", "frame-common heading error of the points"),
+      number_param("tilt_sd", &P::tilt_sd, 0.0, 0.2, "rad",
+                   "the frame's camera tilt (roll and pitch, each), a nuisance marginalised per frame with each point's geometry; 0: not modelled (JSON default: the camera's declared vibration, the robot profile's 0.3 deg)"),
+      number_param("mount_height", &P::mount_height, 0.0, 5.0, "m",
+                   "the mirror viewpoint's height of the tilt's geometry; 0: unknown, tilt not modelled (JSON default: the camera's declared mount height)"),
+      number_param("common_sd_xy", &P::common_sd_xy, 0.0, 2.0, "m", "where the tilt is not modelled (tilt_sd or mount_height 0): a frame-common error of the points' pose, which no number of points averages out"),
+      number_param("common_sd_theta", &P::common_sd_theta, 0.0, 1.0, "rad", "where the tilt is not modelled: a frame-common heading error of the points"),
       positive_param("corridor", &P::corridor, 10.0, "m", "points farther than this from their nearest marking are not associated"),
       positive_param("gate_sigmas", &P::gate_sigmas, 100.0, "", "innovation gate of a point in standard deviations"),
       positive_param("inlier_sigmas", &P::inlier_sigmas, 100.0, "", "a point fits (validity) when within this many standard deviations of its marking"),
@@ -77,6 +81,10 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       integer_param("trust_frames", &P::trust_frames, 1, 1000, "a hypothesis whose last trust_frames updates fit trust_share of the points on average is valid at once"),
       number_param("trust_share", &P::trust_share, 0.0, 1.1, "", "mean share of fitting points over trust_frames updates that makes a hypothesis valid at once (above 1: never)"),
       positive_param("compass_gate", &P::compass_gate, 3.2, "rad", "a hypothesis this far from the compass heading fits nothing that frame"),
+      number_param("compass_sigma", &P::compass_sigma, 0.0, 1.0, "rad",
+                   "the compass's white noise: each reading is fused as theta + bias + this noise; 0: the compass only gates (compass_gate)"),
+      number_param("compass_bias_walk", &P::compass_bias_walk, 0.0, 1.0, "rad/sqrt(s)", "random walk of the compass's bias, estimated beside each hypothesis's pose"),
+      positive_param("compass_bias_sd", &P::compass_bias_sd, 3.2, "rad", "a new hypothesis's prior standard deviation of the compass bias"),
       positive_param("new_sd_xy", &P::new_sd_xy, 10.0, "m", "a proposed pose's initial standard deviation in x and y"),
       positive_param("new_sd_theta", &P::new_sd_theta, 3.2, "rad", "a proposed pose's initial standard deviation in theta"),
       integer_param("alt_points", &P::alt_points, 3, 100000, "alternative poses: line points of the fit"),
@@ -97,12 +105,15 @@ Json UkfMhParams::schema() {
   return s;
 }
 
-UkfMhParams UkfMhParams::from_json(JsonReader& r, double camera_latency) {
+UkfMhParams UkfMhParams::from_json(JsonReader& r, const DeclaredCamera& camera) {
   UkfMhParams p;
   // A team measures its camera's latency once and configures its localizer with it (B-Human
   // timestamps each image and predicts the pose to the image's time): the declared value is the
-  // default, a number given here overrides it.
-  p.latency = camera_latency;
+  // default, a number given here overrides it. The same for the mirror's height (a calibration
+  // fact) and the camera's vibration (measured once on the robot).
+  p.latency = camera.latency;
+  p.tilt_sd = camera.vibration;
+  p.mount_height = camera.mount_height;
   read_params(r, p, params());
   read_params(r, p.motion, motion_params());
   read_params(r, p.set, set_params());
@@ -132,6 +143,7 @@ void UkfMhLocalizer::reset(const std::optional<Pose2>& start) {
   if (start) {
     Hypothesis h;
     h.ukf.reset(*start, Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.02 * 0.02).asDiagonal());
+    if (p_.compass_sigma > 0) h.ukf.start_bias(p_.compass_bias_sd * p_.compass_bias_sd);
     h.validity = 1.0;  // a given start is stood behind until the points say otherwise
     h.age = p_.set.prune_age;
     h.id = next_id_++;
@@ -140,8 +152,8 @@ void UkfMhLocalizer::reset(const std::optional<Pose2>& start) {
   }
 }
 
-std::vector<Eigen::Vector2d> UkfMhLocalizer::to_now(const std::vector<Eigen::Vector2d>& pts, double t) const {
-  if (!(p_.latency > 0) || history_.empty()) return pts;
+Pose2 UkfMhLocalizer::exposure_to_now(double t) const {
+  if (!(p_.latency > 0) || history_.empty()) return Pose2();
   // The motion from t - latency to t, composed oldest first from the frames' increments (the
   // oldest in part, in proportion of its interval: constant velocity within a frame).
   const double from = t - p_.latency;
@@ -153,11 +165,36 @@ std::vector<Eigen::Vector2d> UkfMhLocalizer::to_now(const std::vector<Eigen::Vec
     const Pose2 part(f * it->delta.x, f * it->delta.y, f * it->delta.theta);
     m = part.compose(m);
   }
-  const Pose2 back = m.inverse();
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(pts.size());
-  for (const auto& q : pts) out.push_back(back.transform(q));
-  return out;
+  return m;
+}
+
+void UkfMhLocalizer::prepare_points(const std::vector<Eigen::Vector2d>& image, double t) {
+  const Pose2 back = exposure_to_now(t).inverse();
+  frame_.clear();
+  frame_.reserve(image.size());
+  for (const auto& q : image) frame_.push_back(back.transform(q));
+  tilt_.clear();
+  if (!p_.tilt_modelled()) return;
+  // The tilt turns the camera, whose axes are the robot's at the exposure: a point's move is
+  // computed where the image saw it and turned into the robot frame of now.
+  const double c = std::cos(back.theta), s = std::sin(back.theta);
+  Eigen::Matrix2d rot;
+  rot << c, -s, s, c;
+  tilt_.reserve(image.size());
+  for (const auto& q : image) tilt_.push_back(rot * floor_tilt_jacobian(q, p_.mount_height));
+}
+
+double UkfMhLocalizer::tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const {
+  if (tilt_.empty()) {
+    if (a) a->setZero();
+    return 0.0;
+  }
+  // The distance's change per radian of tilt: the point's move (robot frame) along the marking's
+  // normal turned into the robot frame (c, s: the heading's cosine and sine).
+  const Eigen::Vector2d n_robot(c * g.x() + s * g.y(), -s * g.x() + c * g.y());
+  const Eigen::Vector2d row = tilt_[i].transpose() * n_robot;
+  if (a) *a = row;
+  return p_.tilt_sd * p_.tilt_sd * row.squaredNorm();
 }
 
 bool UkfMhLocalizer::contradicted(const Eigen::Vector3d& q, std::optional<double> heading, const Observations& obs) const {
@@ -184,13 +221,16 @@ double UkfMhLocalizer::point_variance(const Eigen::Vector2d& o) const {
 
 double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const {
   if (pts.empty()) return 0.0;
-  const double common_var = p_.common_sd_xy * p_.common_sd_xy;
+  const double common_var = p_.common_xy_var();
   const double c = std::cos(q.z()), s = std::sin(q.z());
   int fit = 0;
-  for (const auto& o : pts) {
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector2d& o = pts[i];
     const Eigen::Vector2d w(q.x() + c * o.x() - s * o.y(), q.y() + s * o.x() + c * o.y());
     const LocalMarking m = assoc_.associate(w);
-    if (m.marking >= 0 && m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (point_variance(o) + common_var)) ++fit;
+    if (m.marking < 0) continue;
+    const double tilt_var = tilt_.size() == pts.size() ? tilt_variance(i, m.gradient(w), c, s, nullptr) : 0.0;
+    if (m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (point_variance(o) + common_var + tilt_var)) ++fit;
   }
   return static_cast<double>(fit) / static_cast<double>(pts.size());
 }
@@ -198,7 +238,7 @@ double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q, const std::vector<
 void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs,
                                    double dt) {
   // Per point: its noise variance (grows with range, NuBot's weights read as variances).
-  const double common_var = p_.common_sd_xy * p_.common_sd_xy;
+  const double common_var = p_.common_xy_var();
   thread_local std::vector<double> var;
   var.resize(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) var[i] = point_variance(pts[i]);
@@ -217,16 +257,19 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
         hv[ku] = m.value(sp[k].x() + cs[ku] * o.x() - sn[ku] * o.y(), sp[k].y() + sn[ku] * o.x() + cs[ku] * o.y());
       }
       const SigmaPoints::Predicted pr = sp.predict(hv);
-      // The gate: the innovation against its whole spread (pose, point, frame-common error).
-      const double spread = pr.var + var[i] + common_var;
+      Eigen::Vector2d a;
+      const double tilt_var = tilt_variance(i, m.gradient(w), c, s, &a);
+      // The gate: the innovation against its whole spread (pose, point, tilt, frame-common error).
+      const double spread = pr.var + var[i] + tilt_var + common_var;
       if (pr.mean * pr.mean > p_.gate_sigmas * p_.gate_sigmas * spread) continue;
-      sp.add(hv, pr, 0.0, var[i], sum);
+      sp.add(hv, pr, 0.0, var[i], sum, tilt_.empty() ? nullptr : &a);
     }
   };
   Eigen::Matrix3d common = Eigen::Matrix3d::Zero();
   common(0, 0) = common(1, 1) = common_var;
-  common(2, 2) = p_.common_sd_theta * p_.common_sd_theta;
-  h.ukf.update(linearise, p_.iterations, common);
+  common(2, 2) = p_.tilt_modelled() ? 0.0 : p_.common_sd_theta * p_.common_sd_theta;
+  const Eigen::Matrix2d tilt_cov = tilt_.empty() ? Eigen::Matrix2d::Zero() : Eigen::Matrix2d(p_.tilt_sd * p_.tilt_sd * Eigen::Matrix2d::Identity());
+  h.ukf.update(linearise, p_.iterations, common, tilt_cov);
   h.inliers = inlier_share(h.ukf.mean(), pts);
   const Eigen::Vector3d& q = h.ukf.mean();
   const double evidence = contradicted(q, heading, obs) ? 0.0 : h.inliers;
@@ -268,6 +311,7 @@ void UkfMhLocalizer::search(const std::vector<Eigen::Vector2d>& pts, std::option
     Hypothesis h;
     h.ukf.reset(Pose2(cand.pose.x(), cand.pose.y(), cand.pose.z()),
                 Eigen::Vector3d(p_.new_sd_xy * p_.new_sd_xy, p_.new_sd_xy * p_.new_sd_xy, p_.new_sd_theta * p_.new_sd_theta).asDiagonal());
+    if (p_.compass_sigma > 0) h.ukf.start_bias(p_.compass_bias_sd * p_.compass_bias_sd);
     // Half credit for the frame it was fitted to: one frame alone does not make a pose valid, and a
     // pose that explains fewer points than valid_min / 0.5 of them starts below what it can reach.
     h.validity = 0.5 * inlier_share(cand.pose, pts);
@@ -294,9 +338,14 @@ Estimate UkfMhLocalizer::update(const Observations& obs, const Odometry& odo, st
   history_.push_back({last_t_.value_or(obs.t), obs.t, odo.delta});
   while (!history_.empty() && history_.front().t1 < obs.t - p_.latency - 1.0) history_.pop_front();
   last_t_ = obs.t;
+  const double bias_q = p_.compass_bias_walk * p_.compass_bias_walk * std::max(dt, 0.0);
   for (auto& h : set_) {
-    h.ukf.predict(odo.delta, motion_covariance(odo.delta, h.ukf.mean().z(), p_.motion));
+    h.ukf.predict(odo.delta, motion_covariance(odo.delta, h.ukf.mean().z(), p_.motion), bias_q);
     h.age += dt;
+    // The compass as a measurement of theta + bias; a hypothesis it contradicts (the twin, a wrong
+    // search result) is left to the gate, which takes its validity, rather than turned by it.
+    if (heading && p_.compass_sigma > 0 && std::fabs(angle_diff(h.ukf.mean().z(), *heading)) <= p_.compass_gate)
+      h.ukf.fuse_heading(*heading, p_.compass_sigma * p_.compass_sigma);
   }
   alt_.move(odo.delta);
   // Twins: without a compass and without goal colours nothing tells a pose from its point mirror.
@@ -304,11 +353,12 @@ Estimate UkfMhLocalizer::update(const Observations& obs, const Odometry& odo, st
   for (const auto& g : field_.goals) goal_colours = goal_colours || g.colour != "white";
   const bool twins_equal = !heading && !goal_colours;
 
-  const std::vector<Eigen::Vector2d> pts = to_now(subsample(obs.line_points, p_.max_points), obs.t);
+  prepare_points(subsample(obs.line_points, p_.max_points), obs.t);
+  const std::vector<Eigen::Vector2d>& pts = frame_;
   const bool vision = obs.camera_ok && static_cast<int>(pts.size()) >= p_.min_points;
   if (vision) {
     for (auto& h : set_) sensor_update(h, pts, heading, obs, dt);
-    merge(set_, p_.set, twins_equal);
+    merge(set_, p_.set, twins_equal, best_id_, p_.hysteresis);
     prune(set_, p_.set);
     bool any_valid = false;
     for (const auto& h : set_) any_valid = any_valid || h.validity >= p_.valid_min;

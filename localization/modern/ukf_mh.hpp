@@ -30,6 +30,14 @@
 
 namespace omniloc::modern {
 
+/// What the scenario's camera declares, which a localizer may know when built, as it knows the
+/// field (harness::LocalizerContext): zeros where nothing declares it.
+struct DeclaredCamera {
+  double latency = 0.0;       ///< s: the image is this much older than the odometry
+  double mount_height = 0.0;  ///< m: the mirror's viewpoint above the floor; 0 unknown
+  double vibration = 0.0;     ///< rad: per-frame tilt (roll, pitch) standard deviation, each axis
+};
+
 /// Every default argued in docs/localizers.md ("ukf_mh: defaults and their arguments").
 struct UkfMhParams {
   // Measurements.
@@ -38,7 +46,9 @@ struct UkfMhParams {
   double point_sigma = 0.05;     ///< m: a line point's own noise at range weight_ref (matching's point_sigma)
   double weight_d = 2.5;         ///< m: point noise grows as (weight_d^2 + r^2) (NuBot's range weights)
   double weight_ref = 1.5;       ///< m: the range at which the noise is point_sigma (NuBot)
-  double common_sd_xy = 0.03;    ///< m: frame-common error of the points' pose (camera vibration)
+  double tilt_sd = 0.0;          ///< rad: the frame's camera tilt, each axis (JSON default: the camera's declared vibration)
+  double mount_height = 0.0;     ///< m: mirror viewpoint height of the tilt's geometry (JSON default: the camera's declared one)
+  double common_sd_xy = 0.03;    ///< m: where the tilt is not modelled, a frame-common error of the points' pose
   double common_sd_theta = 0.01; ///< rad
   double corridor = 0.5;         ///< m: points farther from their marking are not associated
   double gate_sigmas = 3.0;      ///< innovation gate in standard deviations
@@ -55,6 +65,9 @@ struct UkfMhParams {
   int trust_frames = 5;          ///< frames whose mean evidence may make a hypothesis valid at once
   double trust_share = 0.9;      ///< ... when at least this: validity is raised to valid_min
   double compass_gate = 0.5;     ///< rad: a hypothesis this far from the compass heading fits nothing
+  double compass_sigma = 0.017453292519943295;  ///< rad: the compass's white noise (1 deg); 0: the compass only gates
+  double compass_bias_walk = 0.0017453292519943296;  ///< rad/sqrt(s): its bias's random walk (0.1 deg/sqrt(s))
+  double compass_bias_sd = 0.05; ///< rad: a new hypothesis's prior on the compass bias
   double new_sd_xy = 0.1;        ///< m: a proposal's initial standard deviation
   double new_sd_theta = 0.05;    ///< rad
   // Alternative poses.
@@ -65,8 +78,14 @@ struct UkfMhParams {
   double alt_margin = 0.05;      ///< a proposal must beat the best hypothesis's score by this to enter
   double cell = 0.05;            ///< m: distance-map cell of the fit (Tribots: 50 mm)
 
-  /// `camera_latency`: the camera's declared latency (LocalizerContext), the default of `latency`.
-  static UkfMhParams from_json(JsonReader& r, double camera_latency = 0.0);
+  /// `camera`: what the camera declares (LocalizerContext), the defaults of `latency`, `tilt_sd`
+  /// and `mount_height`.
+  static UkfMhParams from_json(JsonReader& r, const DeclaredCamera& camera = {});
+  /// Whether the tilt is modelled with its geometry (a tilt and a height known).
+  bool tilt_modelled() const { return tilt_sd > 0 && mount_height > 0; }
+  /// The frame-common pose error's variance in x and y: the stand-in for the tilt where it is not
+  /// modelled; where it is, the tilt is that error (it would be counted twice).
+  double common_xy_var() const { return tilt_modelled() ? 0.0 : common_sd_xy * common_sd_xy; }
   static const ParamList<UkfMhParams>& params();
   static Json schema();
 };
@@ -81,8 +100,15 @@ class UkfMhLocalizer : public Localizer {
   const std::vector<Hypothesis>& hypotheses() const { return set_; }
 
  private:
-  /// The points moved into the robot frame of now (latency: the image shows the robot as it was).
-  std::vector<Eigen::Vector2d> to_now(const std::vector<Eigen::Vector2d>& pts, double t) const;
+  /// The motion from the image's exposure to now (latency: the image shows the robot as it was):
+  /// the inverse of it moves the points into the robot frame of now.
+  Pose2 exposure_to_now(double t) const;
+  /// Sets frame_ (the points in the robot frame of now) and tilt_ (each point's move per radian of
+  /// tilt, in that frame) from the image's points.
+  void prepare_points(const std::vector<Eigen::Vector2d>& image, double t);
+  /// Variance of point i's distance to the marking with gradient g (world) from the tilt, at a heading
+  /// of cosine c and sine s; `a` (optional): the distance's change per radian of tilt.
+  double tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const;
   void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
   double point_variance(const Eigen::Vector2d& o) const;
   /// The share of the points within inlier_sigmas standard deviations of their marking at q.
@@ -107,6 +133,8 @@ class UkfMhLocalizer : public Localizer {
     Pose2 delta;
   };
   std::deque<Motion> history_;
+  std::vector<Eigen::Vector2d> frame_;  // this frame's points, robot frame of now
+  std::vector<Eigen::Matrix2d> tilt_;   // per point of frame_: its move per radian of tilt (empty: no tilt model)
 };
 
 }  // namespace omniloc::modern

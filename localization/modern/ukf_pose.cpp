@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include "core/angles.hpp"
+
 namespace omniloc::modern {
 
 namespace {
@@ -45,7 +47,8 @@ SigmaPoints::Predicted SigmaPoints::predict(const std::array<double, 6>& h) cons
   return {mean, pzz / 6.0};
 }
 
-void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum) const {
+void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum,
+                      const Eigen::Vector2d* tilt) const {
   const Eigen::RowVector3d hr = regression(h);
   // H P H^T = sum_j d_j^2 (the regression explains exactly the antisymmetric part of h); what is
   // left of Pzz is the measurement's curvature over the spread: the regression error, added to r.
@@ -54,7 +57,31 @@ void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, dou
   const double w = 1.0 / (r + std::max(0.0, pred.var - explained));
   sum.info.noalias() += hr.transpose() * (w * hr);
   sum.grad.noalias() += hr.transpose() * (w * (z - pred.mean));
+  if (tilt) {
+    sum.info_tilt.noalias() += hr.transpose() * (w * tilt->transpose());
+    sum.tilt_info.noalias() += *tilt * (w * tilt->transpose());
+    sum.tilt_grad.noalias() += *tilt * (w * (z - pred.mean));
+  }
   ++sum.used;
+}
+
+void InformationSum::marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const {
+  j = info;
+  g = grad;
+  if (tilt_cov.isZero(0.0)) return;
+  // S = (T^-1 + A^T D^-1 A)^-1 = T (Id + A^T D^-1 A T)^-1: defined for a singular T as well.
+  const Eigen::Matrix2d s = tilt_cov * (Eigen::Matrix2d::Identity() + tilt_info * tilt_cov).inverse();
+  j.noalias() -= info_tilt * s * info_tilt.transpose();
+  g.noalias() -= info_tilt * (s * tilt_grad);
+  j = 0.5 * (j + j.transpose()).eval();
+}
+
+Eigen::Matrix2d floor_tilt_jacobian(const Eigen::Vector2d& p, double h) {
+  // Columns: the floor point's move per radian about the robot's x axis (roll) and y axis (pitch).
+  Eigen::Matrix2d m;
+  m << p.x() * p.y() / h, -h - p.x() * p.x() / h,  //
+      h + p.y() * p.y() / h, -p.x() * p.y() / h;
+  return m;
 }
 
 Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const MotionNoise& n) {
@@ -71,9 +98,51 @@ Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const Motion
 void UkfPose::reset(const Pose2& mean, const Eigen::Matrix3d& cov) {
   x_ = Eigen::Vector3d(mean.x, mean.y, mean.theta);
   p_ = cov;
+  has_bias_ = false;
+  b_ = pbb_ = 0.0;
+  pxb_.setZero();
 }
 
-void UkfPose::predict(const Pose2& d, const Eigen::Matrix3d& q) {
+void UkfPose::start_bias(double var) {
+  has_bias_ = true;
+  b_ = 0.0;
+  pbb_ = var;
+  pxb_.setZero();
+}
+
+void UkfPose::condition_bias(const Eigen::Vector3d& x0, const Eigen::Matrix3d& p0) {
+  // b = b0 + G (x - x0) + e with G = P_bx P0^-1 and e independent of x: the new x moves b's mean
+  // by G dx, and its covariance: P_bb - G P0 G^T + G P G^T, P_xb = P G^T.
+  const Eigen::RowVector3d g = p0.ldlt().solve(pxb_).transpose();
+  const Eigen::Vector3d dx(x_.x() - x0.x(), x_.y() - x0.y(), angle_diff(x_.z(), x0.z()));
+  b_ += g.dot(dx);
+  pbb_ += g * (p_ - p0) * g.transpose();
+  pbb_ = std::max(pbb_, 0.0);
+  pxb_ = p_ * g.transpose();
+}
+
+double UkfPose::fuse_heading(double z, double var) {
+  const double nu = angle_diff(z, x_.z() + (has_bias_ ? b_ : 0.0));
+  // H = [0 0 1 | 1]: P H^T is the theta column plus the bias column.
+  Eigen::Vector4d ph;
+  ph.head<3>() = p_.col(2) + (has_bias_ ? pxb_ : Eigen::Vector3d::Zero());
+  ph(3) = has_bias_ ? pxb_(2) + pbb_ : 0.0;
+  const double s = ph(2) + ph(3) + var;
+  if (!(s > 0)) return nu;
+  const Eigen::Vector4d k = ph / s;
+  x_ += k.head<3>() * nu;
+  x_.z() = wrap_angle(x_.z());
+  p_ -= k.head<3>() * ph.head<3>().transpose();
+  p_ = 0.5 * (p_ + p_.transpose()).eval();
+  if (has_bias_) {
+    b_ += k(3) * nu;
+    pxb_ -= k.head<3>() * ph(3);
+    pbb_ = std::max(pbb_ - k(3) * ph(3), 0.0);
+  }
+  return nu;
+}
+
+void UkfPose::predict(const Pose2& d, const Eigen::Matrix3d& q, double bias_q) {
   // Unscented transform of f(x) = x (+) d. The centre point (weight 0 in the mean) anchors the
   // heading: the others' headings are averaged as differences from it, never across the wrap.
   const SigmaPoints sp(x_, p_);
@@ -88,18 +157,30 @@ void UkfPose::predict(const Pose2& d, const Eigen::Matrix3d& q) {
   }
   Eigen::Matrix3d p = Eigen::Matrix3d::Zero();
   for (const auto& v : y) p.noalias() += (v - mean) * (v - mean).transpose() / 6.0;
+  if (has_bias_) {
+    // The new pose's covariance with the bias through x: Cov(f(x), x) P^-1 P_xb, Cov(f(x), x) from
+    // the sigma points (the motion noise is independent of the bias).
+    Eigen::Matrix3d cyx = Eigen::Matrix3d::Zero();
+    for (int s = 0; s < 6; ++s) cyx.noalias() += (y[static_cast<std::size_t>(s)] - mean) * (sp[s] - x_).transpose() / 6.0;
+    pxb_ = cyx * p_.ldlt().solve(pxb_);
+    pbb_ += bias_q;
+  }
   x_ = mean;
   x_.z() = wrap_angle(x_.z());
   p_ = p + q;
   p_ = 0.5 * (p_ + p_.transpose()).eval();
 }
 
-Eigen::Vector3d UkfPose::step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out) const {
+Eigen::Vector3d UkfPose::step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out,
+                              const Eigen::Matrix2d& tilt_cov) const {
   const Eigen::Matrix3d id = Eigen::Matrix3d::Identity();
-  // (Id + I C)^-1: the frame-common error caps what any number of points can tell.
-  const Eigen::Matrix3d shrink = (id + sum.info * common).inverse();
-  const Eigen::Matrix3d w = shrink * sum.info;
-  const Eigen::Vector3d g = shrink * sum.grad;
+  Eigen::Matrix3d info;
+  Eigen::Vector3d grad;
+  sum.marginalise_tilt(tilt_cov, info, grad);
+  // (Id + J C)^-1: a frame-common pose error caps what any number of points can tell.
+  const Eigen::Matrix3d shrink = (id + info * common).inverse();
+  const Eigen::Matrix3d w = shrink * info;
+  const Eigen::Vector3d g = shrink * grad;
   const Eigen::Matrix3d p_inv = p_.inverse();
   Eigen::Matrix3d post_inv = p_inv + 0.5 * (w + w.transpose());
   Eigen::Vector3d prior_pull(x_.x() - at.x(), x_.y() - at.y(), angle_diff(x_.z(), at.z()));

@@ -14,11 +14,18 @@
 // updated mean with the prior kept fixed (the iterated Kalman filter; Bell, Cathey 1993), so that
 // points are associated again from a better pose.
 //
-// The frame's points also share one error that does not average out over them (the camera's
-// per-frame vibration tilts the whole floor picture; docs/camera.md, docs/error_budget.md): their
-// information I is combined with a frame-common pose error of covariance C as a pose measurement
-// of covariance I^-1 + C, written without inverting I (which is singular when one line is seen):
-// W = (Id + I C)^-1 I, and the gradient b becomes (Id + I C)^-1 b.
+// The frame's points also share errors that do not average out over them. The camera's per-frame
+// tilt (vibration: roll and pitch) moves each floor point by its own geometry, (r^2 + h^2) / h per
+// radian along its range and h across it (docs/camera.md): a nuisance w of two unknowns with prior
+// covariance T, entering point i as a_i . w. It is marginalised per frame: the points' noise is
+// D + A T A^T, whose inverse by Woodbury needs only sums over the points (H^T D^-1 H, H^T D^-1 A,
+// A^T D^-1 A and the gradients), so a frame still costs O(points):
+//   J = H^T D^-1 H - H^T D^-1 A S A^T D^-1 H,   S = (T^-1 + A^T D^-1 A)^-1 = T (Id + A^T D^-1 A T)^-1.
+// Near points hardly move with a tilt while far ones move a lot, so the points' spread in range
+// separates the tilt from the pose (the same model as the accuracy bound's, harness/scoring/bound.cpp).
+// What else is common to a frame may be given as a pose error of covariance C, combined as a pose
+// measurement of covariance J^-1 + C, written without inverting J (singular when one line is seen):
+// W = (Id + J C)^-1 J, and the gradient b becomes (Id + J C)^-1 b.
 #include <array>
 
 #include <Eigen/Core>
@@ -32,8 +39,21 @@ namespace omniloc::modern {
 struct InformationSum {
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
   Eigen::Vector3d grad = Eigen::Vector3d::Zero();
+  /// The tilt nuisance's sums: H^T D^-1 A, A^T D^-1 A, A^T D^-1 (z - h).
+  Eigen::Matrix<double, 3, 2> info_tilt = Eigen::Matrix<double, 3, 2>::Zero();
+  Eigen::Matrix2d tilt_info = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d tilt_grad = Eigen::Vector2d::Zero();
   int used = 0;  ///< measurements accumulated
+  /// The pose's information and gradient with the tilt (prior covariance `tilt_cov`) marginalised.
+  void marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const;
 };
+
+/// How a floor point p (robot frame, metres) seen from a mirror viewpoint h above the floor moves
+/// per radian of camera tilt (columns: about the robot's x and y axes). The point is seen along the
+/// ray (p, -h); a small turn w of the camera turns the ray by w x ray, which meets the floor h (-wy,
+/// wx) sideways and p (wx py - wy px) / h along the range: (r^2 + h^2) / h per radian towards the
+/// point, h across it. The same geometry as the accuracy bound's (harness/scoring/bound.cpp).
+Eigen::Matrix2d floor_tilt_jacobian(const Eigen::Vector2d& p, double h);
 
 /// The 2 n + 1 = 7 sigma points of a 3-D Gaussian and their regression helpers. Julier and
 /// Uhlmann's choice n + kappa = 3 (kappa = 0) matches the fourth moment of a Gaussian; the centre
@@ -53,7 +73,9 @@ class SigmaPoints {
   Predicted predict(const std::array<double, 6>& h) const;
   /// Adds the measurement z with noise variance r to `sum`, linearised at the centre by the
   /// regression of h (the regression error Pzz - H P H^T joins r).
-  void add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum) const;
+  /// `tilt` (optional): d(z)/d(tilt) of the measurement, accumulated for the tilt's marginalisation.
+  void add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum,
+           const Eigen::Vector2d* tilt = nullptr) const;
   /// H (1 x 3) of the regression for values h (central differences in the sigma coordinates).
   Eigen::RowVector3d regression(const std::array<double, 6>& h) const;
 
@@ -78,31 +100,57 @@ struct MotionNoise {
 /// The increment's noise covariance in the world frame of a robot at heading `theta`.
 Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const MotionNoise& n);
 
+/// The pose filter, optionally with a compass's bias b beside the pose: a compass reads theta + b +
+/// white noise, and b walks at random (an MTi-class heading sensor: docs/scenario.md, the robot
+/// noise profile), so its readings are not independent of one another and cannot be fused as if they
+/// were. The bias enters no other measurement and no motion, so it is kept as a linear appendix to
+/// the unscented pose filter: its mean, variance and cross-covariance with the pose. A pose update
+/// that does not see the bias moves it by Gaussian conditioning (b given x: b + P_bx P_xx^-1 dx),
+/// the motion carries the cross-covariance through the sigma points' regression, and a compass
+/// reading is a linear Kalman update of the joint (x, b).
 class UkfPose {
  public:
+  /// Starts at `mean` with covariance `cov`; no bias state.
   void reset(const Pose2& mean, const Eigen::Matrix3d& cov);
+  /// Adds the compass bias state: mean 0, variance `var`, uncorrelated with the pose.
+  void start_bias(double var);
+  bool has_bias() const { return has_bias_; }
+  double bias() const { return b_; }
+  double bias_variance() const { return pbb_; }
+  const Eigen::Vector3d& bias_cross() const { return pxb_; }
   /// x <- x (+) delta through the sigma points (the heading's spread swings the increment), then
-  /// + Q (world frame).
-  void predict(const Pose2& delta, const Eigen::Matrix3d& q);
+  /// + Q (world frame); the bias's variance grows by `bias_q`.
+  void predict(const Pose2& delta, const Eigen::Matrix3d& q, double bias_q = 0.0);
+  /// A compass reading z of theta + bias (variance `var` of its white noise; without a bias state,
+  /// of theta): the Kalman update of (x, b). Returns the innovation (wrapped).
+  double fuse_heading(double z, double var);
   /// The iterated sensor update. `linearise(centre, sigma, sum)` adds the frame's measurements
-  /// linearised at `centre` (sigma points around it with the prior covariance). `common`: the
-  /// frame-common error's covariance (zero: independent measurements). Returns the last sum.
+  /// linearised at `centre` (sigma points around it with the prior covariance). `tilt_cov`: the
+  /// frame's tilt prior (zero: none); `common`: any further frame-common pose error's covariance
+  /// (zero: none). Returns the last sum.
   template <class Linearise>
-  InformationSum update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common);
+  InformationSum update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common,
+                        const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero());
   const Eigen::Vector3d& mean() const { return x_; }
   Pose2 pose() const { return Pose2(x_.x(), x_.y(), x_.z()); }
   const Eigen::Matrix3d& covariance() const { return p_; }
   /// One Gauss-Newton step from `at` with the prior (x_, p_) and the measurements' `sum` taken at
   /// `at`; sets `cov_out` to the posterior covariance. Public for tests.
-  Eigen::Vector3d step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out) const;
+  Eigen::Vector3d step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out,
+                       const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero()) const;
 
  private:
+  /// After the pose moved from (x0, p0) to (x_, p_) on evidence that does not see the bias.
+  void condition_bias(const Eigen::Vector3d& x0, const Eigen::Matrix3d& p0);
   Eigen::Vector3d x_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d p_ = Eigen::Matrix3d::Identity();
+  bool has_bias_ = false;
+  double b_ = 0.0, pbb_ = 0.0;
+  Eigen::Vector3d pxb_ = Eigen::Vector3d::Zero();
 };
 
 template <class Linearise>
-InformationSum UkfPose::update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common) {
+InformationSum UkfPose::update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common, const Eigen::Matrix2d& tilt_cov) {
   Eigen::Vector3d at = x_;
   Eigen::Matrix3d post = p_;
   InformationSum sum;
@@ -113,13 +161,16 @@ InformationSum UkfPose::update(Linearise&& linearise, int iterations, const Eige
     linearise(at, sp, next);
     if (next.used == 0) break;  // nothing associated from here: keep the last step's result
     sum = next;
-    at = step(at, sum, common, &post);
+    at = step(at, sum, common, &post, tilt_cov);
     ++done;
   }
   if (done == 0) return sum;
+  const Eigen::Vector3d x0 = x_;
+  const Eigen::Matrix3d p0 = p_;
   x_ = at;
   x_.z() = wrap_angle(x_.z());
   p_ = 0.5 * (post + post.transpose());
+  if (has_bias_) condition_bias(x0, p0);
   return sum;
 }
 
