@@ -207,7 +207,7 @@ struct Hello {
   double hello_timeout_s = 60, frame_timeout_s = 10, exit_timeout_s = 5;
   Json params = Json::object();  ///< the scenario's localizer params, unchanged
   Field field;
-  Json camera = Json::object();  ///< width, height, channels, layout, mirror_centre_px, calibration, latency_s
+  Json camera = Json::object();  ///< width, height, channels, layout, mirror_centre_px, calibration, latency_s, mount_height_m, vibration_rad
   Json vision = Json::object();  ///< {"line_points": true, "blobs": bool}
   Json raw;                      ///< the message as sent
 

@@ -277,6 +277,8 @@ class Camera:
     layout: str = "HWC"
     mirror_centre_px: Tuple[float, float] = (0.0, 0.0)  #: (cu, cv), pixels, image frame
     latency_s: float = 0.0  #: the camera's declared latency: the image is this much older than the frame's odometry (0: not declared)
+    mount_height_m: Optional[float] = None  #: metres: the mirror viewpoint's declared height above the floor (None: not told)
+    vibration_rad: Optional[float] = None  #: radians: the declared per-frame tilt's standard deviation, each of roll and pitch (None: not told)
     raw: Dict[str, Any] = dataclass_field(default_factory=dict, repr=False)
 
     @classmethod
@@ -284,7 +286,9 @@ class Camera:
         c = j.get("mirror_centre_px", [0.0, 0.0])
         return cls(width=int(j.get("width", 0)), height=int(j.get("height", 0)), channels=int(j.get("channels", 3)),
                    layout=str(j.get("layout", "HWC")), mirror_centre_px=(float(c[0]), float(c[1])),
-                   latency_s=float(j.get("latency_s", 0.0)), raw=j)
+                   latency_s=float(j.get("latency_s", 0.0)),
+                   mount_height_m=float(j["mount_height_m"]) if "mount_height_m" in j else None,
+                   vibration_rad=float(j["vibration_rad"]) if "vibration_rad" in j else None, raw=j)
 
     def calibration(self) -> Calibration:
         """The pixel -> robot-frame floor map (raises ProtocolError when hello had none)."""

@@ -15,7 +15,7 @@ sys.path.insert(0, str(CLIENTS / "python"))
 import omniloc_client as olp  # noqa: E402
 
 CAMERA = {
-    "width": 4, "height": 2, "channels": 3, "layout": "HWC", "mirror_centre_px": [2.0, 1.0], "latency_s": 0.033,
+    "width": 4, "height": 2, "channels": 3, "layout": "HWC", "mirror_centre_px": [2.0, 1.0], "latency_s": 0.033, "mount_height_m": 0.75, "vibration_rad": 0.005,
     "calibration": {
         "bearings_rad": [0.0, math.pi / 2, math.pi, 3 * math.pi / 2],
         "radii_px": [[1.0, 2.0, 4.0]] * 4,
@@ -131,6 +131,8 @@ class ServeTest(unittest.TestCase):
         self.assertEqual(loc.hello_seen.field.goal_colours, ["yellow", "blue"])
         self.assertEqual(loc.hello_seen.camera.latency_s, 0.033)
         self.assertEqual(olp.Camera.from_json({}).latency_s, 0.0)  # an omniloc from before latency_s: not declared
+        self.assertEqual((loc.hello_seen.camera.mount_height_m, loc.hello_seen.camera.vibration_rad), (0.75, 0.005))
+        self.assertEqual((olp.Camera.from_json({}).mount_height_m, olp.Camera.from_json({}).vibration_rad), (None, None))  # not told
         f = loc.frames[1]
         self.assertEqual((f.k, f.odometry, f.heading, f.camera_ok, f.line_points), (1, (0.1, 0.02, 0.01), None, True, [(1.0, 0.5)]))
         self.assertEqual(f.image_shape, (2, 4, 3))
