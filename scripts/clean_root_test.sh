@@ -77,9 +77,11 @@ if [ -n "$cache" ] && mkdir -p "$cache" 2>/dev/null; then
   say "download cache: $cache ($(find "$cache" -name '*.deb' | wc -l) .debs, $(du -sh "$cache" | cut -f1))"
   cache_in=(--skip=essential/unlink --setup-hook='mkdir -p "$1"/var/cache/apt/archives/'
             --setup-hook="sync-in '$cache' /var/cache/apt/archives/")
-  # Only the .debs the cache lacks are copied back (sync-out copied all 400-odd every time).
+  # Only the .debs the cache lacks are copied back (sync-out copied all 400-odd every time), each by
+  # copy and rename: the package stage's root may read the cache at the same time (.ci/run).
   printf '%s\n' 'for f in "$1"/var/cache/apt/archives/*.deb; do' \
-    '  [ ! -f "$f" ] || [ -e "$2/${f##*/}" ] || cp "$f" "$2/"' 'done; true  # a cache that cannot be written costs a download, not the check' >"$work/cache_out.sh"
+    '  [ ! -f "$f" ] || [ -e "$2/${f##*/}" ] || { cp "$f" "$2/.${f##*/}.$$" && mv "$2/.${f##*/}.$$" "$2/${f##*/}"; }' \
+    'done; true  # a cache that cannot be written costs a download, not the check' >"$work/cache_out.sh"
   cache_out=(--customize-hook="bash '$work/cache_out.sh' \"\$1\" '$cache'")
 fi
 limit=${OMNILOC_FRESH_ROOT_LIMIT:-1080}

@@ -9,7 +9,9 @@ case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exi
 cd "$(dirname "$0")/.."
 secs="${1:-60}"
 shift || true
-scripts/asan_build.sh scenario_fuzz
+# OMNILOC_FUZZ_BUILT=1 (scripts/sanitize.sh --with-fuzz, which built it with the tests): no configure
+# or build here, which would touch build-asan/ while its ctest reads it.
+[ "${OMNILOC_FUZZ_BUILT:-0}" = 1 ] || scripts/asan_build.sh scenario_fuzz
 corpus=build-asan/fuzz-corpus
 mkdir -p "$corpus" build-asan/fuzz-artifacts
 seeds=$(mktemp -d)

@@ -4,12 +4,20 @@
 # slow end-to-end scenario tests or the benchmarks, then runs ctest -LE 'scenario|cluster|mutation|python'
 # (label python: the checks of Python code, which the Release tree's run covers; tests/CMakeLists.txt).
 # Leaks inside Mesa (llvmpipe, OSMesa, LLVM) are suppressed by .ci/lsan-mesa.supp, nothing else.
-# Usage: scripts/sanitize.sh [ctest arguments]
+# With --with-fuzz SECS (CI), the fuzz target is built with the tests and scripts/fuzz.sh runs for
+# SECS seconds beside the sanitized ctest: libFuzzer uses one core, so alone it left the other idle.
+# The script then fails when either fails. Usage: scripts/sanitize.sh [--with-fuzz SECS] [ctest arguments]
 set -euo pipefail
 case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 # olp_cpp_example: the one-header C++ client, whose stream tests (ctest olp_cpp_client) are unit tests.
 targets=(omniloc olp_cpp_example)
+fuzz_secs=""
+if [ "${1:-}" = --with-fuzz ]; then
+  fuzz_secs=${2:?--with-fuzz needs the seconds}
+  shift 2
+  targets+=(scenario_fuzz)
+fi
 # Only what the sanitized ctest below runs: not the slow scenario tests, nor cluster_test (label
 # cluster) and regression_test (its committed numbers are GCC Release's), which it leaves out.
 for f in tests/*_test.cpp; do
@@ -20,6 +28,10 @@ done
 t0=$(date +%s)
 scripts/asan_build.sh "${targets[@]}"
 t1=$(date +%s)
+if [ -n "$fuzz_secs" ]; then
+  OMNILOC_FUZZ_BUILT=1 scripts/fuzz.sh "$fuzz_secs" >build-asan/fuzz_beside.log 2>&1 &
+  fuzz_pid=$!
+fi
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=0"
 export LSAN_OPTIONS="suppressions=$PWD/.ci/lsan-mesa.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
@@ -40,5 +52,14 @@ cd build-asan
 # -E Regression.: the committed reference numbers are those of the GCC Release build; this clang
 # build gives slightly different floats (tracking_short: position rmse 0.0476 and 0.0484 m, with no
 # sanitizer report), so that byte-exact gate belongs to the Release stage. Not yet explained.
-ctest --output-on-failure -j"$(nproc)" --timeout 1800 -LE 'scenario|cluster|mutation|python' -E '_NOT_BUILT$|^Regression\.' "$@"
+rc=0
+ctest --output-on-failure -j"$(nproc)" --timeout 1800 -LE 'scenario|cluster|mutation|python' -E '_NOT_BUILT$|^Regression\.' "$@" || rc=$?
 echo "sanitize: build $((t1 - t0)) s, tests $(($(date +%s) - t1)) s"
+if [ -n "$fuzz_secs" ]; then
+  frc=0
+  wait "$fuzz_pid" || frc=$?
+  echo "--- scripts/fuzz.sh $fuzz_secs, run beside the tests:"
+  cat fuzz_beside.log
+  [ $frc -eq 0 ] || rc=$frc
+fi
+exit $rc
