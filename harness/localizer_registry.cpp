@@ -20,6 +20,8 @@ external::ExternalConfig read_external(JsonReader& r) {
       throw ConfigError(r.child_path("label"), "\"" + cfg.label + "\"", "a name that is not a built-in localizer's (omniloc list)");
   return cfg;
 }
+// What the scenario's camera declares, as ukf_mh's defaults take it.
+modern::DeclaredCamera declared_camera(const LocalizerContext& ctx) { return {ctx.camera_latency, ctx.camera_mount_height, ctx.camera_vibration}; }
 }  // namespace
 
 const std::vector<LocalizerInfo>& localizers() {
@@ -30,28 +32,28 @@ const std::vector<LocalizerInfo>& localizers() {
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<MatchingLocalizer>(*ctx.field, MatchingParams::from_json(r), ctx.cache_dir);
        },
-       &MatchingParams::schema},
+       &MatchingParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)MatchingParams::from_json(r); }},
       {"mcl", "Monte Carlo localization, distance-map sensor model: 600 particles with compass headings (paper 002); without a compass 5000, KLD-adaptive, 2 m clamp", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<McLLocalizer>(*ctx.field, McLParams::from_json(r), ctx.seed, ctx.cache_dir);
        },
-       &McLParams::schema},
+       &McLParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)McLParams::from_json(r); }},
       {"hybrid", "MCL until converged, then matching tracking; wrong-localisation detection restarts MCL (paper 002)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<HybridLocalizer>(*ctx.field, HybridParams::from_json(r), ctx.seed, ctx.cache_dir);
        },
-       &HybridParams::schema},
+       &HybridParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)HybridParams::from_json(r); }},
       {"grid_global", "MTi-heading grid search (315 samples, best 5 refined by RPROP, up to 3 shifted passes), then matching tracking with MTi drift correction (paper 000)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) {
          return std::make_unique<GridGlobalLocalizer>(*ctx.field, GridGlobalParams::from_json(r), ctx.cache_dir);
        },
-       &GridGlobalParams::schema},
+       &GridGlobalParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)GridGlobalParams::from_json(r); }},
       {"ukf_mh", "modern reference: a few unscented Kalman filter hypotheses on line points associated with the markings, validity-filtered, with Falcons-style simplex field fits as alternative poses (after B-Human's SelfLocator / UKFPose2D and the Falcons' localization; docs/modern_localizer.md)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, modern::UkfMhParams::from_json(r, {ctx.camera_latency, ctx.camera_mount_height, ctx.camera_vibration}), ctx.seed, ctx.cache_dir); },
-       &modern::UkfMhParams::schema},
+       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, modern::UkfMhParams::from_json(r, declared_camera(ctx)), ctx.seed, ctx.cache_dir); },
+       &modern::UkfMhParams::schema, [](JsonReader& r, const LocalizerContext& ctx) { (void)modern::UkfMhParams::from_json(r, declared_camera(ctx)); }},
       {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },
-       [] { return params_schema(LandmarkLocalizerParams::params()); }},
+       [] { return params_schema(LandmarkLocalizerParams::params()); }, [](JsonReader& r, const LocalizerContext&) { (void)LandmarkLocalizerParams::from_json(r); }},
       {"external", "a user's localizer in any language, run as its own process and spoken to in olp/1 (docs/protocol.md); named in results by its label, else by the name the client reports", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) -> std::unique_ptr<Localizer> {
          external::ExternalConfig cfg = read_external(r);
@@ -60,7 +62,7 @@ const std::vector<LocalizerInfo>& localizers() {
          return std::make_unique<external::ExternalLocalizer>(std::move(cfg), *ctx.session);
        },
        &external::ExternalConfig::schema,
-       [](JsonReader& r) { read_external(r); }},
+       [](JsonReader& r, const LocalizerContext&) { read_external(r); }},
   };
   return list;
 }
@@ -108,7 +110,7 @@ void check_localizer(const LocalizerSpec& l, const LocalizerContext& ctx) {
     r.allow("comment");
     const std::string type = r.string("type", std::nullopt);
     const LocalizerInfo& info = localizer_info(type, r.child_path("type"));
-    if (info.check) info.check(r);
+    if (info.check) info.check(r, ctx);
     else info.make(r, ctx);
     r.finish();
   } catch (const ConfigError& e) {

@@ -2,7 +2,8 @@
 # Builds TARGETS in build-asan/: clang-14 with AddressSanitizer + UndefinedBehaviorSanitizer and
 # libFuzzer coverage, shared by scripts/sanitize.sh (unit tests) and scripts/fuzz.sh (fuzz target),
 # so the libraries are compiled once for both. Installs clang-14, its runtimes (libFuzzer is in
-# libclang-rt-14-dev), its linker lld-14 and Ninja from Debian when missing. Usage: scripts/asan_build.sh TARGET...
+# libclang-rt-14-dev), its linker lld-14 and Ninja from Debian when missing.
+# Usage: scripts/asan_build.sh TARGET... | --deps-only (install, build nothing)
 set -euo pipefail
 case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
@@ -17,6 +18,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+[ "${1:-}" != --deps-only ] || exit 0  # .ci/run installs first, then builds beside other stages
 # -O2 keeps the sanitized tests fast enough for CI. -gline-tables-only gives a report's stack its
 # files and lines, which is all a sanitizer prints, without the full debug information of -g: objects
 # a quarter the size and 10-20 % less compile time (measured on four of the heaviest files).

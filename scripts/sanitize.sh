@@ -6,13 +6,19 @@
 # Leaks inside Mesa (llvmpipe, OSMesa, LLVM) are suppressed by .ci/lsan-mesa.supp, nothing else.
 # With --with-fuzz SECS (CI), the fuzz target is built with the tests and scripts/fuzz.sh runs for
 # SECS seconds beside the sanitized ctest: libFuzzer uses one core, so alone it left the other idle.
-# The script then fails when either fails. Usage: scripts/sanitize.sh [--with-fuzz SECS] [ctest arguments]
+# The script then fails when either fails. --print-targets [--with-fuzz SECS]: prints the build's
+# targets and exits (.ci/run builds them beside other stages first).
+# Usage: scripts/sanitize.sh [--print-targets] [--with-fuzz SECS] [ctest arguments]
 set -euo pipefail
 case "${1:-}" in -h | --help) sed -n '2,/^set -/{/^#/s/^# \{0,1\}//p}' "$0"; exit 0 ;; esac  # the header above; nothing runs
 cd "$(dirname "$0")/.."
 # olp_cpp_example: the one-header C++ client, whose stream tests (ctest olp_cpp_client) are unit tests.
 targets=(omniloc olp_cpp_example)
 fuzz_secs=""
+if [ "${1:-}" = --print-targets ]; then
+  print_targets=1
+  shift
+fi
 if [ "${1:-}" = --with-fuzz ]; then
   fuzz_secs=${2:?--with-fuzz needs the seconds}
   shift 2
@@ -25,6 +31,10 @@ for f in tests/*_test.cpp; do
   case "$name" in scenario_* | cluster_test | regression_test) continue ;; esac
   targets+=("$name")
 done
+if [ -n "${print_targets:-}" ]; then
+  echo "${targets[@]}"
+  exit 0
+fi
 t0=$(date +%s)
 scripts/asan_build.sh "${targets[@]}"
 t1=$(date +%s)

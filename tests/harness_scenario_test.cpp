@@ -238,3 +238,40 @@ TEST(Runner, KidnapTeleportsWithoutOdometryAndIsLogged) {
   // Dead reckoning cannot know about the teleport: the final error is about the jump (~4.3 m).
   EXPECT_GT(r.robots[0].all.pos_max_m, 3.5);
 }
+
+// Validation checks a built-in localizer's parameters without building it (no distance map, no
+// association grid): it must refuse exactly what building refuses, with the same words.
+TEST(LocalizerCheck, RefusesWhatBuildingRefusesWithTheSameError) {
+  const Field field = Field::preset("msl2012");
+  LocalizerContext ctx;
+  ctx.field = &field;
+  const auto error_of = [](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const LocalizerError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  int compared = 0;
+  for (const auto& info : localizers()) {
+    if (info.type == "external") continue;  // building it needs a run (its client process)
+    std::vector<Json> docs = {Json{{"type", info.type}}, Json{{"type", info.type}, {"no_such_key", 1}}};
+    const Json schema = info.schema();
+    for (const auto& [key, prop] : schema.items()) {
+      docs.push_back(Json{{"type", info.type}, {key, "a string"}});
+      if (prop.contains("minimum")) docs.push_back(Json{{"type", info.type}, {key, prop["minimum"].get<double>() - 1.0}});
+    }
+    for (const Json& j : docs) {
+      const LocalizerSpec spec(j, "/localizer");
+      const std::string checked = error_of([&] { check_localizer(spec, ctx); });
+      const std::string built = error_of([&] { (void)make_localizer(spec, ctx); });
+      EXPECT_EQ(checked, built) << j.dump();
+      if (j.size() == 1) {
+        EXPECT_EQ(checked, "") << j.dump();  // the defaults are valid
+      }
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 50);
+}
