@@ -81,6 +81,12 @@ while True:
     dx, dy, dth = msg["odometry"]
     c, s = math.cos(th), math.sin(th)
     x, y, th = x + c * dx - s * dy, y + s * dx + c * dy, th + dth  # left to right, as Pose2::compose
+    if kind == "stall_at" and k == n_at - 1:
+        # The grandchild is started, and its pid noted, a frame before the stall and before this
+        # frame's answer: started at the stall itself, on a busy machine the host's timeout could
+        # end the client before the pid was written, and the test would not know the grandchild.
+        child = subprocess.Popen(["sleep", "1000"])
+        note_pid(child.pid)
     if k == n_at:
         print(f"faulty_client: {kind} at frame {k}", file=sys.stderr, flush=True)
         if kind == "exit_at":
@@ -88,8 +94,6 @@ while True:
         if kind == "kill_at":
             os.kill(os.getpid(), signal.SIGKILL)
         if kind == "stall_at":
-            child = subprocess.Popen(["sleep", "1000"])
-            note_pid(child.pid)
             time.sleep(1000)
         if kind == "ignore_term_at":
             signal.signal(signal.SIGTERM, signal.SIG_IGN)
