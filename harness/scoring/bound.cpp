@@ -11,6 +11,7 @@
 #include <Eigen/LU>
 
 #include "core/angles.hpp"
+#include "core/floor_tilt.hpp"
 
 namespace omniloc::harness {
 
@@ -163,16 +164,7 @@ MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w) {
   return m;
 }
 
-Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h) {
-  // A floor point p is seen along the ray (p, -h) from the mirror's viewpoint. Turning the camera
-  // by small angles (wx about x, wy about y) turns the ray by w x ray, and the floor point moves by
-  // h (-wy, wx) sideways plus p (wx py - wy px) / h along its range: (r^2 + h^2) / h per radian for a
-  // tilt towards the point, h for one across it.
-  Eigen::Matrix2d M;
-  M << p.x() * p.y() / h, -h - p.x() * p.x() / h,  //
-      h + p.y() * p.y() / h, -p.x() * p.y() / h;
-  return M;
-}
+Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h) { return floor_tilt_jacobian(p, h); }
 
 Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen::Matrix2d& tilt_cov, double line_corr, Eigen::Vector3d* score) {
   // J = H^T R^-1 H with R = D + A C A^T; Woodbury: R^-1 = D^-1 - D^-1 A (C^-1 + A^T D^-1 A)^-1 A^T D^-1.

@@ -76,14 +76,6 @@ void InformationSum::marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Ma
   j = 0.5 * (j + j.transpose()).eval();
 }
 
-Eigen::Matrix2d floor_tilt_jacobian(const Eigen::Vector2d& p, double h) {
-  // Columns: the floor point's move per radian about the robot's x axis (roll) and y axis (pitch).
-  Eigen::Matrix2d m;
-  m << p.x() * p.y() / h, -h - p.x() * p.x() / h,  //
-      h + p.y() * p.y() / h, -p.x() * p.y() / h;
-  return m;
-}
-
 Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const MotionNoise& n) {
   const double dist = std::hypot(delta.x, delta.y), turn = std::fabs(delta.theta);
   const double var_xy = n.trans_per_sqrt_m * n.trans_per_sqrt_m * dist + (n.scale * dist) * (n.scale * dist) + n.floor_xy * n.floor_xy;

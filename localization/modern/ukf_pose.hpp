@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include "core/floor_tilt.hpp"
 #include "core/pose2.hpp"
 
 namespace omniloc::modern {
@@ -48,12 +49,8 @@ struct InformationSum {
   void marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const;
 };
 
-/// How a floor point p (robot frame, metres) seen from a mirror viewpoint h above the floor moves
-/// per radian of camera tilt (columns: about the robot's x and y axes). The point is seen along the
-/// ray (p, -h); a small turn w of the camera turns the ray by w x ray, which meets the floor h (-wy,
-/// wx) sideways and p (wx py - wy px) / h along the range: (r^2 + h^2) / h per radian towards the
-/// point, h across it. The same geometry as the accuracy bound's (harness/scoring/bound.cpp).
-Eigen::Matrix2d floor_tilt_jacobian(const Eigen::Vector2d& p, double h);
+/// The floor geometry of a camera tilt (core/floor_tilt.hpp), the same as the accuracy bound's.
+using omniloc::floor_tilt_jacobian;
 
 /// The 2 n + 1 = 7 sigma points of a 3-D Gaussian and their regression helpers. Julier and
 /// Uhlmann's choice n + kappa = 3 (kappa = 0) matches the fourth moment of a Gaussian; the centre
