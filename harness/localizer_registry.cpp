@@ -22,38 +22,56 @@ external::ExternalConfig read_external(JsonReader& r) {
 }
 // What the scenario's camera declares, as ukf_mh's defaults take it.
 modern::DeclaredCamera declared_camera(const LocalizerContext& ctx) { return {ctx.camera_latency, ctx.camera_mount_height, ctx.camera_vibration}; }
+
+// A built-in's entry from one reader of its parameters: `make` builds from what `read` returns and
+// `check` is `read` alone, so validation and building can never accept different files or say
+// different errors.
+template <class Read, class Build>
+LocalizerInfo builtin(std::string type, std::string description, bool needs_start_pose, bool needs_vision, Read read, Build build,
+                      std::function<Json()> schema) {
+  return {std::move(type), std::move(description), needs_start_pose, needs_vision,
+          [read, build](JsonReader& r, const LocalizerContext& ctx) -> std::unique_ptr<Localizer> { return build(read(r, ctx), ctx); },
+          std::move(schema), [read](JsonReader& r, const LocalizerContext& ctx) { (void)read(r, ctx); }};
+}
+
+// The reader of a parameter struct that needs nothing from the context.
+template <class P>
+auto reads() {
+  return [](JsonReader& r, const LocalizerContext&) { return P::from_json(r); };
+}
 }  // namespace
 
 const std::vector<LocalizerInfo>& localizers() {
   static const std::vector<LocalizerInfo> list = {
-      {"odometry_only", "dead reckoning from the true start pose (odometry drift baseline)", true, false,
-       [](JsonReader&, const LocalizerContext&) { return std::make_unique<OdometryOnlyLocalizer>(); }, [] { return Json::object(); }},
-      {"matching", "matching-optimisation tracking (RPROP on the distance map) fused with odometry by a Kalman filter (paper 002)", true, true,
-       [](JsonReader& r, const LocalizerContext& ctx) {
-         return std::make_unique<MatchingLocalizer>(*ctx.field, MatchingParams::from_json(r), ctx.cache_dir);
-       },
-       &MatchingParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)MatchingParams::from_json(r); }},
-      {"mcl", "Monte Carlo localization, distance-map sensor model: 600 particles with compass headings (paper 002); without a compass 5000, KLD-adaptive, 2 m clamp", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) {
-         return std::make_unique<McLLocalizer>(*ctx.field, McLParams::from_json(r), ctx.seed, ctx.cache_dir);
-       },
-       &McLParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)McLParams::from_json(r); }},
-      {"hybrid", "MCL until converged, then matching tracking; wrong-localisation detection restarts MCL (paper 002)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) {
-         return std::make_unique<HybridLocalizer>(*ctx.field, HybridParams::from_json(r), ctx.seed, ctx.cache_dir);
-       },
-       &HybridParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)HybridParams::from_json(r); }},
-      {"grid_global", "MTi-heading grid search (315 samples, best 5 refined by RPROP, up to 3 shifted passes), then matching tracking with MTi drift correction (paper 000)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) {
-         return std::make_unique<GridGlobalLocalizer>(*ctx.field, GridGlobalParams::from_json(r), ctx.cache_dir);
-       },
-       &GridGlobalParams::schema, [](JsonReader& r, const LocalizerContext&) { (void)GridGlobalParams::from_json(r); }},
-      {"ukf_mh", "modern reference: a few unscented Kalman filter hypotheses on line points associated with the markings, validity-filtered, with Falcons-style simplex field fits as alternative poses (after B-Human's SelfLocator / UKFPose2D and the Falcons' localization; docs/modern_localizer.md)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, modern::UkfMhParams::from_json(r, declared_camera(ctx)), ctx.seed, ctx.cache_dir); },
-       &modern::UkfMhParams::schema, [](JsonReader& r, const LocalizerContext& ctx) { (void)modern::UkfMhParams::from_json(r, declared_camera(ctx)); }},
-      {"landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
-       [](JsonReader& r, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, LandmarkLocalizerParams::from_json(r)); },
-       [] { return params_schema(LandmarkLocalizerParams::params()); }, [](JsonReader& r, const LocalizerContext&) { (void)LandmarkLocalizerParams::from_json(r); }},
+      builtin("odometry_only", "dead reckoning from the true start pose (odometry drift baseline)", true, false,
+              [](JsonReader&, const LocalizerContext&) { return 0; },
+              [](int, const LocalizerContext&) { return std::make_unique<OdometryOnlyLocalizer>(); }, [] { return Json::object(); }),
+      builtin("matching", "matching-optimisation tracking (RPROP on the distance map) fused with odometry by a Kalman filter (paper 002)", true, true,
+              reads<MatchingParams>(),
+              [](MatchingParams p, const LocalizerContext& ctx) { return std::make_unique<MatchingLocalizer>(*ctx.field, p, ctx.cache_dir); },
+              &MatchingParams::schema),
+      builtin("mcl", "Monte Carlo localization, distance-map sensor model: 600 particles with compass headings (paper 002); without a compass 5000, KLD-adaptive, 2 m clamp", false, true,
+              reads<McLParams>(),
+              [](McLParams p, const LocalizerContext& ctx) { return std::make_unique<McLLocalizer>(*ctx.field, p, ctx.seed, ctx.cache_dir); },
+              &McLParams::schema),
+      builtin("hybrid", "MCL until converged, then matching tracking; wrong-localisation detection restarts MCL (paper 002)", false, true,
+              reads<HybridParams>(),
+              [](HybridParams p, const LocalizerContext& ctx) { return std::make_unique<HybridLocalizer>(*ctx.field, p, ctx.seed, ctx.cache_dir); },
+              &HybridParams::schema),
+      builtin("grid_global", "MTi-heading grid search (315 samples, best 5 refined by RPROP, up to 3 shifted passes), then matching tracking with MTi drift correction (paper 000)", false, true,
+              reads<GridGlobalParams>(),
+              [](GridGlobalParams p, const LocalizerContext& ctx) { return std::make_unique<GridGlobalLocalizer>(*ctx.field, p, ctx.cache_dir); },
+              &GridGlobalParams::schema),
+      builtin("ukf_mh", "modern reference: a few unscented Kalman filter hypotheses on line points associated with the markings, validity-filtered, with Falcons-style simplex field fits as alternative poses (after B-Human's SelfLocator / UKFPose2D and the Falcons' localization; docs/modern_localizer.md)", false, true,
+              [](JsonReader& r, const LocalizerContext& ctx) { return modern::UkfMhParams::from_json(r, declared_camera(ctx)); },
+              [](modern::UkfMhParams p, const LocalizerContext& ctx) { return std::make_unique<modern::UkfMhLocalizer>(*ctx.field, p, ctx.seed, ctx.cache_dir); },
+              &modern::UkfMhParams::schema),
+      builtin("landmarks", "pose from bearings of coloured blobs (goal edges, colour cubes) matched by colour; least squares with >= 4, ToTal-like with 3 (papers 004 and 003)", false, true,
+              reads<LandmarkLocalizerParams>(),
+              [](LandmarkLocalizerParams p, const LocalizerContext& ctx) { return std::make_unique<LandmarkLocalizer>(*ctx.field, p); },
+              [] { return params_schema(LandmarkLocalizerParams::params()); }),
+      // Not a builtin(): its check reads the keys and checks the program, while building needs a run
+      // (the session its client is told of) and starts the program.
       {"external", "a user's localizer in any language, run as its own process and spoken to in olp/1 (docs/protocol.md); named in results by its label, else by the name the client reports", false, true,
        [](JsonReader& r, const LocalizerContext& ctx) -> std::unique_ptr<Localizer> {
          external::ExternalConfig cfg = read_external(r);
