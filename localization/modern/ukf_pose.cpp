@@ -64,9 +64,16 @@ void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, dou
   }
   if (group >= 0 && load > 0) {
     InformationSum::Group* g = nullptr;
-    for (int k = 0; k < sum.n_groups && !g; ++k)
-      if (sum.groups[static_cast<std::size_t>(k)].id == group) g = &sum.groups[static_cast<std::size_t>(k)];
+    const bool direct = group < InformationSum::kDirectIds;
+    if (direct) {
+      const int k = sum.slot_of[static_cast<std::size_t>(group)];
+      if (k >= 0) g = &sum.groups[static_cast<std::size_t>(k)];
+    } else {
+      for (int k = 0; k < sum.n_groups && !g; ++k)
+        if (sum.groups[static_cast<std::size_t>(k)].id == group) g = &sum.groups[static_cast<std::size_t>(k)];
+    }
     if (!g && sum.n_groups < InformationSum::kMaxGroups) {
+      if (direct) sum.slot_of[static_cast<std::size_t>(group)] = static_cast<std::int8_t>(sum.n_groups);
       g = &sum.groups[static_cast<std::size_t>(sum.n_groups++)];
       g->h.setZero();
       g->a.setZero();

@@ -35,6 +35,7 @@
 // measurement of covariance J^-1 + C, written without inverting J (singular when one line is seen):
 // W = (Id + J C)^-1 J, and the gradient b becomes (Id + J C)^-1 b.
 #include <array>
+#include <cstdint>
 
 #include <Eigen/Core>
 
@@ -62,6 +63,7 @@ struct InformationSum {
     tilt_grad.setZero();
     used = 0;
     n_groups = 0;
+    slot_of = filled_slots();
   }
   /// One marking's sums for its shared offset (load l: the offset's effect on a point's value):
   /// H^T D^-1 l, A^T D^-1 l, l^T D^-1 l and l^T D^-1 (z - h).
@@ -77,6 +79,15 @@ struct InformationSum {
   static constexpr int kMaxGroups = 32;
   std::array<Group, kMaxGroups> groups;
   int n_groups = 0;
+  /// The group of each id below kDirectIds (-1: none yet), so that a point finds its marking's sums
+  /// without a search; larger ids are searched for.
+  static constexpr int kDirectIds = 64;
+  std::array<std::int8_t, kDirectIds> slot_of = filled_slots();
+  static constexpr std::array<std::int8_t, kDirectIds> filled_slots() {
+    std::array<std::int8_t, kDirectIds> a{};
+    for (auto& v : a) v = -1;
+    return a;
+  }
   /// The pose's information and gradient with the markings' offsets (standardized prior variance
   /// `group_var`: the correlation of two points on one marking; 0: none) and the tilt (prior
   /// covariance `tilt_cov`) marginalised.
