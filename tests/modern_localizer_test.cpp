@@ -467,6 +467,125 @@ TEST(UkfPose, TiltMarginalisationEqualsDenseGls) {
   EXPECT_EQ(g, sum.grad);
 }
 
+// The markings' shared offsets (standardized prior variance rho, load l_i per point) and the tilt,
+// marginalised from the sums that SigmaPoints::add accumulates, equal the dense generalized least
+// squares with the points' covariance D + L rho L^T + A T A^T (linear measurements, so the
+// regression is exact).
+TEST(UkfPose, MarkingOffsetMarginalisationEqualsDenseGls) {
+  Rng rng(11);
+  const int m = 30, groups = 4;
+  const SigmaPoints sp(Eigen::Vector3d(0.5, -0.2, 0.1), spd(0.01, 0.02, 0.003, 0.001, 0.0005, -0.0002));
+  Eigen::MatrixXd h(m, 3), a(m, 2), l = Eigen::MatrixXd::Zero(m, groups);
+  Eigen::VectorXd d(m), e(m);
+  InformationSum sum;
+  for (int i = 0; i < m; ++i) {
+    h.row(i) << rng.normal(0, 1), rng.normal(0, 1), rng.normal(0, 3);
+    a.row(i) << rng.normal(0, 5), rng.normal(0, 5);
+    d(i) = 0.0002 + 0.0002 * rng.uniform(0, 1);
+    const int k = (i * 7) % groups;
+    l(i, k) = 0.01 + 0.02 * rng.uniform(0, 1);
+    e(i) = rng.normal(0, 0.02);
+    std::array<double, 6> v{};
+    for (int q = 0; q < 6; ++q) v[static_cast<std::size_t>(q)] = h.row(i).dot(sp[q]) + 0.3;
+    const SigmaPoints::Predicted pr = sp.predict(v);
+    const Eigen::Vector2d ai = a.row(i).transpose();
+    sp.add(v, pr, pr.mean + e(i), d(i), sum, &ai, 7 + 3 * k, l(i, k));
+  }
+  EXPECT_EQ(sum.n_groups, groups);
+  const double rho = 0.12;
+  for (const Eigen::Matrix2d& t : {Eigen::Matrix2d(Eigen::Vector2d(2.7e-5, 1.5e-5).asDiagonal()), Eigen::Matrix2d(Eigen::Matrix2d::Zero())}) {
+    const Eigen::MatrixXd r = Eigen::MatrixXd(d.asDiagonal()) + rho * l * l.transpose() + a * t * a.transpose();
+    const Eigen::MatrixXd ri = r.inverse();
+    const Eigen::Matrix3d j_dense = h.transpose() * ri * h;
+    const Eigen::Vector3d g_dense = h.transpose() * ri * e;
+    Eigen::Matrix3d j;
+    Eigen::Vector3d g;
+    sum.marginalise(t, rho, j, g);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(g(i), g_dense(i), 1e-8 * std::max(1.0, std::fabs(g_dense(i)))) << i;
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(j(i, k), j_dense(i, k), 1e-8 * j_dense.norm()) << i << "," << k;
+    }
+  }
+  // No offsets and no tilt: the independent points' sums.
+  Eigen::Matrix3d j;
+  Eigen::Vector3d g;
+  sum.marginalise(Eigen::Matrix2d::Zero(), 0.0, j, g);
+  EXPECT_EQ(j, sum.info);
+  EXPECT_EQ(g, sum.grad);
+}
+
+// n points on one marking, each of variance v with correlation rho: together they tell the
+// marking's normal offset as n / (v (1 + (n - 1) rho)), not n / v; 15 points at rho 0.1 are worth
+// 6.25 independent ones.
+TEST(UkfPose, OneMarkingsPointsAreWorthLessThanIndependentOnes) {
+  const SigmaPoints sp(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 0.01);
+  const double v = 0.0004, rho = 0.1;
+  const int n = 15;
+  InformationSum sum;
+  for (int i = 0; i < n; ++i) {
+    std::array<double, 6> x{};
+    for (int q = 0; q < 6; ++q) x[static_cast<std::size_t>(q)] = sp[q].x();
+    sp.add(x, sp.predict(x), 0.0, (1.0 - rho) * v, sum, nullptr, 3, std::sqrt(v));
+  }
+  Eigen::Matrix3d j;
+  Eigen::Vector3d g;
+  sum.marginalise(Eigen::Matrix2d::Zero(), rho, j, g);
+  EXPECT_NEAR(j(0, 0), n / (v * (1 + (n - 1) * rho)), 1e-6 * n / v);
+  EXPECT_NEAR(j(0, 0) * v, 6.25, 1e-9);
+  EXPECT_NEAR(j(1, 1), 0.0, 1e-9);
+}
+
+// A point whose scan ray meets its marking at a grazing angle (|n . u| below 0.3) is anywhere across
+// the line's width: its variance grows by w^2 / 12, (0.125 m)^2 / 12 = 1.302e-3 m^2 for the MSL line
+// at a grazing_spread of 1 / sqrt(12) line widths. A ray 0.29 off square grazes; one 0.31 off
+// square, or crossing squarely, keeps the point's own variance; a threshold of 0 has no grazing class.
+TEST(UkfMh, GrazingPointSpreadsOverTheLinesWidth) {
+  const double own = 0.02 * 0.02, spread = 0.125 / std::sqrt(12.0), gv = spread * spread;
+  const Eigen::Vector2d ray(1.0, 0.0);
+  const auto normal_at = [](double c) { return Eigen::Vector2d(c, std::sqrt(1.0 - c * c)); };
+  EXPECT_NEAR(incidence_variance(own, ray, normal_at(0.0), 0.3, gv), own + 1.3020833333333333e-3, 1e-15);
+  EXPECT_NEAR(incidence_variance(own, ray, normal_at(-0.29), 0.3, gv), own + 1.3020833333333333e-3, 1e-15);
+  EXPECT_NEAR(incidence_variance(own, ray, normal_at(0.29), 0.3, gv), own + 1.3020833333333333e-3, 1e-15);
+  EXPECT_EQ(incidence_variance(own, ray, normal_at(0.31), 0.3, gv), own);
+  EXPECT_EQ(incidence_variance(own, ray, normal_at(-1.0), 0.3, gv), own);
+  EXPECT_EQ(incidence_variance(own, ray, normal_at(0.0), 0.0, gv), own);
+}
+
+// Points whose rays graze the sideline 20 cm off it (robot frame (x, -1.3) for x = 5 ... 6.6 m,
+// |n . u| = 0.19-0.25) pull the pose towards them (1.75 cm to -y with the defaults, which have no
+// grazing class); given the grazing spread of a line width / sqrt(12) they weigh less and pull it
+// less, and told a spread of 10 line widths they hardly move it.
+TEST(UkfMh, GrazingPointsWeighLessWithTheirSpread) {
+  const Field f = Field::preset("msl2012");
+  const Pose2 truth(0.5, -4.5, 0.0);
+  Rng rng(5);
+  Observations clean;
+  clean.t = 0.0;
+  clean.line_points = scenes::line_points(f, truth, 60, rng);
+  Observations with = clean;
+  for (double x = 5.0; x <= 6.61; x += 0.4) {
+    with.line_points.emplace_back(x, -1.3);
+    with.line_points.emplace_back(-x, -1.3);
+  }
+  const auto estimate = [&](const Observations& obs, double spread) {
+    UkfMhParams p;
+    p.grazing_spread = spread;
+    p.alt_tracking_restarts = 0;  // no proposals: the one hypothesis's update alone
+    UkfMhLocalizer loc(f, p, 1, "");
+    loc.reset(truth);
+    return loc.update(obs, Odometry{0.0, Pose2()}, std::nullopt).pose;
+  };
+  const double base = estimate(clean, 0.0).y;
+  const double none = estimate(with, 0.0).y - base, spread = estimate(with, 1.0 / std::sqrt(12.0)).y - base,
+               wide = estimate(with, 10.0).y - base;
+  // All three pull to -y. These far points' own variance is 0.0152 m^2, the spread adds 0.0013 m^2:
+  // their weight falls to 0.92 of it, and the pull about so (measured 0.92).
+  EXPECT_LT(none, -0.01);
+  EXPECT_GT(spread, 0.97 * none);
+  EXPECT_LT(spread, 0.8 * none);
+  EXPECT_GT(wide, 0.2 * none);
+}
+
 namespace {
 
 // Noise-free line points of a robot at `truth` in a 4 x 3 m box of lines (x = +-2, y = +-1.5) whose

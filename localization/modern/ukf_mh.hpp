@@ -30,6 +30,16 @@
 
 namespace omniloc::modern {
 
+/// A line point's noise variance along its marking's normal `normal` (unit), its scan ray's direction
+/// being `ray` (unit, the same frame): its own variance `own_var`, plus `grazing_var` where the ray
+/// meets the marking at a grazing angle (|normal . ray| below `grazing_below`). The scan lines take a
+/// point at the middle of a white run along the ray, the line's centre when the run spans the line
+/// from edge to edge; a ray crossing a line of width w at incidence c runs over w / c of white, which
+/// below about 1 / 3 is longer than any run the detector accepts (three widths and 2 px), so an
+/// accepted grazing run is a piece of the line cut by the pixels' classification, and its middle lies
+/// anywhere across the line's width: w^2 / 12 more.
+double incidence_variance(double own_var, const Eigen::Vector2d& ray, const Eigen::Vector2d& normal, double grazing_below, double grazing_var);
+
 /// What the scenario's camera declares, which a localizer may know when built, as it knows the
 /// field (harness::LocalizerContext): zeros where nothing declares it.
 struct DeclaredCamera {
@@ -46,6 +56,9 @@ struct UkfMhParams {
   double point_sigma = 0.05;     ///< m: a line point's own noise at range weight_ref (matching's point_sigma)
   double weight_d = 2.5;         ///< m: point noise grows as (weight_d^2 + r^2) (NuBot's range weights)
   double weight_ref = 1.5;       ///< m: the range at which the noise is point_sigma (NuBot)
+  double grazing_below = 0.3;    ///< |n.u| (marking normal, scan ray) below which the ray meets the marking at a grazing angle
+  double grazing_spread = 0.28867513459481287;  ///< a grazing point's added spread across its marking, in line widths (uniform: 1 / sqrt(12)); 0: none
+  double marking_sd = 0.005;     ///< m: an offset shared by a frame's points on one marking (the bound's line correlation x its white noise); 0: none
   double tilt_sd = 0.0;          ///< rad: the frame's camera tilt, each axis (JSON default: the camera's declared vibration)
   double mount_height = 0.0;     ///< m: mirror viewpoint height of the tilt's geometry (JSON default: the camera's declared one)
   double common_sd_xy = 0.03;    ///< m: where the tilt is not modelled, a frame-common error of the points' pose
@@ -111,6 +124,9 @@ class UkfMhLocalizer : public Localizer {
   double tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const;
   void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
   double point_variance(const Eigen::Vector2d& o) const;
+  /// Point i's variance (its own, `own`, plus the grazing term) against a marking of normal g (world)
+  /// at a heading of cosine c and sine s.
+  double noise_variance(std::size_t i, double own, const Eigen::Vector2d& g, double c, double s) const;
   /// The share of the points within inlier_sigmas standard deviations of their marking at q.
   double inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const;
   bool contradicted(const Eigen::Vector3d& q, std::optional<double> heading, const Observations& obs) const;
@@ -135,6 +151,8 @@ class UkfMhLocalizer : public Localizer {
   std::deque<Motion> history_;
   std::vector<Eigen::Vector2d> frame_;  // this frame's points, robot frame of now
   std::vector<Eigen::Matrix2d> tilt_;   // per point of frame_: its move per radian of tilt (empty: no tilt model)
+  std::vector<Eigen::Vector2d> ray_;    // per point of frame_: its scan ray's direction (unit, robot frame of now; empty: no grazing class)
+  double grazing_var_ = 0.0;            // m^2: a grazing point's added variance (grazing_spread of the field's line width)
 };
 
 }  // namespace omniloc::modern

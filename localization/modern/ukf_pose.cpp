@@ -48,7 +48,7 @@ SigmaPoints::Predicted SigmaPoints::predict(const std::array<double, 6>& h) cons
 }
 
 void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum,
-                      const Eigen::Vector2d* tilt) const {
+                      const Eigen::Vector2d* tilt, int group, double load) const {
   const Eigen::RowVector3d hr = regression(h);
   // H P H^T = sum_j d_j^2 (the regression explains exactly the antisymmetric part of h); what is
   // left of Pzz is the measurement's curvature over the spread: the regression error, added to r.
@@ -62,18 +62,61 @@ void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, dou
     sum.tilt_info.noalias() += *tilt * (w * tilt->transpose());
     sum.tilt_grad.noalias() += *tilt * (w * (z - pred.mean));
   }
+  if (group >= 0 && load > 0) {
+    InformationSum::Group* g = nullptr;
+    const bool direct = group < InformationSum::kDirectIds;
+    if (direct) {
+      const int k = sum.slot_of[static_cast<std::size_t>(group)];
+      if (k >= 0) g = &sum.groups[static_cast<std::size_t>(k)];
+    } else {
+      for (int k = 0; k < sum.n_groups && !g; ++k)
+        if (sum.groups[static_cast<std::size_t>(k)].id == group) g = &sum.groups[static_cast<std::size_t>(k)];
+    }
+    if (!g && sum.n_groups < InformationSum::kMaxGroups) {
+      if (direct) sum.slot_of[static_cast<std::size_t>(group)] = static_cast<std::int8_t>(sum.n_groups);
+      g = &sum.groups[static_cast<std::size_t>(sum.n_groups++)];
+      g->h.setZero();
+      g->a.setZero();
+      g->ll = g->le = 0.0;
+      g->id = group;
+    }
+    if (g) {
+      const double wl = w * load;
+      g->h.noalias() += hr.transpose() * wl;
+      if (tilt) g->a.noalias() += *tilt * wl;
+      g->ll += wl * load;
+      g->le += wl * (z - pred.mean);
+    }
+  }
   ++sum.used;
 }
 
-void InformationSum::marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const {
+void InformationSum::marginalise(const Eigen::Matrix2d& tilt_cov, double group_var, Eigen::Matrix3d& j, Eigen::Vector3d& g) const {
   j = info;
   g = grad;
-  if (tilt_cov.isZero(0.0)) return;
-  // S = (T^-1 + A^T D^-1 A)^-1 = T (Id + A^T D^-1 A T)^-1: defined for a singular T as well.
-  const Eigen::Matrix2d s = tilt_cov * (Eigen::Matrix2d::Identity() + tilt_info * tilt_cov).inverse();
-  j.noalias() -= info_tilt * s * info_tilt.transpose();
-  g.noalias() -= info_tilt * (s * tilt_grad);
-  j = 0.5 * (j + j.transpose()).eval();
+  Eigen::Matrix<double, 3, 2> ht = info_tilt;
+  Eigen::Matrix2d tt = tilt_info;
+  Eigen::Vector2d tg = tilt_grad;
+  if (group_var > 0) {
+    // Per marking, (D + rho l l^T)^-1 = D^-1 - k D^-1 l l^T D^-1 with k = rho / (1 + rho l^T D^-1 l):
+    // every sum loses its share along that marking's offset.
+    for (int i = 0; i < n_groups; ++i) {
+      const Group& q = groups[static_cast<std::size_t>(i)];
+      const double k = group_var / (1.0 + group_var * q.ll);
+      j.noalias() -= k * q.h * q.h.transpose();
+      g.noalias() -= (k * q.le) * q.h;
+      ht.noalias() -= k * q.h * q.a.transpose();
+      tt.noalias() -= k * q.a * q.a.transpose();
+      tg.noalias() -= (k * q.le) * q.a;
+    }
+  }
+  if (!tilt_cov.isZero(0.0)) {
+    // S = (T^-1 + A^T R'^-1 A)^-1 = T (Id + A^T R'^-1 A T)^-1: defined for a singular T as well.
+    const Eigen::Matrix2d s = tilt_cov * (Eigen::Matrix2d::Identity() + tt * tilt_cov).inverse();
+    j.noalias() -= ht * s * ht.transpose();
+    g.noalias() -= ht * (s * tg);
+  }
+  if (group_var > 0 || !tilt_cov.isZero(0.0)) j = 0.5 * (j + j.transpose()).eval();
 }
 
 Eigen::Matrix3d motion_covariance(const Pose2& delta, double theta, const MotionNoise& n) {
@@ -164,11 +207,11 @@ void UkfPose::predict(const Pose2& d, const Eigen::Matrix3d& q, double bias_q) {
 }
 
 Eigen::Vector3d UkfPose::step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out,
-                              const Eigen::Matrix2d& tilt_cov) const {
+                              const Eigen::Matrix2d& tilt_cov, double group_var) const {
   const Eigen::Matrix3d id = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d info;
   Eigen::Vector3d grad;
-  sum.marginalise_tilt(tilt_cov, info, grad);
+  sum.marginalise(tilt_cov, group_var, info, grad);
   // (Id + J C)^-1: a frame-common pose error caps what any number of points can tell.
   const Eigen::Matrix3d shrink = (id + info * common).inverse();
   const Eigen::Matrix3d w = shrink * info;

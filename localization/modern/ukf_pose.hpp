@@ -23,10 +23,19 @@
 //   J = H^T D^-1 H - H^T D^-1 A S A^T D^-1 H,   S = (T^-1 + A^T D^-1 A)^-1 = T (Id + A^T D^-1 A T)^-1.
 // Near points hardly move with a tilt while far ones move a lot, so the points' spread in range
 // separates the tilt from the pose (the same model as the accuracy bound's, harness/scoring/bound.cpp).
+// Points on one marking share part of their error as well (the line's image as a whole: its edges'
+// blur and classification along its length, the map's error over the ranges it spans): a further
+// nuisance, one offset per marking and frame, entering point i of that marking as l_i z with z of
+// prior variance rho (ukf_mh: l_i the offset's standard deviation in metres, the same for every
+// point, and rho 1). The markings' offsets are independent, so R' = D + L rho L^T is block diagonal by marking
+// and each block is inverted by Sherman-Morrison from four more sums per marking (H^T D^-1 l,
+// A^T D^-1 l, l^T D^-1 l, l^T D^-1 (z - h)); the tilt is then marginalised against R' as above.
+// Both are exact, and a frame still costs O(points).
 // What else is common to a frame may be given as a pose error of covariance C, combined as a pose
 // measurement of covariance J^-1 + C, written without inverting J (singular when one line is seen):
 // W = (Id + J C)^-1 J, and the gradient b becomes (Id + J C)^-1 b.
 #include <array>
+#include <cstdint>
 
 #include <Eigen/Core>
 
@@ -45,8 +54,46 @@ struct InformationSum {
   Eigen::Matrix2d tilt_info = Eigen::Matrix2d::Zero();
   Eigen::Vector2d tilt_grad = Eigen::Vector2d::Zero();
   int used = 0;  ///< measurements accumulated
-  /// The pose's information and gradient with the tilt (prior covariance `tilt_cov`) marginalised.
-  void marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const;
+  /// Back to no measurements.
+  void clear() {
+    info.setZero();
+    grad.setZero();
+    info_tilt.setZero();
+    tilt_info.setZero();
+    tilt_grad.setZero();
+    used = 0;
+    n_groups = 0;
+    slot_of = filled_slots();
+  }
+  /// One marking's sums for its shared offset (load l: the offset's effect on a point's value):
+  /// H^T D^-1 l, A^T D^-1 l, l^T D^-1 l and l^T D^-1 (z - h).
+  /// Set when a marking's first measurement comes (the first n_groups are in use; the rest are not
+  /// initialised: a frame's sums are made twice per hypothesis, most without any group).
+  struct Group {
+    Eigen::Vector3d h;
+    Eigen::Vector2d a;
+    double ll, le;
+    int id;
+  };
+  /// A frame sees about ten markings; the points of any beyond this many are taken as independent.
+  static constexpr int kMaxGroups = 32;
+  std::array<Group, kMaxGroups> groups;
+  int n_groups = 0;
+  /// The group of each id below kDirectIds (-1: none yet), so that a point finds its marking's sums
+  /// without a search; larger ids are searched for.
+  static constexpr int kDirectIds = 64;
+  std::array<std::int8_t, kDirectIds> slot_of = filled_slots();
+  static constexpr std::array<std::int8_t, kDirectIds> filled_slots() {
+    std::array<std::int8_t, kDirectIds> a{};
+    for (auto& v : a) v = -1;
+    return a;
+  }
+  /// The pose's information and gradient with the markings' offsets (standardized prior variance
+  /// `group_var`: the correlation of two points on one marking; 0: none) and the tilt (prior
+  /// covariance `tilt_cov`) marginalised.
+  void marginalise(const Eigen::Matrix2d& tilt_cov, double group_var, Eigen::Matrix3d& j, Eigen::Vector3d& g) const;
+  /// marginalise() without the markings' offsets.
+  void marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const { marginalise(tilt_cov, 0.0, j, g); }
 };
 
 /// The floor geometry of a camera tilt (core/floor_tilt.hpp), the same as the accuracy bound's.
@@ -71,8 +118,10 @@ class SigmaPoints {
   /// Adds the measurement z with noise variance r to `sum`, linearised at the centre by the
   /// regression of h (the regression error Pzz - H P H^T joins r).
   /// `tilt` (optional): d(z)/d(tilt) of the measurement, accumulated for the tilt's marginalisation.
+  /// `group` (>= 0): the marking whose shared offset the measurement carries with load `load`
+  /// (r is then only the measurement's own, independent part).
   void add(const std::array<double, 6>& h, const Predicted& pred, double z, double r, InformationSum& sum,
-           const Eigen::Vector2d* tilt = nullptr) const;
+           const Eigen::Vector2d* tilt = nullptr, int group = -1, double load = 0.0) const;
   /// H (1 x 3) of the regression for values h (central differences in the sigma coordinates).
   Eigen::RowVector3d regression(const std::array<double, 6>& h) const;
 
@@ -124,17 +173,17 @@ class UkfPose {
   /// The iterated sensor update. `linearise(centre, sigma, sum)` adds the frame's measurements
   /// linearised at `centre` (sigma points around it with the prior covariance). `tilt_cov`: the
   /// frame's tilt prior (zero: none); `common`: any further frame-common pose error's covariance
-  /// (zero: none). Returns the last sum.
+  /// (zero: none); `group_var`: the markings' shared offsets' standardized variance (0: none).
   template <class Linearise>
-  InformationSum update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common,
-                        const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero());
+  void update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common,
+                        const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero(), double group_var = 0.0);
   const Eigen::Vector3d& mean() const { return x_; }
   Pose2 pose() const { return Pose2(x_.x(), x_.y(), x_.z()); }
   const Eigen::Matrix3d& covariance() const { return p_; }
   /// One Gauss-Newton step from `at` with the prior (x_, p_) and the measurements' `sum` taken at
   /// `at`; sets `cov_out` to the posterior covariance. Public for tests.
   Eigen::Vector3d step(const Eigen::Vector3d& at, const InformationSum& sum, const Eigen::Matrix3d& common, Eigen::Matrix3d* cov_out,
-                       const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero()) const;
+                       const Eigen::Matrix2d& tilt_cov = Eigen::Matrix2d::Zero(), double group_var = 0.0) const;
 
  private:
   /// After the pose moved from (x0, p0) to (x_, p_) on evidence that does not see the bias.
@@ -147,28 +196,29 @@ class UkfPose {
 };
 
 template <class Linearise>
-InformationSum UkfPose::update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common, const Eigen::Matrix2d& tilt_cov) {
+void UkfPose::update(Linearise&& linearise, int iterations, const Eigen::Matrix3d& common, const Eigen::Matrix2d& tilt_cov,
+                               double group_var) {
   Eigen::Vector3d at = x_;
   Eigen::Matrix3d post = p_;
-  InformationSum sum;
-  int done = 0;
+  // Two sums used in turn: the last one that had measurements is kept without copying its groups.
+  InformationSum sums[2];
+  int last = -1;
   for (int it = 0; it < iterations; ++it) {
     const SigmaPoints sp(at, p_);
-    InformationSum next;
+    InformationSum& next = sums[last == 0 ? 1 : 0];
+    next.clear();
     linearise(at, sp, next);
     if (next.used == 0) break;  // nothing associated from here: keep the last step's result
-    sum = next;
-    at = step(at, sum, common, &post, tilt_cov);
-    ++done;
+    last = last == 0 ? 1 : 0;
+    at = step(at, next, common, &post, tilt_cov, group_var);
   }
-  if (done == 0) return sum;
+  if (last < 0) return;
   const Eigen::Vector3d x0 = x_;
   const Eigen::Matrix3d p0 = p_;
   x_ = at;
   x_.z() = wrap_angle(x_.z());
   p_ = 0.5 * (post + post.transpose());
   if (has_bias_) condition_bias(x0, p0);
-  return sum;
 }
 
 }  // namespace omniloc::modern
