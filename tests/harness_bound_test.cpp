@@ -11,6 +11,7 @@
 
 #include "core/angles.hpp"
 #include "harness/scoring/metrics.hpp"
+#include "core/floor_tilt.hpp"
 #include "harness/scoring/bound.hpp"
 
 using namespace omniloc;
@@ -134,7 +135,7 @@ TEST(Bound, CompassAddsItsInformation) {
 TEST(Bound, TiltJacobianMatchesTheRayGeometry) {
   const double h = 0.75, eps = 1e-7;
   for (const Eigen::Vector2d& p : {Eigen::Vector2d(5, 0), Eigen::Vector2d(-1.2, 3.3), Eigen::Vector2d(0.4, -0.9)}) {
-    const Eigen::Matrix2d M = tilt_jacobian(p, h);
+    const Eigen::Matrix2d M = floor_tilt_jacobian(p, h);
     for (int axis = 0; axis < 2; ++axis) {
       Eigen::Vector3d w = Eigen::Vector3d::Zero();
       w(axis) = eps;
@@ -144,8 +145,8 @@ TEST(Bound, TiltJacobianMatchesTheRayGeometry) {
       EXPECT_NEAR((hit - p).y() / eps, M(1, axis), 1e-5 * (1 + M.norm()));
     }
   }
-  EXPECT_NEAR(tilt_jacobian({5, 0}, h).col(1).norm(), (25 + h * h) / h, 1e-12);
-  EXPECT_NEAR(tilt_jacobian({5, 0}, h).col(0).norm(), h, 1e-12);
+  EXPECT_NEAR(floor_tilt_jacobian({5, 0}, h).col(1).norm(), (25 + h * h) / h, 1e-12);
+  EXPECT_NEAR(floor_tilt_jacobian({5, 0}, h).col(0).norm(), h, 1e-12);
 }
 
 // The Woodbury form equals H^T R^-1 H with R = D + A C A^T built densely, tilt and marking offsets.
@@ -242,7 +243,7 @@ TEST(Bound, MonteCarloEfficientEstimatorReachesTheBound) {
       // The errors as the model makes them: the tilt moves the point on the floor, the marking's
       // offset and the white noise move it along the marking's normal (robot frame).
       const Eigen::Vector2d nr = truth.rotation().transpose() * match[i].normal;
-      noisy[i] = robot[i] + tilt_jacobian(robot[i], h) * tilt + nr * (s * offset[static_cast<std::size_t>(match[i].marking)] + std::sqrt(1 - rho) * s * N01(rng));
+      noisy[i] = robot[i] + floor_tilt_jacobian(robot[i], h) * tilt + nr * (s * offset[static_cast<std::size_t>(match[i].marking)] + std::sqrt(1 - rho) * s * N01(rng));
     }
     for (int which = 0; which < 2; ++which) {
       Eigen::Vector3d x(truth.x, truth.y, truth.theta);

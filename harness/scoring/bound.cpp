@@ -164,8 +164,6 @@ MarkingMatch match_marking(const Field& field, const Eigen::Vector2d& w) {
   return m;
 }
 
-Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h) { return floor_tilt_jacobian(p, h); }
-
 Eigen::Matrix3d frame_information(const std::vector<BoundRow>& rows, const Eigen::Matrix2d& tilt_cov, double line_corr, Eigen::Vector3d* score) {
   // J = H^T R^-1 H with R = D + A C A^T; Woodbury: R^-1 = D^-1 - D^-1 A (C^-1 + A^T D^-1 A)^-1 A^T D^-1.
   // The nuisances: the tilt (2) and, with line_corr > 0, one offset per marking.
@@ -261,7 +259,7 @@ BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Po
   const Eigen::Vector2d d = world - pose.translation();
   row.h = Eigen::Vector3d(m.normal.x(), m.normal.y(), d.x() * m.normal.y() - d.y() * m.normal.x());
   row.var = var;
-  row.a = tilt_jacobian(robot, h).transpose() * (pose.rotation().transpose() * m.normal);
+  row.a = floor_tilt_jacobian(robot, h).transpose() * (pose.rotation().transpose() * m.normal);
   row.e = m.residual;
   return row;
 }
@@ -583,7 +581,7 @@ std::vector<FrameWork> match_points(const std::vector<FrameRecord>& frames, cons
       q.h = Eigen::Vector3d(m.normal.x(), m.normal.y(), lever.x() * m.normal.y() - lever.y() * m.normal.x());
       q.offset = static_cast<float>(m.normal.dot(w));
       q.marking = static_cast<std::int16_t>(m.marking);
-      q.a = tilt_jacobian(p, h).transpose() * (rot.transpose() * m.normal);
+      q.a = floor_tilt_jacobian(p, h).transpose() * (rot.transpose() * m.normal);
       raw[static_cast<std::size_t>(q.band)].push_back(q.residual);
       fw.pts.push_back(q);
     }

@@ -80,10 +80,6 @@ CovarianceBound invert_information(const Eigen::Matrix3d& info);
 /// also when P or J_z is singular (a known start pose, a frame without points).
 Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& F, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Jz);
 
-/// d(floor point)/d(mirror tilt) for a robot-frame floor point `p` seen from a mirror at height `h`
-/// (roll about x, pitch about y, radians): the 2 x 2 map of a small tilt onto the point's position.
-Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& p, double h);
-
 /// A point mapped to the world and matched to its nearest marking: the signed distance along the
 /// marking's normal and that normal (world frame). `kind`: 0 none, 1 segment/arc, 2 spot.
 struct MarkingMatch {

@@ -96,9 +96,6 @@ struct InformationSum {
   void marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const { marginalise(tilt_cov, 0.0, j, g); }
 };
 
-/// The floor geometry of a camera tilt (core/floor_tilt.hpp), the same as the accuracy bound's.
-using omniloc::floor_tilt_jacobian;
-
 /// The 2 n + 1 = 7 sigma points of a 3-D Gaussian and their regression helpers. Julier and
 /// Uhlmann's choice n + kappa = 3 (kappa = 0) matches the fourth moment of a Gaussian; the centre
 /// point then has weight 0 and the six others 1 / 6 each, at mean +- sqrt(3) L_j (L the Cholesky
