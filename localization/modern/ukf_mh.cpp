@@ -245,7 +245,8 @@ double UkfMhLocalizer::noise_variance(std::size_t i, double own, const Eigen::Ve
   return incidence_variance(own, ray_[i], Eigen::Vector2d(c * g.x() + s * g.y(), -s * g.x() + c * g.y()), p_.grazing_below, grazing_var_);
 }
 
-double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const {
+double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q) const {
+  const std::vector<Eigen::Vector2d>& pts = frame_;
   if (pts.empty()) return 0.0;
   const double common_var = p_.common_xy_var();
   const double c = std::cos(q.z()), s = std::sin(q.z());
@@ -256,8 +257,8 @@ double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q, const std::vector<
     const LocalMarking m = assoc_.associate(w);
     if (m.marking < 0) continue;
     const Eigen::Vector2d g = m.gradient(w);
-    const double tilt_var = tilt_.size() == pts.size() ? tilt_variance(i, g, c, s, nullptr) : 0.0;
-    const double own = ray_.size() == pts.size() ? noise_variance(i, point_variance(o), g, c, s) : point_variance(o);
+    const double tilt_var = tilt_variance(i, g, c, s, nullptr);
+    const double own = noise_variance(i, point_variance(o), g, c, s);
     if (m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (own + common_var + tilt_var)) ++fit;
   }
   return static_cast<double>(fit) / static_cast<double>(pts.size());
@@ -308,7 +309,7 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   common(2, 2) = p_.tilt_modelled() ? 0.0 : p_.common_sd_theta * p_.common_sd_theta;
   const Eigen::Matrix2d tilt_cov = tilt_.empty() ? Eigen::Matrix2d::Zero() : Eigen::Matrix2d(p_.tilt_sd * p_.tilt_sd * Eigen::Matrix2d::Identity());
   h.ukf.update(linearise, p_.iterations, common, tilt_cov, shared_var > 0 ? 1.0 : 0.0);
-  h.inliers = inlier_share(h.ukf.mean(), pts);
+  h.inliers = inlier_share(h.ukf.mean());
   const Eigen::Vector3d& q = h.ukf.mean();
   const double evidence = contradicted(q, heading, obs) ? 0.0 : h.inliers;
   const double alpha = 1.0 - std::exp(-std::max(dt, 0.0) / p_.validity_time);
@@ -352,7 +353,7 @@ void UkfMhLocalizer::search(const std::vector<Eigen::Vector2d>& pts, std::option
     if (p_.compass_sigma > 0) h.ukf.start_bias(p_.compass_bias_sd * p_.compass_bias_sd);
     // Half credit for the frame it was fitted to: one frame alone does not make a pose valid, and a
     // pose that explains fewer points than valid_min / 0.5 of them starts below what it can reach.
-    h.validity = 0.5 * inlier_share(cand.pose, pts);
+    h.validity = 0.5 * inlier_share(cand.pose);
     h.inliers = 2.0 * h.validity;
     h.id = next_id_++;
     // Replacement: when full, the least valid hypothesis that is not the current estimate goes.

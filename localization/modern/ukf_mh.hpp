@@ -127,8 +127,9 @@ class UkfMhLocalizer : public Localizer {
   /// Point i's variance (its own, `own`, plus the grazing term) against a marking of normal g (world)
   /// at a heading of cosine c and sine s.
   double noise_variance(std::size_t i, double own, const Eigen::Vector2d& g, double c, double s) const;
-  /// The share of the points within inlier_sigmas standard deviations of their marking at q.
-  double inlier_share(const Eigen::Vector3d& q, const std::vector<Eigen::Vector2d>& pts) const;
+  /// The share of this frame's points (frame_, whose tilt_ and ray_ rows go with them) within
+  /// inlier_sigmas standard deviations of their marking at q.
+  double inlier_share(const Eigen::Vector3d& q) const;
   bool contradicted(const Eigen::Vector3d& q, std::optional<double> heading, const Observations& obs) const;
   void search(const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, bool twins_equal, bool searching);
 

@@ -63,24 +63,7 @@ void SigmaPoints::add(const std::array<double, 6>& h, const Predicted& pred, dou
     sum.tilt_grad.noalias() += *tilt * (w * (z - pred.mean));
   }
   if (group >= 0 && load > 0) {
-    InformationSum::Group* g = nullptr;
-    const bool direct = group < InformationSum::kDirectIds;
-    if (direct) {
-      const int k = sum.slot_of[static_cast<std::size_t>(group)];
-      if (k >= 0) g = &sum.groups[static_cast<std::size_t>(k)];
-    } else {
-      for (int k = 0; k < sum.n_groups && !g; ++k)
-        if (sum.groups[static_cast<std::size_t>(k)].id == group) g = &sum.groups[static_cast<std::size_t>(k)];
-    }
-    if (!g && sum.n_groups < InformationSum::kMaxGroups) {
-      if (direct) sum.slot_of[static_cast<std::size_t>(group)] = static_cast<std::int8_t>(sum.n_groups);
-      g = &sum.groups[static_cast<std::size_t>(sum.n_groups++)];
-      g->h.setZero();
-      g->a.setZero();
-      g->ll = g->le = 0.0;
-      g->id = group;
-    }
-    if (g) {
+    if (InformationSum::Group* g = sum.group(group)) {
       const double wl = w * load;
       g->h.noalias() += hr.transpose() * wl;
       if (tilt) g->a.noalias() += *tilt * wl;

@@ -88,6 +88,9 @@ struct InformationSum {
     for (auto& v : a) v = -1;
     return a;
   }
+  /// The sums of marking `id` (>= 0), started at zero on its first measurement; null when
+  /// kMaxGroups markings already have theirs.
+  Group* group(int id);
   /// The pose's information and gradient with the markings' offsets (standardized prior variance
   /// `group_var`: the correlation of two points on one marking; 0: none) and the tilt (prior
   /// covariance `tilt_cov`) marginalised.
@@ -95,6 +98,26 @@ struct InformationSum {
   /// marginalise() without the markings' offsets.
   void marginalise_tilt(const Eigen::Matrix2d& tilt_cov, Eigen::Matrix3d& j, Eigen::Vector3d& g) const { marginalise(tilt_cov, 0.0, j, g); }
 };
+
+// Inline: it is called once per associated point, the update's innermost loop.
+inline InformationSum::Group* InformationSum::group(int id) {
+  const bool direct = id < kDirectIds;
+  if (direct) {
+    const int k = slot_of[static_cast<std::size_t>(id)];
+    if (k >= 0) return &groups[static_cast<std::size_t>(k)];
+  } else {
+    for (int k = 0; k < n_groups; ++k)
+      if (groups[static_cast<std::size_t>(k)].id == id) return &groups[static_cast<std::size_t>(k)];
+  }
+  if (n_groups >= kMaxGroups) return nullptr;
+  if (direct) slot_of[static_cast<std::size_t>(id)] = static_cast<std::int8_t>(n_groups);
+  Group& g = groups[static_cast<std::size_t>(n_groups++)];
+  g.h.setZero();
+  g.a.setZero();
+  g.ll = g.le = 0.0;
+  g.id = id;
+  return &g;
+}
 
 /// The 2 n + 1 = 7 sigma points of a 3-D Gaussian and their regression helpers. Julier and
 /// Uhlmann's choice n + kappa = 3 (kappa = 0) matches the fourth moment of a Gaussian; the centre
