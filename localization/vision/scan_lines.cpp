@@ -37,7 +37,7 @@ LineDetector::LineDetector(const ScanLineParams& p, const CalibrationMap& map, c
   for (int k = 0; k < p.rays; ++k) {
     const double b = kTwoPi * k / p.rays;
     const Eigen::Vector2d dir(-std::sin(b), -std::cos(b));
-    std::vector<Sample> ray;
+    Ray ray{Eigen::Vector2d(std::cos(b), std::sin(b)), {}};
     int last_u = -1, last_v = -1;
     for (double r = map.min_radius() + 1.0; r <= map.max_radius(); r += kStep) {
       const auto d = map.ground_distance(r, b);
@@ -51,7 +51,11 @@ LineDetector::LineDetector(const ScanLineParams& p, const CalibrationMap& map, c
       last_v = v;
       const auto d1 = map.ground_distance(r + 0.5, b), d0 = map.ground_distance(r - 0.5, b);
       const double m_per_px = (d1 && d0) ? std::max(1e-4, *d1 - *d0) : 0.01;
-      ray.push_back({u, v, r, p.line_width / m_per_px});
+      // Each sample's r is the first kStep inside its pixel: the ray entered the pixel kStep / 2
+      // before it on average.
+      const auto entry = map.ground_distance(r - 0.5 * kStep, b);
+      if (!entry) continue;
+      ray.samples.push_back({u, v, r, p.line_width / m_per_px, *entry});
     }
     rays_.push_back(std::move(ray));
   }
@@ -61,7 +65,7 @@ ScanResult LineDetector::detect(const Image& img) const {
   ScanResult res;
   double grey_sum = 0;
   std::size_t grey_n = 0;
-  for (const auto& ray : rays_) {
+  for (const auto& [ray_dir, ray] : rays_) {
     int green_end = -1000;  // index of the last green sample
     int white_start = -1;
     for (int i = 0; i < static_cast<int>(ray.size()); ++i) {
@@ -81,22 +85,20 @@ ScanResult LineDetector::detect(const Image& img) const {
           while (white_end > white_start && table_.classify(img.row(ray[white_end].v) + 3 * ray[white_end].u) != kLineWhite) --white_end;
           if (i - white_end - 1 <= p_.max_gap) {
             // The run spans from where the ray enters its first white pixel to where it enters the
-            // next one (ray[white_end + 1] exists: the green sample i lies beyond). Each sample's r is
-            // the first 0.5 px step inside its pixel, on average kStep / 2 past the pixel's edge, so the
-            // run's centre is the mean of the two entries less that. (Taking the last white pixel's
-            // entry as the far end put every line point half a pixel, about 1.2 cm at 3 m, short of
-            // the line's centre until commit 6184583: tests/vision_test.cpp.)
-            const double r_in = ray[white_start].r, r_out = ray[white_end + 1].r;
-            const double len = r_out - r_in;
+            // next one (ray[white_end + 1] exists: the green sample i lies beyond). (Taking the last
+            // white pixel's entry as the far end put every line point half a pixel, about 1.2 cm at
+            // 3 m, short of the line's centre until commit 6184583: tests/vision_test.cpp.)
+            const Sample &first = ray[white_start], &beyond = ray[white_end + 1];
+            const double len = beyond.r - first.r;
             const Sample& mid = ray[(white_start + white_end) / 2];
             if (len <= p_.width_factor * mid.expected_px + p_.width_slack_px && len >= p_.min_width_factor * mid.expected_px - p_.width_slack_px) {
-              const double rmid = 0.5 * (r_in + r_out) - 0.5 * kStep;
-              const Eigen::Vector2d dir = (Eigen::Vector2d(mid.u + 0.5, mid.v + 0.5) - map_.centre()).normalized();
-              const Eigen::Vector2d pix = map_.centre() + rmid * dir;
-              if (auto p = map_.to_robot(pix.x(), pix.y())) {
-                res.points.push_back(*p);
-                res.pixels.push_back(pix);
-              }
+              // The line's centre is the middle of its two edges on the floor, taken along the ray's
+              // own bearing. The middle in image radius is not: within 1 m the mirror's law is
+              // curved, and it put the point up to 1.3 cm short of the line at 0.45 m
+              // (docs/modern_localizer.md "The bias's cause"); and the calibration table's value at
+              // the pixel holding that middle moved it by up to half a pixel across and along the ray.
+              res.points.push_back(0.5 * (first.entry_m + beyond.entry_m) * ray_dir);
+              res.pixels.push_back(map_.centre() + (0.5 * (first.r + beyond.r) - 0.5 * kStep) * Eigen::Vector2d(-ray_dir.y(), -ray_dir.x()));
             }
           }
           white_start = -1;

@@ -55,11 +55,16 @@ class LineDetector {
     int u, v;
     double r;
     double expected_px;  // width of a painted line at this radius
+    double entry_m;      // floor distance (metres) where the ray enters this pixel, on average
+  };
+  struct Ray {
+    Eigen::Vector2d dir;  ///< robot frame unit vector of the ray's bearing (the map's bearing convention)
+    std::vector<Sample> samples;
   };
   ScanLineParams p_;
   const CalibrationMap& map_;
   const ColourTable& table_;
-  std::vector<std::vector<Sample>> rays_;
+  std::vector<Ray> rays_;
 };
 
 }  // namespace omniloc
