@@ -36,12 +36,40 @@ constexpr double kDistanceRange = 2.0;   // metres; farther is stored as 2 m
 // quad, which is what llvmpipe's fwidth is (OSMesa's bytes are the same either way), whereas NVIDIA's
 // plain fwidth is finer and gave 0.4-0.5 % fewer line points per frame than OSMesa, 4 seed-to-seed
 // standard deviations; with fwidthCoarse the H200's runs match OSMesa's (docs/performance.md "GPUs").
+//
+// The floor point of each pixel is found per pixel, not interpolated from the mesh's vertices: the
+// floor position is not affine in the image (it holds D(r) p / |p|, D the floor distance at image
+// radius r, whose chord over a mesh cell strays from the curve), and the vertices' floor points
+// interpolated across the mesh's long cells drew lines up to 1 cm nearer the robot at 1-2 m than
+// the mirror puts them (tests/camera_test.cpp FloorLinesLieWhereTheMirrorPutsThem). gl_TexCoord[0]
+// is the fragment's render-space position (exact under affine interpolation); the elevation comes
+// from a table of the mirror's law every 1/16 px (linear interpolation: well under a millimetre).
 const char* const kFloorCommon = R"(#version 130
 #extension GL_ARB_derivative_control : enable
 uniform sampler2D distance_map;
+uniform sampler2D elevation_map;
 uniform float range, half_width;
 uniform vec3 line, carpet, outside;
+uniform float elev_lo, elev_step, elev_n, body_px, rim_px, inv_ss, eye_height;
+uniform vec2 centre_rs, floor_half;
+uniform vec3 cam_r0, cam_r1, cam_r2;
+uniform vec4 robot;
 float distance_to_line(vec2 uv) { return texture(distance_map, uv).r * range; }
+// Render-space position to the distance field's texture coordinates of the floor point seen there
+// (outside [0, 1] where the ray misses the floor).
+vec2 floor_uv_at(vec2 rs) {
+  vec2 p = (rs - centre_rs) * inv_ss;
+  float len = max(length(p), 1e-4);
+  float r = clamp(len, body_px, rim_px);
+  float e = texture(elevation_map, vec2(((r - elev_lo) / elev_step + 0.5) / elev_n, 0.5)).r;
+  vec2 sc = -p / len;  // (sin b, cos b): the image's x = cx - r sin b, y = cy - r cos b
+  vec3 dc = vec3(cos(e) * sc.y, cos(e) * sc.x, sin(e));
+  vec3 d = vec3(dot(cam_r0, dc), dot(cam_r1, dc), dot(cam_r2, dc));
+  if (d.z > -1e-6) return vec2(-1.0);
+  vec2 q = (eye_height / -d.z) * d.xy;
+  vec2 w = robot.xy + vec2(robot.z * q.x - robot.w * q.y, robot.w * q.x + robot.z * q.y);
+  return (w + floor_half) / (2.0 * floor_half);
+}
 // Share of a box as wide as the pixel's extent across the line that the line covers.
 float line_cover(float d) {
 #ifdef GL_ARB_derivative_control
@@ -55,7 +83,7 @@ bool on_floor(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(less
 )";
 const char* const kFloorShader = R"(
 void main() {
-  vec2 uv = gl_TexCoord[0].st;
+  vec2 uv = floor_uv_at(gl_TexCoord[0].st);
   float cover = line_cover(distance_to_line(uv));
   gl_FragColor = vec4((on_floor(uv) ? mix(carpet, line, cover) : outside) * gl_Color.rgb, 1.0);
 }
@@ -64,13 +92,13 @@ void main() {
 // test of the texture coordinates cost 4 % of the frame.
 const char* const kFloorShaderInside = R"(
 void main() {
-  gl_FragColor = vec4(mix(carpet, line, line_cover(distance_to_line(gl_TexCoord[0].st))) * gl_Color.rgb, 1.0);
+  gl_FragColor = vec4(mix(carpet, line, line_cover(distance_to_line(floor_uv_at(gl_TexCoord[0].st)))) * gl_Color.rgb, 1.0);
 }
 )";
 // The same field as flat class ids (a pixel is line where its centre is).
 const char* const kFloorLabelShader = R"(
 void main() {
-  vec2 uv = gl_TexCoord[0].st;
+  vec2 uv = floor_uv_at(gl_TexCoord[0].st);
   gl_FragColor = vec4(on_floor(uv) ? (distance_to_line(uv) <= half_width ? line : carpet) : outside, 1.0);
 }
 )";
@@ -82,11 +110,13 @@ FloorMesh::FloorMesh(GlContext& ctx, const Field& field, const CameraConfig& cfg
   upload_distance_field(field);
   compile_programs(0.5 * field.line_width);
   build_mesh(cfg, mirror, ss);
+  upload_mirror(cfg, mirror, ss);
 }
 
 FloorMesh::~FloorMesh() {
   ctx_.make_current();
   ctx_.gl().DeleteTextures(1, &tex_distance_);
+  ctx_.gl().DeleteTextures(1, &tex_elevation_);
   ctx_.gl().DeleteProgram(prog_floor_);
   ctx_.gl().DeleteProgram(prog_floor_inside_);
   ctx_.gl().DeleteProgram(prog_floor_labels_);
@@ -112,6 +142,51 @@ void FloorMesh::upload_distance_field(const Field& field) {
   gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
   gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R16, tw, th, 0, GL_RED, GL_UNSIGNED_SHORT, dist.data());
   if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + ctx_.backend() + "\": floor distance texture upload failed");
+}
+
+void FloorMesh::upload_mirror(const CameraConfig& cfg, const MirrorProfile& mirror, int ss) {
+  const GlApi& gl = ctx_.gl();
+  constexpr double kStepPx = 1.0 / 16;
+  const double lo = mirror.body_radius(), hi = mirror.rim();
+  const int n = static_cast<int>(std::ceil((hi - lo) / kStepPx)) + 1;
+  std::vector<float> elev(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) elev[static_cast<std::size_t>(i)] = static_cast<float>(mirror.elevation(std::min(hi, lo + i * kStepPx)));
+  gl.GenTextures(1, &tex_elevation_);
+  gl.ActiveTexture(GL_TEXTURE1);
+  gl.BindTexture(GL_TEXTURE_2D, tex_elevation_);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, n, 1, 0, GL_RED, GL_FLOAT, elev.data());
+  gl.ActiveTexture(GL_TEXTURE0);
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + ctx_.backend() + "\": mirror elevation texture upload failed");
+  (void)cfg;
+  for (unsigned prog : {prog_floor_, prog_floor_inside_, prog_floor_labels_}) {
+    gl.UseProgram(prog);
+    gl.Uniform1i(gl.GetUniformLocation(prog, "elevation_map"), 1);
+    gl.Uniform1f(gl.GetUniformLocation(prog, "elev_lo"), static_cast<float>(lo));
+    gl.Uniform1f(gl.GetUniformLocation(prog, "elev_step"), static_cast<float>(kStepPx));
+    gl.Uniform1f(gl.GetUniformLocation(prog, "elev_n"), static_cast<float>(n));
+    gl.Uniform1f(gl.GetUniformLocation(prog, "body_px"), static_cast<float>(lo));
+    gl.Uniform1f(gl.GetUniformLocation(prog, "rim_px"), static_cast<float>(hi));
+    gl.Uniform1f(gl.GetUniformLocation(prog, "inv_ss"), static_cast<float>(1.0 / ss));
+    gl.Uniform2f(gl.GetUniformLocation(prog, "floor_half"), static_cast<float>(hx_), static_cast<float>(hy_));
+    gl.UseProgram(0);
+  }
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + ctx_.backend() + "\": floor shader set-up failed");
+}
+
+void FloorMesh::set_frame_uniforms(const GlApi& gl, unsigned prog, const FrameProjection& f) const {
+  gl.UseProgram(prog);
+  gl.Uniform2f(gl.GetUniformLocation(prog, "centre_rs"), static_cast<float>(f.centre.x() * f.ss), static_cast<float>(f.centre.y() * f.ss));
+  gl.Uniform1f(gl.GetUniformLocation(prog, "eye_height"), static_cast<float>(f.h));
+  gl.Uniform4f(gl.GetUniformLocation(prog, "robot"), static_cast<float>(f.pose.x), static_cast<float>(f.pose.y), static_cast<float>(f.c),
+               static_cast<float>(f.s));
+  const char* rows[3] = {"cam_r0", "cam_r1", "cam_r2"};
+  for (int i = 0; i < 3; ++i)
+    gl.Uniform3f(gl.GetUniformLocation(prog, rows[i]), static_cast<float>(f.R(i, 0)), static_cast<float>(f.R(i, 1)), static_cast<float>(f.R(i, 2)));
 }
 
 void FloorMesh::compile_programs(double half_w) {
@@ -243,7 +318,8 @@ void FloorMesh::place_vertices(const FrameProjection& f, const WorldState& world
     pos_[3 * i] = mesh_xy_[2 * i];
     pos_[3 * i + 1] = mesh_xy_[2 * i + 1];
     pos_[3 * i + 2] = -999.0f;
-    floor_uv(w, &tex_[2 * i]);
+    tex_[2 * i] = mesh_xy_[2 * i];  // the shaders find the floor point of each pixel from its position
+    tex_[2 * i + 1] = mesh_xy_[2 * i + 1];
     // The lamps' light only: sun beams are drawn over this, with sharp edges.
     const float illum = labels ? 1.0f : static_cast<float>(std::min(1.0, world.lighting.artificial_at(w) / kRadianceScale));
     col_[4 * i] = col_[4 * i + 1] = col_[4 * i + 2] = illum;
@@ -269,7 +345,11 @@ void FloorMesh::draw(const GlApi& gl, const FrameProjection& f, const WorldState
   gl.DepthMask(GL_FALSE);
   gl.DepthFunc(GL_LESS);
   gl.BindTexture(GL_TEXTURE_2D, tex_distance_);
-  gl.UseProgram(labels ? prog_floor_labels_ : prog_floor_);
+  gl.ActiveTexture(GL_TEXTURE1);
+  gl.BindTexture(GL_TEXTURE_2D, tex_elevation_);
+  gl.ActiveTexture(GL_TEXTURE0);
+  if (!idx_inside_.empty()) set_frame_uniforms(gl, prog_floor_inside_, f);
+  set_frame_uniforms(gl, labels ? prog_floor_labels_ : prog_floor_, f);
   gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
   gl.VertexPointer(3, GL_FLOAT, 0, pos_.data());
   gl.ColorPointer(4, GL_FLOAT, 0, col_.data());
@@ -286,7 +366,7 @@ void FloorMesh::draw(const GlApi& gl, const FrameProjection& f, const WorldState
 // In cells of at most 0.1 m projected through the mirror, so a beam's edges are as sharp as the
 // pixels (a per-vertex light on the image-fixed floor mesh would smear them over a mesh cell).
 void FloorMesh::draw_sun_beams(const GlApi& gl, const FrameProjection& f, const WorldState& world) {
-  gl.UseProgram(prog_floor_);
+  set_frame_uniforms(gl, prog_floor_, f);
   gl.EnableClientState(GL_TEXTURE_COORD_ARRAY);
   for (const auto& sp : world.lighting.sun) {
     if (sp.surface != SunPatch::Surface::kFloor) continue;
@@ -302,9 +382,7 @@ void FloorMesh::draw_sun_beams(const GlApi& gl, const FrameProjection& f, const 
       float xyz[3];
       f(Eigen::Vector3d(w.x(), w.y(), 0.0), xyz);
       pos_.insert(pos_.end(), {xyz[0], xyz[1], -999.0f});
-      float uv[2];
-      floor_uv(w, uv);
-      tex_.insert(tex_.end(), uv, uv + 2);
+      tex_.insert(tex_.end(), {xyz[0], xyz[1]});
       const float il = static_cast<float>(std::min(1.0, world.lighting.at(w) / kRadianceScale));
       col_.insert(col_.end(), {il, il, il, 1.0f});
     };

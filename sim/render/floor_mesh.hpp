@@ -1,9 +1,11 @@
 #pragma once
 // The floor as the camera draws it: an image-fixed polar mesh (rings placed where the floor distance
 // stops being linear in the image radius, as few sectors per ring as the floor's curvature allows)
-// whose texture coordinates are, each frame, the floor points its rays hit; a distance field of the
-// field's markings that fragment shaders turn into anti-aliased lines; cells hidden behind the hall's
-// walls left out. Also the sun beams on the carpet, drawn again over the mesh with the same shader.
+// that carries, each frame, the lamps' light at the floor points its rays hit and which walls hide
+// them; fragment shaders find each pixel's own floor point through the mirror (its elevation from a
+// table of the mirror's law, the frame's tilt and pose) and turn a distance field of the field's
+// markings into anti-aliased lines there; cells hidden behind the hall's walls left out. Also the
+// sun beams on the carpet, drawn again over the mesh with the same shader.
 // Kept apart from the standing scene because it is projected the other way round: from image to
 // floor, not from world to image.
 //
@@ -44,17 +46,17 @@ class FloorMesh {
   void upload_distance_field(const Field& field);
   void compile_programs(double line_half_width);
   void build_mesh(const CameraConfig& cfg, const MirrorProfile& mirror, int ss);
+  /// The mirror's elevation per image radius as a texture, and the shaders' constant uniforms.
+  void upload_mirror(const CameraConfig& cfg, const MirrorProfile& mirror, int ss);
+  /// The frame's pose, tilt and mount height for `prog`'s per-pixel floor point.
+  void set_frame_uniforms(const GlApi& gl, unsigned prog, const FrameProjection& f) const;
   /// Per mesh vertex: this frame's floor point and which walls hide it (hidden_).
   void place_vertices(const FrameProjection& f, const WorldState& world, bool labels);
-  void floor_uv(const Eigen::Vector2d& w, float* uv) const {
-    uv[0] = static_cast<float>((w.x() + hx_) / (2 * hx_));
-    uv[1] = static_cast<float>((w.y() + hy_) / (2 * hy_));
-  }
-
   GlContext& ctx_;
   double hx_ = 0, hy_ = 0;   // floor half extents covered by the distance field, metres
   double wall_height_ = 0;   // metres
   unsigned tex_distance_ = 0;
+  unsigned tex_elevation_ = 0;  // texture unit 1: elevation (rad) per image radius
   unsigned prog_floor_ = 0, prog_floor_inside_ = 0, prog_floor_labels_ = 0;
   std::vector<float> mesh_xy_;              // render-space positions
   std::vector<Eigen::Vector3d> mesh_dir_;   // camera-frame unit ray of each vertex

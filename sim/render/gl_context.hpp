@@ -34,6 +34,7 @@ struct GlApi {
   X(void, GenTextures, (GLsizei, GLuint*))                                                        \
   X(void, DeleteTextures, (GLsizei, const GLuint*))                                               \
   X(void, BindTexture, (GLenum, GLuint))                                                          \
+  X(void, ActiveTexture, (GLenum))                                                                \
   X(void, TexImage2D, (GLenum, GLint, GLint, GLsizei, GLsizei, GLint, GLenum, GLenum, const void*)) \
   X(void, TexParameteri, (GLenum, GLenum, GLint))                                                 \
   X(void, TexParameterf, (GLenum, GLenum, GLfloat))                                               \
@@ -76,7 +77,9 @@ struct GlApi {
   X(GLint, GetUniformLocation, (GLuint, const GLchar*))                                           \
   X(void, Uniform1i, (GLint, GLint))                                                              \
   X(void, Uniform1f, (GLint, GLfloat))                                                            \
-  X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))
+  X(void, Uniform2f, (GLint, GLfloat, GLfloat))                                                   \
+  X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))                                          \
+  X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))
 #define OMNILOC_GL_MEMBER(ret, name, args) ret(*name) args = nullptr;
   OMNILOC_GL_FUNCS(OMNILOC_GL_MEMBER)
 #undef OMNILOC_GL_MEMBER
