@@ -296,7 +296,8 @@ TEST_F(VisionTest, LinePointRadialErrorSplitsIntoDetectorAndMap) {
 // table's value at the pixel holding the middle, up to half a pixel off across and along the ray).
 // Through the simulator's exact mirror, so that only the detector is measured. Before (middle in
 // image radius, pixel's table value): -1.36 cm within 0.9 m, mean |offset| 1.70 cm at 0.9-6 m;
-// now -0.37 cm and 1.26 cm.
+// -0.37 cm and 1.26 cm with the middle on the floor (53b1f48); -0.17 cm and 0.99 cm since the
+// renderer draws each pixel's own floor point (a4652a0: CameraTest.FloorLinesLieWhereTheMirrorPutsThem).
 TEST_F(VisionTest, NearLinePointsAreCentredOnTheFloor) {
   const CalibrationMap exact = harness::exact_calibration(quiet_camera());
   const LineDetector det(ScanLineParams{}, exact, *table_);

@@ -69,7 +69,7 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       number_param("grazing_spread", &P::grazing_spread, 0.0, 10.0, "line widths",
                    "a grazing point's added standard deviation across its marking, in the field's line widths (its run is a piece of the line, anywhere across its width: 1 / sqrt(12)); 0: no grazing class"),
       number_param("marking_sd", &P::marking_sd, 0.0, 1.0, "m",
-                   "standard deviation of an offset shared by a frame's points on one marking (the line's image as a whole), marginalised per frame; 0: points independent (the accuracy bound's line correlation times its white point noise, measured on recordings outside the evaluation sets: 0.30 x 1.7 cm = 0.5 cm)"),
+                   "standard deviation of an offset shared by a frame's points on one marking (the line's image as a whole), marginalised per frame; 0: points independent (the accuracy bound's line correlation times its white point noise, measured on recordings outside the evaluation sets: 0.32 x 1.3 cm = 0.4 cm; 0.5 cm on the images before a4652a0)"),
       number_param("tilt_sd", &P::tilt_sd, 0.0, 0.2, "rad",
                    "the frame's camera tilt (roll and pitch, each), a nuisance marginalised per frame with each point's geometry; 0: not modelled (JSON default: the camera's declared vibration, the robot profile's 0.3 deg)"),
       number_param("mount_height", &P::mount_height, 0.0, 5.0, "m",

@@ -58,7 +58,7 @@ struct UkfMhParams {
   double weight_ref = 1.5;       ///< m: the range at which the noise is point_sigma (NuBot)
   double grazing_below = 0.3;    ///< |n.u| (marking normal, scan ray) below which the ray meets the marking at a grazing angle
   double grazing_spread = 0.28867513459481287;  ///< a grazing point's added spread across its marking, in line widths (uniform: 1 / sqrt(12)); 0: none
-  double marking_sd = 0.005;     ///< m: an offset shared by a frame's points on one marking (the bound's line correlation x its white noise); 0: none
+  double marking_sd = 0.004;     ///< m: an offset shared by a frame's points on one marking (the bound's line correlation x its white noise); 0: none
   double tilt_sd = 0.0;          ///< rad: the frame's camera tilt, each axis (JSON default: the camera's declared vibration)
   double mount_height = 0.0;     ///< m: mirror viewpoint height of the tilt's geometry (JSON default: the camera's declared one)
   double common_sd_xy = 0.03;    ///< m: where the tilt is not modelled, a frame-common error of the points' pose
