@@ -319,6 +319,54 @@ TEST(Bound, PosteriorEqualsKalmanCovariance) {
   }
 }
 
+// The posterior bound's own check: the filter the bound describes, run on measurements drawn as
+// the model says (each frame's error independent, with the frame's information as its inverse
+// covariance, and the process error drawn from Q), misses its own covariance by no more than
+// sampling error; the same measurements made to repeat from frame to frame (an AR(1) error with
+// correlation 0.95 and the same marginal covariance: the same line at the same pixels for seconds)
+// make it miss by more than 1.3, which is what the check is there to show.
+TEST(Bound, PosteriorCheckFindsFrameToFrameCorrelation) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> N01;
+  const int frames = 4000;
+  const Eigen::Matrix3d info = Eigen::Vector3d(1.0 / 1e-4, 1.0 / 4e-4, 1.0 / 1e-5).asDiagonal();  // 1 cm, 2 cm, 3 mrad
+  const Eigen::Matrix3d cov = info.inverse();
+  Eigen::Matrix3d Q = Eigen::Vector3d(4e-6, 4e-6, 1e-6).asDiagonal();  // 2 mm, 1 mrad per frame
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 2) = -0.02;
+  F(1, 2) = 0.03;
+  for (const double rho : {0.0, 0.95}) {
+    std::vector<OracleStep> steps(frames);
+    Eigen::Vector3d z = Eigen::Vector3d::Zero();
+    for (int k = 0; k < frames; ++k) {
+      OracleStep& s = steps[static_cast<std::size_t>(k)];
+      s.F = F;
+      s.Q = Q;
+      s.info = info;
+      s.process_error = Eigen::Vector3d(std::sqrt(Q(0, 0)) * N01(rng), std::sqrt(Q(1, 1)) * N01(rng), std::sqrt(Q(2, 2)) * N01(rng));
+      // The frame's measurement error z (the efficient single-frame estimator's error, covariance
+      // info^-1), correlated with the previous frame's by rho; the score is -info z.
+      const Eigen::Vector3d fresh(std::sqrt(cov(0, 0)) * N01(rng), std::sqrt(cov(1, 1)) * N01(rng), std::sqrt(cov(2, 2)) * N01(rng));
+      z = k == 0 ? fresh : Eigen::Vector3d(rho * z + std::sqrt(1 - rho * rho) * fresh);
+      // The state's error moves with its process error; the measurement sees the state plus z, so
+      // relative to the filter's error-state model the frame's error is z.
+      s.score = -info * z;
+    }
+    const OracleResult r = posterior_oracle(steps, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero(), 1.0);
+    const double pos = std::sqrt(r.pos_sq / r.pos_var), th = std::sqrt(r.heading_sq / r.heading_var);
+    std::printf("correlation %.2f: the check's filter at %.3f x its position covariance, %.3f x its heading\n", rho, pos, th);
+    ASSERT_EQ(r.frames, static_cast<std::size_t>(frames));
+    if (rho == 0.0) {
+      // A mean square over ~4000 frames of a filter whose errors are correlated over a few frames:
+      // a few per cent of sampling error.
+      EXPECT_NEAR(pos, 1.0, 0.06);
+      EXPECT_NEAR(th, 1.0, 0.06);
+    } else {
+      EXPECT_GT(pos, 1.3);
+    }
+  }
+}
+
 // RPE over one frame (TUM / evo, no alignment): one estimate 3 cm off sideways spoils the two pairs
 // it belongs to by exactly 3 cm each; over one second there is no pair in half a second of frames
 // (null, never 0); a pair across a teleport is left out.

@@ -254,6 +254,47 @@ Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& 
   return posterior_step_impl<Eigen::MatrixXd>(P, F, Q, Jz);
 }
 
+namespace {
+// One step of the check's filter in error form (P- and e- already predicted): the update with the
+// frame's information J and score, the same arithmetic as posterior_step_impl's.
+template <class M, class V>
+void oracle_update(V& e, M& P, const M& J, const V& score) {
+  const M I = M::Identity(P.rows(), P.cols());
+  const auto lu = M(I + P * J).partialPivLu();
+  e = lu.solve(V(e - P * score));
+  const M out = lu.solve(P);
+  P = 0.5 * (out + out.transpose());
+}
+
+template <class M, class V>
+void oracle_tally(const V& e, const M& P, double settle_pos_var, OracleResult& r) {
+  if (P(0, 0) + P(1, 1) > settle_pos_var) return;
+  r.pos_sq += e(0) * e(0) + e(1) * e(1);
+  r.heading_sq += e(2) * e(2);
+  r.pos_var += P(0, 0) + P(1, 1);
+  r.heading_var += P(2, 2);
+  ++r.frames;
+}
+}  // namespace
+
+OracleResult posterior_oracle(const std::vector<OracleStep>& steps, const Eigen::VectorXd& e0, const Eigen::MatrixXd& P0, double settle_pos_var) {
+  OracleResult r;
+  Eigen::VectorXd e = e0;
+  Eigen::MatrixXd P = P0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const OracleStep& s = steps[k];
+    if (s.reset) {
+      P = s.reset_cov;
+    } else if (k > 0) {
+      e = s.F * e + s.process_error;
+      P = s.F * P * s.F.transpose() + s.Q;
+    }
+    oracle_update(e, P, s.info, s.score);
+    oracle_tally(e, P, settle_pos_var, r);
+  }
+  return r;
+}
+
 BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h) {
   BoundRow row;
   const Eigen::Vector2d d = world - pose.translation();
@@ -698,6 +739,7 @@ CompassReadings compass_readings(const std::vector<FrameRecord>& frames) {
 // estimator's error beside them (the bound's own check).
 struct SingleFrame {
   std::vector<Eigen::Matrix3d> info;
+  std::vector<Eigen::Vector3d> score;  // H^T R^-1 e at the truth, the compass's included
   std::map<std::string, std::size_t> why;  // frames without a finite bound, by reason
   Series series;
   std::size_t used_points = 0;
@@ -710,6 +752,7 @@ SingleFrame single_frame_bounds(const std::vector<FrameRecord>& frames, const st
   const std::size_t nf = frames.size();
   SingleFrame sf;
   sf.info.assign(nf, Eigen::Matrix3d::Zero());
+  sf.score.assign(nf, Eigen::Vector3d::Zero());
   std::vector<BoundRow> rows;
   std::map<int, int> line_of;
   for (std::size_t k = 0; k < nf; ++k) {
@@ -736,6 +779,7 @@ SingleFrame single_frame_bounds(const std::vector<FrameRecord>& frames, const st
       sf.info[k](2, 2) += 1.0 / (compass_sigma * compass_sigma);
       score(2) += angle_diff(*frames[k].heading, frames[k].truth.theta) / (compass_sigma * compass_sigma);
     }
+    sf.score[k] = score;
     std::string reason;
     if (!frames[k].camera_ok) reason = "camera not ok";
     else if (fw.raw_points == 0) reason = "no points";
@@ -838,6 +882,89 @@ Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vecto
     post.heading.push_back(*out_frames[k].pheading);
   }
   return post;
+}
+
+// The posterior bound's own check on this run's data: the filter the bound describes (six states,
+// the odometry's scale among them) run in error form with the true association, the measured noise
+// and the recorded odometry. Its process error is the recorded odometry's slip: the increments
+// less the scale fitted to them from the truth (least squares per axis over the run), whose own
+// error is the scale states' starting error. Scored from the frames whose position variance is
+// below (0.5 m)^2 (after a global start or a kidnap, once the filter has settled).
+Json posterior_check(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const SingleFrame& sf,
+                     const std::vector<double>& resets, const BoundSetup& setup, const Field& field) {
+  const std::size_t nf = frames.size();
+  std::vector<bool> reset_before(nf, false);
+  for (std::size_t k = 1; k < nf; ++k)
+    for (double tr : resets) reset_before[k] = reset_before[k] || moved_between(tr, frames[k - 1].t, frames[k].t);
+  Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
+  for (std::size_t k = 1; k < nf; ++k) {
+    if (reset_before[k]) continue;
+    const Pose2 u = frames[k - 1].truth.between(frames[k].truth);
+    const Pose2& o = frames[k].odometry;
+    num += Eigen::Vector3d(o.x * u.x, o.y * u.y, o.theta * u.theta);
+    den += Eigen::Vector3d(u.x * u.x, u.y * u.y, u.theta * u.theta);
+  }
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  for (int i = 0; i < 3; ++i)
+    if (den(i) > 1e-9) scale(i) = num(i) / den(i);
+  const double fx = 2.0 * field.half_floor_x(), fy = 2.0 * field.half_floor_y();
+  const Eigen::Vector3d uniform(fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0);
+  using V6 = Eigen::Matrix<double, 6, 1>;
+  M6 P = M6::Zero();
+  if (!setup.start_pose_given) P.topLeftCorner<3, 3>() = uniform.asDiagonal();
+  P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
+  V6 e = V6::Zero();
+  if (setup.scale_sigma > 0) e.tail<3>() = scale - Eigen::Vector3d::Ones();
+  M6 F, Q, J = M6::Zero();
+  V6 score = V6::Zero();
+  OracleResult r, scored;
+  for (std::size_t k = 0; k < nf; ++k) {
+    if (reset_before[k]) {
+      P.topLeftCorner<3, 3>() = uniform.asDiagonal();
+      P.topRightCorner<3, 3>().setZero();
+      P.bottomLeftCorner<3, 3>().setZero();
+    } else if (k > 0) {
+      motion_model(poses[k - 1], poses[k], setup, F, Q);
+      const Pose2 u = frames[k - 1].truth.between(frames[k].truth);
+      const Pose2& o = frames[k].odometry;
+      const double sx = o.x - scale(0) * u.x, sy = o.y - scale(1) * u.y;
+      const double c = std::cos(frames[k - 1].truth.theta), sn = std::sin(frames[k - 1].truth.theta);
+      V6 nu = V6::Zero();
+      nu << c * sx - sn * sy, sn * sx + c * sy, angle_diff(o.theta, scale(2) * u.theta), 0, 0, 0;
+      if (setup.scale_sigma <= 0) nu.head<2>() += Eigen::Vector2d(c * (scale(0) - 1) * u.x - sn * (scale(1) - 1) * u.y, sn * (scale(0) - 1) * u.x + c * (scale(1) - 1) * u.y);
+      e = F * e + nu;
+      P = F * P * F.transpose() + Q;
+    }
+    J.topLeftCorner<3, 3>() = sf.info[k];
+    score.head<3>() = sf.score[k];
+    oracle_update(e, P, J, score);
+    oracle_tally(e, P, 0.25, r);
+    // At the pose scored, as the posterior bound: carried over the latency by the odometry, whose
+    // noise there (not recorded: the odometry is per frame) enters both sides as the model's variance.
+    if (setup.latency_s > 0) {
+      motion_model(poses[k], frames[k].truth, setup, F, Q);
+      const V6 ef = F * e;
+      const M6 Pf = F * P * F.transpose() + Q;
+      if (Pf(0, 0) + Pf(1, 1) <= 0.25) {
+        scored.pos_sq += ef.head<2>().squaredNorm() + Q(0, 0) + Q(1, 1);
+        scored.heading_sq += ef(2) * ef(2) + Q(2, 2);
+        scored.pos_var += Pf(0, 0) + Pf(1, 1);
+        scored.heading_var += Pf(2, 2);
+        ++scored.frames;
+      }
+    }
+  }
+  if (setup.latency_s <= 0) scored = r;
+  Json c{{"estimator", "the posterior bound's filter on this run: true association, the measured noise, the recorded odometry (its scale fitted from the truth)"},
+         {"frames", scored.frames}};
+  const double n = static_cast<double>(scored.frames);
+  c["position_rms_m"] = scored.frames ? Json(std::sqrt(scored.pos_sq / n)) : Json(nullptr);
+  c["heading_rms_rad"] = scored.frames ? Json(std::sqrt(scored.heading_sq / n)) : Json(nullptr);
+  c["position_ratio"] = scored.pos_var > 0 ? Json(std::sqrt(scored.pos_sq / scored.pos_var)) : Json(nullptr);
+  c["heading_ratio"] = scored.heading_var > 0 ? Json(std::sqrt(scored.heading_sq / scored.heading_var)) : Json(nullptr);
+  c["position_ratio_at_exposure"] = r.pos_var > 0 ? Json(std::sqrt(r.pos_sq / r.pos_var)) : Json(nullptr);
+  c["heading_ratio_at_exposure"] = r.heading_var > 0 ? Json(std::sqrt(r.heading_sq / r.heading_var)) : Json(nullptr);
+  return c;
 }
 
 // The odometry's error per frame against the truth's increments, beside the model's prediction
@@ -963,6 +1090,7 @@ BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
   b["posterior"]["prior"] = setup.start_pose_given ? "the true start pose (the localizer was given it)"
                                                    : "uniform over the floor and heading (the localizer was not given its start)";
   if (!setup.resets.empty()) b["posterior"]["restarts_at_s"] = setup.resets;
+  b["posterior"]["check"] = posterior_check(frames, poses, sf, resets, setup, field);
   std::size_t no_bound = 0;
   Json why_j = Json::object();
   for (const auto& [k, v] : sf.why) {

@@ -80,6 +80,31 @@ CovarianceBound invert_information(const Eigen::Matrix3d& info);
 /// also when P or J_z is singular (a known start pose, a frame without points).
 Eigen::MatrixXd posterior_step(const Eigen::MatrixXd& P, const Eigen::MatrixXd& F, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Jz);
 
+/// One frame of the posterior bound's own check: the motion model from the previous frame (F, Q;
+/// `reset`: a kidnap, the prior drawn anew as `reset_cov`), the frame's information J and score
+/// (H^T R^-1 e at the truth, e the measured minus the true residuals: -J^-1 score is the efficient
+/// single-frame estimator's error) and the recorded odometry's error over the step, in the state's
+/// coordinates (`process_error`: what F's noise was in this run).
+struct OracleStep {
+  Eigen::MatrixXd F, Q, reset_cov;
+  Eigen::MatrixXd info;
+  Eigen::VectorXd score, process_error;
+  bool reset = false;
+};
+/// The check's sums over the frames whose position variance is at most `settle_pos_var` (m^2):
+/// squared errors of the filter and its own variances, position and heading (states 0, 1 and 2).
+struct OracleResult {
+  double pos_sq = 0, heading_sq = 0, pos_var = 0, heading_var = 0;
+  std::size_t frames = 0;
+};
+/// The filter the posterior bound describes, run in error form from error `e0` and covariance `P0`:
+/// e- = F e + process_error, then e+ = (I + P- J)^-1 (e- - P- score), P+ as posterior_step. Its
+/// errors match its covariance when the frames' measurement errors are independent and as modelled;
+/// errors correlated from frame to frame (the same line at the same pixels for seconds, a
+/// calibration error) make it miss its covariance, and the posterior bound is then optimistic by
+/// about the ratio.
+OracleResult posterior_oracle(const std::vector<OracleStep>& steps, const Eigen::VectorXd& e0, const Eigen::MatrixXd& P0, double settle_pos_var);
+
 /// A point mapped to the world and matched to its nearest marking: the signed distance along the
 /// marking's normal and that normal (world frame). `kind`: 0 none, 1 segment/arc, 2 spot.
 struct MarkingMatch {
