@@ -103,6 +103,21 @@ void main() {
 }
 )";
 
+// A one-channel table as a texture on the active unit, bilinear and clamped at its edges.
+unsigned upload_table(const GlApi& gl, const std::string& backend, const char* what, GLint internal, int w, int h, GLenum type, const void* data) {
+  unsigned tex = 0;
+  gl.GenTextures(1, &tex);
+  gl.BindTexture(GL_TEXTURE_2D, tex);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, internal, w, h, 0, GL_RED, type, data);
+  if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + backend + "\": " + what + " texture upload failed");
+  return tex;
+}
+
 }  // namespace
 
 FloorMesh::FloorMesh(GlContext& ctx, const Field& field, const CameraConfig& cfg, const MirrorProfile& mirror, int ss)
@@ -110,7 +125,7 @@ FloorMesh::FloorMesh(GlContext& ctx, const Field& field, const CameraConfig& cfg
   upload_distance_field(field);
   compile_programs(0.5 * field.line_width);
   build_mesh(cfg, mirror, ss);
-  upload_mirror(cfg, mirror, ss);
+  upload_mirror(mirror, ss);
 }
 
 FloorMesh::~FloorMesh() {
@@ -133,36 +148,19 @@ void FloorMesh::upload_distance_field(const Field& field) {
       const double d = std::min(field.distance_to_marking(p), kDistanceRange);
       dist[static_cast<std::size_t>(j) * tw + i] = static_cast<std::uint16_t>(std::lround(65535.0 * d / kDistanceRange));
     }
-  gl.GenTextures(1, &tex_distance_);
-  gl.BindTexture(GL_TEXTURE_2D, tex_distance_);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R16, tw, th, 0, GL_RED, GL_UNSIGNED_SHORT, dist.data());
-  if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + ctx_.backend() + "\": floor distance texture upload failed");
+  tex_distance_ = upload_table(gl, ctx_.backend(), "floor distance", GL_R16, tw, th, GL_UNSIGNED_SHORT, dist.data());
 }
 
-void FloorMesh::upload_mirror(const CameraConfig& cfg, const MirrorProfile& mirror, int ss) {
+void FloorMesh::upload_mirror(const MirrorProfile& mirror, int ss) {
   const GlApi& gl = ctx_.gl();
   constexpr double kStepPx = 1.0 / 16;
   const double lo = mirror.body_radius(), hi = mirror.rim();
   const int n = static_cast<int>(std::ceil((hi - lo) / kStepPx)) + 1;
   std::vector<float> elev(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) elev[static_cast<std::size_t>(i)] = static_cast<float>(mirror.elevation(std::min(hi, lo + i * kStepPx)));
-  gl.GenTextures(1, &tex_elevation_);
   gl.ActiveTexture(GL_TEXTURE1);
-  gl.BindTexture(GL_TEXTURE_2D, tex_elevation_);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, n, 1, 0, GL_RED, GL_FLOAT, elev.data());
+  tex_elevation_ = upload_table(gl, ctx_.backend(), "mirror elevation", GL_R32F, n, 1, GL_FLOAT, elev.data());
   gl.ActiveTexture(GL_TEXTURE0);
-  if (gl.GetError() != GL_NO_ERROR) throw RuntimeFailure("GL back-end \"" + ctx_.backend() + "\": mirror elevation texture upload failed");
-  (void)cfg;
   for (unsigned prog : {prog_floor_, prog_floor_inside_, prog_floor_labels_}) {
     gl.UseProgram(prog);
     gl.Uniform1i(gl.GetUniformLocation(prog, "elevation_map"), 1);

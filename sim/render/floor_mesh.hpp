@@ -47,7 +47,7 @@ class FloorMesh {
   void compile_programs(double line_half_width);
   void build_mesh(const CameraConfig& cfg, const MirrorProfile& mirror, int ss);
   /// The mirror's elevation per image radius as a texture, and the shaders' constant uniforms.
-  void upload_mirror(const CameraConfig& cfg, const MirrorProfile& mirror, int ss);
+  void upload_mirror(const MirrorProfile& mirror, int ss);
   /// The frame's pose, tilt and mount height for `prog`'s per-pixel floor point.
   void set_frame_uniforms(const GlApi& gl, unsigned prog, const FrameProjection& f) const;
   /// Per mesh vertex: this frame's floor point and which walls hide it (hidden_).
