@@ -106,6 +106,16 @@ class Gate(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
         self.assertIn("gate: 4 of 4 checks passed", p.stdout)
 
+    def test_example_rules_file_passes_the_shipped_references(self):
+        # data/gate/ci_quick_rules.json is what the suite's own comment points a team to: it must
+        # exist, load, and pass the built-in references, and the degraded localizer must fail it.
+        example = ROOT / "data" / "gate" / "ci_quick_rules.json"
+        p = self.gate(self.shipped, "--rules", example)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertTrue(all(ln.startswith("PASS") for ln in self.verdicts(p.stdout)), p.stdout)
+        p = self.gate(self.bad, "--rules", example)
+        self.assertNotEqual(p.returncode, 0, p.stdout + p.stderr)
+
     def test_fail_by_limit_names_value_and_limit(self):
         # The mean the gate judges is the one the C++ aggregate wrote (computed independently).
         mean = self.aggregate_mean(self.good, "ci_tracking", "r0/position_m/rmse")
