@@ -837,16 +837,31 @@ void motion_model(const Pose2& a, const Pose2& to, const BoundSetup& setup, M6& 
   Qm(2, 2) = setup.rot_sigma * setup.rot_sigma * turn + setup.rot_per_trans * setup.rot_per_trans * d;
 }
 
-// The posterior recursion over the frames (into `out_frames`); `resets` sorted.
-Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const std::vector<Eigen::Matrix3d>& info,
-                        const std::vector<double>& resets, const BoundSetup& setup, const Field& field, std::vector<FrameBound>& out_frames) {
+// Without the start pose, and after a kidnap, the localizer knows only that the robot is on the
+// floor: a prior with the variance of a uniform position on it and a uniform heading. The posterior
+// recursion and its check start from it and return to it alike.
+Eigen::Vector3d floor_prior(const Field& field) {
   const double fx = 2.0 * field.half_floor_x(), fy = 2.0 * field.half_floor_y();
-  // Without the start pose, and after a kidnap, the localizer knows only that the robot is on the
-  // floor: a prior with the variance of a uniform position on it and a uniform heading.
-  const Eigen::Vector3d uniform(fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0);
+  return {fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0};
+}
+M6 start_covariance(const BoundSetup& setup, const Eigen::Vector3d& uniform) {
   M6 P = M6::Zero();
   if (!setup.start_pose_given) P.topLeftCorner<3, 3>() = uniform.asDiagonal();
   P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
+  return P;
+}
+// A kidnap: the pose's prior drawn anew, the scale's kept (it is the same wheels).
+void reset_pose(M6& P, const Eigen::Vector3d& uniform) {
+  P.topLeftCorner<3, 3>() = uniform.asDiagonal();
+  P.topRightCorner<3, 3>().setZero();
+  P.bottomLeftCorner<3, 3>().setZero();
+}
+
+// The posterior recursion over the frames (into `out_frames`); `resets` sorted.
+Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const std::vector<Eigen::Matrix3d>& info,
+                        const std::vector<double>& resets, const BoundSetup& setup, const Field& field, std::vector<FrameBound>& out_frames) {
+  const Eigen::Vector3d uniform = floor_prior(field);
+  M6 P = start_covariance(setup, uniform);
   Series post;
   std::size_t reset_at = 0;
   M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
@@ -859,9 +874,7 @@ Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vecto
       ++reset_at;
     }
     if (reset) {
-      P.topLeftCorner<3, 3>() = uniform.asDiagonal();
-      P.topRightCorner<3, 3>().setZero();
-      P.bottomLeftCorner<3, 3>().setZero();
+      reset_pose(P, uniform);
     } else if (k > 0) {
       motion_model(poses[k - 1], poses[k], setup, F, Q);
     }
@@ -907,12 +920,9 @@ Json posterior_check(const std::vector<FrameRecord>& frames, const std::vector<P
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();
   for (int i = 0; i < 3; ++i)
     if (den(i) > 1e-9) scale(i) = num(i) / den(i);
-  const double fx = 2.0 * field.half_floor_x(), fy = 2.0 * field.half_floor_y();
-  const Eigen::Vector3d uniform(fx * fx / 12.0, fy * fy / 12.0, kPi * kPi / 3.0);
+  const Eigen::Vector3d uniform = floor_prior(field);
   using V6 = Eigen::Matrix<double, 6, 1>;
-  M6 P = M6::Zero();
-  if (!setup.start_pose_given) P.topLeftCorner<3, 3>() = uniform.asDiagonal();
-  P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
+  M6 P = start_covariance(setup, uniform);
   V6 e = V6::Zero();
   if (setup.scale_sigma > 0) e.tail<3>() = scale - Eigen::Vector3d::Ones();
   M6 F, Q, J = M6::Zero();
@@ -920,9 +930,7 @@ Json posterior_check(const std::vector<FrameRecord>& frames, const std::vector<P
   OracleResult r, scored;
   for (std::size_t k = 0; k < nf; ++k) {
     if (reset_before[k]) {
-      P.topLeftCorner<3, 3>() = uniform.asDiagonal();
-      P.topRightCorner<3, 3>().setZero();
-      P.bottomLeftCorner<3, 3>().setZero();
+      reset_pose(P, uniform);
     } else if (k > 0) {
       motion_model(poses[k - 1], poses[k], setup, F, Q);
       const Pose2 u = frames[k - 1].truth.between(frames[k].truth);
