@@ -295,6 +295,190 @@ OracleResult posterior_oracle(const std::vector<OracleStep>& steps, const Eigen:
   return r;
 }
 
+namespace {
+// J = V diag(w) V^T: its symmetric root, the root's inverse on the range and the projector on the
+// range. A direction with less than 1e-12 of the largest eigenvalue is outside the range (the
+// information along a line is that many orders below across it).
+struct InfoRoots {
+  Eigen::Matrix3d root = Eigen::Matrix3d::Zero(), inv_root = Eigen::Matrix3d::Zero(), proj = Eigen::Matrix3d::Zero();
+};
+InfoRoots info_roots(const Eigen::Matrix3d& J) {
+  InfoRoots r;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (J + J.transpose()));
+  const Eigen::Vector3d w = es.eigenvalues();
+  const double top = w.maxCoeff();
+  if (!(top > 0)) return r;
+  const Eigen::Matrix3d& V = es.eigenvectors();
+  Eigen::Vector3d sq = Eigen::Vector3d::Zero(), isq = Eigen::Vector3d::Zero(), on = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (w(i) > 1e-12 * top) {
+      sq(i) = std::sqrt(w(i));
+      isq(i) = 1.0 / sq(i);
+      on(i) = 1.0;
+    }
+  }
+  r.root = V * sq.asDiagonal() * V.transpose();
+  r.inv_root = V * isq.asDiagonal() * V.transpose();
+  r.proj = V * on.asDiagonal() * V.transpose();
+  return r;
+}
+
+// The frame's rows H = [J^{1/2}, 0, sqrt(rho) Pi] on a state of N entries (pose first, z last); the
+// fresh part's covariance is (1 - rho) I.
+template <int N>
+Eigen::Matrix<double, 3, N> correlated_rows(const InfoRoots& r, double rho, int n = N) {
+  Eigen::Matrix<double, 3, N> H = Eigen::Matrix<double, 3, N>::Zero(3, n);
+  H.template leftCols<3>() = r.root;
+  H.template rightCols<3>() = std::sqrt(rho) * r.proj;
+  return H;
+}
+
+// One Kalman update of the temporal model's filter on state x (pose errors first, the estimate of
+// z last) with the frame's whitened error eta: innovation eta - H x, fresh noise (1 - rho) I
+// (invertible: rho <= kMaxCarriedShare). Joseph form, so P stays symmetric and positive.
+template <class M, class V, class H3>
+void correlated_update(V& x, M& P, const H3& H, const Eigen::Vector3d& eta, double rho) {
+  const Eigen::Matrix3d R = (1.0 - rho) * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d S = H * P * H.transpose() + R;
+  const auto K = (P * H.transpose() * S.inverse()).eval();
+  x += K * (eta - H * x);
+  const M IKH = M::Identity(P.rows(), P.cols()) - K * H;
+  const M out = IKH * P * IKH.transpose() + K * R * K.transpose();
+  P = 0.5 * (out + out.transpose());
+}
+
+// The motion of the augmented state: the steps' F, Q on the first n entries; z times a, with
+// (1 - a^2) noise so that its variance stays 1.
+template <class M>
+void augment_motion(M& Fa, M& Qa, const Eigen::Ref<const Eigen::MatrixXd>& F, const Eigen::Ref<const Eigen::MatrixXd>& Q, double a) {
+  const Eigen::Index n = F.rows(), N = Fa.rows();
+  Fa.setZero();
+  Qa.setZero();
+  Fa.topLeftCorner(n, n) = F;
+  Qa.topLeftCorner(n, n) = Q;
+  Fa.bottomRightCorner(3, 3) = a * Eigen::Matrix3d::Identity();
+  Qa.bottomRightCorner(3, 3) = (1.0 - a * a) * Eigen::Matrix3d::Identity();
+  (void)N;
+}
+}  // namespace
+
+Eigen::Vector3d whitened_error(const Eigen::Matrix3d& info, const Eigen::Vector3d& score) { return -(info_roots(info).inv_root * score); }
+
+TemporalCorrelation fit_temporal_correlation(const std::vector<Eigen::Vector3d>& eta, const std::vector<bool>& has,
+                                             const std::vector<int>& segment, int max_lag) {
+  TemporalCorrelation tc;
+  tc.lags = std::max(1, max_lag);
+  const std::size_t n = eta.size();
+  double r0 = 0;
+  std::size_t n0 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!has[k]) continue;
+    r0 += eta[k].squaredNorm();
+    ++n0;
+  }
+  std::vector<double> r(static_cast<std::size_t>(tc.lags), std::numeric_limits<double>::quiet_NaN());
+  for (int l = 1; l <= tc.lags; ++l) {
+    double sum = 0;
+    std::size_t pairs = 0;
+    for (std::size_t k = 0; k + static_cast<std::size_t>(l) < n; ++k) {
+      const std::size_t j = k + static_cast<std::size_t>(l);
+      if (!has[k] || !has[j] || segment[k] != segment[j]) continue;
+      sum += eta[k].dot(eta[j]);
+      ++pairs;
+    }
+    if (l == 1) tc.pairs = pairs;
+    if (pairs > 0 && r0 > 0) r[static_cast<std::size_t>(l - 1)] = (sum / static_cast<double>(pairs)) / (r0 / static_cast<double>(n0));
+  }
+  tc.autocorrelation = r;
+  if (tc.pairs < 3 * static_cast<std::size_t>(tc.lags)) {
+    tc.why = "fewer than " + std::to_string(3 * tc.lags) + " pairs of consecutive frames with a bound: taken as independent";
+    return tc;
+  }
+  // rho a^l against r(l): for each a, the least-squares rho is sum r a^l / sum a^2l.
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 1; i < 1000; ++i) {
+    const double a = 0.001 * i;
+    double ra = 0, aa = 0;
+    double p = 1;
+    for (int l = 1; l <= tc.lags; ++l) {
+      p *= a;
+      const double rl = r[static_cast<std::size_t>(l - 1)];
+      if (!std::isfinite(rl)) continue;
+      ra += rl * p;
+      aa += p * p;
+    }
+    if (!(aa > 0)) continue;
+    const double rho = std::clamp(ra / aa, 0.0, kMaxCarriedShare);
+    double sse = 0;
+    p = 1;
+    for (int l = 1; l <= tc.lags; ++l) {
+      p *= a;
+      const double rl = r[static_cast<std::size_t>(l - 1)];
+      if (std::isfinite(rl)) sse += (rl - rho * p) * (rl - rho * p);
+    }
+    if (sse < best) {
+      best = sse;
+      tc.rho = rho;
+      tc.a = a;
+    }
+  }
+  if (tc.rho <= 0) tc.a = 0;
+  return tc;
+}
+
+Eigen::MatrixXd correlated_frame_information(const Eigen::Matrix3d& info, double rho, int states) {
+  using HX = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+  const HX H = correlated_rows<Eigen::Dynamic>(info_roots(info), rho, states);
+  return H.transpose() * H / (1.0 - rho);
+}
+
+OracleResult posterior_oracle_correlated(const std::vector<OracleStep>& steps, const std::vector<Eigen::Vector3d>& eta,
+                                         const TemporalCorrelation& tc, const Eigen::VectorXd& e0, const Eigen::MatrixXd& P0,
+                                         double settle_pos_var, OracleResult* white) {
+  using MX = Eigen::MatrixXd;
+  using VX = Eigen::VectorXd;
+  OracleResult r;
+  const Eigen::Index n = e0.size(), N = n + 3;
+  VX x = VX::Zero(N);
+  x.head(n) = e0;
+  MX P = MX::Zero(N, N);
+  P.topLeftCorner(n, n) = P0;
+  P.bottomRightCorner(3, 3).setIdentity();
+  VX ew = e0;
+  MX Pw = P0;
+  MX Fa(N, N), Qa(N, N);
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const OracleStep& s = steps[k];
+    if (s.reset) {
+      P.topLeftCorner(n, n) = s.reset_cov;
+      P.block(0, n, 3, 3).setZero();
+      P.block(n, 0, 3, 3).setZero();
+      Pw = s.reset_cov;
+    } else if (k > 0) {
+      augment_motion(Fa, Qa, s.F, s.Q, tc.a);
+      x = Fa * x;
+      x.head(n) += s.process_error;
+      P = Fa * P * Fa.transpose() + Qa;
+      ew = s.F * ew + s.process_error;
+      Pw = s.F * Pw * s.F.transpose() + s.Q;
+    }
+    const InfoRoots ir = info_roots(s.info.topLeftCorner<3, 3>());
+    if (ir.proj.any()) correlated_update(x, P, correlated_rows<Eigen::Dynamic>(ir, tc.rho, static_cast<int>(N)), eta[k], tc.rho);
+    oracle_tally(x, P, settle_pos_var, r);
+    if (white) {
+      oracle_update(ew, Pw, s.info, s.score);
+      if (P(0, 0) + P(1, 1) <= settle_pos_var) {
+        white->pos_sq += ew(0) * ew(0) + ew(1) * ew(1);
+        white->heading_sq += ew(2) * ew(2);
+        white->pos_var += P(0, 0) + P(1, 1);
+        white->heading_var += P(2, 2);
+        ++white->frames;
+      }
+    }
+  }
+  return r;
+}
+
 BoundRow bound_row(const MarkingMatch& m, const Eigen::Vector2d& world, const Pose2& pose, const Eigen::Vector2d& robot, double var, double h) {
   BoundRow row;
   const Eigen::Vector2d d = world - pose.translation();
@@ -850,21 +1034,43 @@ M6 start_covariance(const BoundSetup& setup, const Eigen::Vector3d& uniform) {
   P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * setup.scale_sigma * setup.scale_sigma;
   return P;
 }
-// A kidnap: the pose's prior drawn anew, the scale's kept (it is the same wheels).
-void reset_pose(M6& P, const Eigen::Vector3d& uniform) {
-  P.topLeftCorner<3, 3>() = uniform.asDiagonal();
-  P.topRightCorner<3, 3>().setZero();
-  P.bottomLeftCorner<3, 3>().setZero();
+// A kidnap: the pose's prior drawn anew, the scale's kept (it is the same wheels), and the carried
+// image error with the temporal model (it is the same camera).
+template <class M>
+void reset_pose(M& P, const Eigen::Vector3d& uniform) {
+  const Eigen::Index rest = P.rows() - 3;
+  P.template topLeftCorner<3, 3>() = uniform.asDiagonal();
+  P.topRightCorner(3, rest).setZero();
+  P.bottomLeftCorner(rest, 3).setZero();
 }
 
-// The posterior recursion over the frames (into `out_frames`); `resets` sorted.
-Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const std::vector<Eigen::Matrix3d>& info,
-                        const std::vector<double>& resets, const BoundSetup& setup, const Field& field, std::vector<FrameBound>& out_frames) {
+// With the temporal model: the six states and the carried error z (three) behind them.
+using M9 = Eigen::Matrix<double, 9, 9>;
+using V9 = Eigen::Matrix<double, 9, 1>;
+M9 augmented(const M6& P6) {
+  M9 P = M9::Zero();
+  P.topLeftCorner<6, 6>() = P6;
+  P.bottomRightCorner<3, 3>().setIdentity();
+  return P;
+}
+
+// The posterior recursion over the frames: `white` takes the frames as independent; `carried` (when
+// tc.rho > 0) adds the errors they carry over (TemporalCorrelation), and is the bound put in
+// `out_frames` (else `white` is). `resets` sorted.
+struct PosteriorSeries {
+  Series white, carried;
+};
+PosteriorSeries posterior_bounds(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const std::vector<Eigen::Matrix3d>& info,
+                                 const std::vector<InfoRoots>& roots, const TemporalCorrelation& tc, const std::vector<double>& resets,
+                                 const BoundSetup& setup, const Field& field, std::vector<FrameBound>& out_frames) {
   const Eigen::Vector3d uniform = floor_prior(field);
   M6 P = start_covariance(setup, uniform);
-  Series post;
+  const bool temporal = tc.rho > 0;
+  M9 P9 = augmented(P);
+  PosteriorSeries out;
   std::size_t reset_at = 0;
   M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
+  M9 F9, Q9;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     F.setIdentity();
     Q.setZero();
@@ -873,28 +1079,43 @@ Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vecto
       reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
       ++reset_at;
     }
+    F9.setIdentity();
+    Q9.setZero();
     if (reset) {
       reset_pose(P, uniform);
+      reset_pose(P9, uniform);
     } else if (k > 0) {
       motion_model(poses[k - 1], poses[k], setup, F, Q);
+      augment_motion(F9, Q9, F, Q, tc.a);
     }
     Jz.setZero();
     Jz.topLeftCorner<3, 3>() = info[k];
     P = posterior_step_impl<M6>(P, F, Q, Jz);
+    if (temporal) {
+      const Eigen::Matrix<double, 3, 9> H = correlated_rows<9>(roots[k], tc.rho);
+      P9 = posterior_step_impl<M9>(P9, F9, Q9, M9(H.transpose() * H / (1.0 - tc.rho)));
+    }
     // The recursion runs on the poses the images were exposed at; the pose scored is the frame's,
-    // the latency later: carried forward through the odometry over it (its noise included).
-    M6 Pf = P;
+    // the latency later: carried forward through the odometry over it (its noise included). The
+    // carried error z does not move the pose, so the pose and scale block is all that is carried.
+    M6 Pf = P, Pf9 = P9.topLeftCorner<6, 6>();
     if (setup.latency_s > 0) {
       motion_model(poses[k], frames[k].truth, setup, F, Q);
       Pf = F * P * F.transpose() + Q;
+      Pf9 = F * Pf9 * F.transpose() + Q;
     }
-    const double pp = std::max(0.0, Pf(0, 0) + Pf(1, 1)), ph = std::max(0.0, Pf(2, 2));
-    out_frames[k].ppos = std::sqrt(pp);
-    out_frames[k].pheading = std::sqrt(ph);
-    post.pos.push_back(*out_frames[k].ppos);
-    post.heading.push_back(*out_frames[k].pheading);
+    const auto add = [](Series& sr, const M6& C) {
+      sr.pos.push_back(std::sqrt(std::max(0.0, C(0, 0) + C(1, 1))));
+      sr.heading.push_back(std::sqrt(std::max(0.0, C(2, 2))));
+    };
+    add(out.white, Pf);
+    if (temporal) add(out.carried, Pf9);
+    const Series& used = temporal ? out.carried : out.white;
+    out_frames[k].ppos = used.pos.back();
+    out_frames[k].pheading = used.heading.back();
   }
-  return post;
+  if (!temporal) out.carried = out.white;
+  return out;
 }
 
 // The posterior bound's own check on this run's data: the filter the bound describes (six states,
@@ -903,8 +1124,15 @@ Series posterior_bounds(const std::vector<FrameRecord>& frames, const std::vecto
 // less the scale fitted to them from the truth (least squares per axis over the run), whose own
 // error is the scale states' starting error. Scored from the frames whose position variance is
 // below (0.5 m)^2 (after a global start or a kidnap, once the filter has settled).
-Json posterior_check(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const SingleFrame& sf,
-                     const std::vector<double>& resets, const BoundSetup& setup, const Field& field) {
+// `white` gets the filter that takes the frames as independent; `carried`, with tc.rho > 0, the
+// temporal model's filter (the carried error z among its states: what the bound with carried
+// errors describes) and the independent filter's errors against its covariance.
+struct PosteriorCheck {
+  Json white, carried;
+};
+PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const SingleFrame& sf,
+                               const std::vector<InfoRoots>& roots, const std::vector<Eigen::Vector3d>& eta, const TemporalCorrelation& tc,
+                               const std::vector<double>& resets, const BoundSetup& setup, const Field& field) {
   const std::size_t nf = frames.size();
   std::vector<bool> reset_before(nf, false);
   for (std::size_t k = 1; k < nf; ++k)
@@ -925,12 +1153,33 @@ Json posterior_check(const std::vector<FrameRecord>& frames, const std::vector<P
   M6 P = start_covariance(setup, uniform);
   V6 e = V6::Zero();
   if (setup.scale_sigma > 0) e.tail<3>() = scale - Eigen::Vector3d::Ones();
+  const bool temporal = tc.rho > 0;
+  M9 P9 = augmented(P);
+  V9 x9 = V9::Zero();
+  x9.head<6>() = e;
   M6 F, Q, J = M6::Zero();
+  M9 F9, Q9;
   V6 score = V6::Zero();
-  OracleResult r, scored;
+  // r: at the exposure pose; scored: at the frame's pose (the latency later); c: the temporal
+  // model's filter; wc: the independent filter's errors against the temporal model's covariance.
+  OracleResult r, scored, rc, scored_c, rwc, scored_wc;
+  // At the pose scored, as the posterior bound: carried over the latency by the odometry, whose
+  // noise there (not recorded: the odometry is per frame) enters both sides as the model's variance.
+  const auto tally_scored = [&](const V6& err, const M6& Pk, std::size_t k, OracleResult& out) {
+    motion_model(poses[k], frames[k].truth, setup, F, Q);
+    const V6 ef = F * err;
+    const M6 Pf = F * Pk * F.transpose() + Q;
+    if (Pf(0, 0) + Pf(1, 1) > 0.25) return;
+    out.pos_sq += ef.head<2>().squaredNorm() + Q(0, 0) + Q(1, 1);
+    out.heading_sq += ef(2) * ef(2) + Q(2, 2);
+    out.pos_var += Pf(0, 0) + Pf(1, 1);
+    out.heading_var += Pf(2, 2);
+    ++out.frames;
+  };
   for (std::size_t k = 0; k < nf; ++k) {
     if (reset_before[k]) {
       reset_pose(P, uniform);
+      reset_pose(P9, uniform);
     } else if (k > 0) {
       motion_model(poses[k - 1], poses[k], setup, F, Q);
       const Pose2 u = frames[k - 1].truth.between(frames[k].truth);
@@ -942,37 +1191,59 @@ Json posterior_check(const std::vector<FrameRecord>& frames, const std::vector<P
       if (setup.scale_sigma <= 0) nu.head<2>() += Eigen::Vector2d(c * (scale(0) - 1) * u.x - sn * (scale(1) - 1) * u.y, sn * (scale(0) - 1) * u.x + c * (scale(1) - 1) * u.y);
       e = F * e + nu;
       P = F * P * F.transpose() + Q;
+      if (temporal) {
+        augment_motion(F9, Q9, F, Q, tc.a);
+        x9 = F9 * x9;
+        x9.head<6>() += nu;
+        P9 = F9 * P9 * F9.transpose() + Q9;
+      }
     }
     J.topLeftCorner<3, 3>() = sf.info[k];
     score.head<3>() = sf.score[k];
     oracle_update(e, P, J, score);
     oracle_tally(e, P, 0.25, r);
-    // At the pose scored, as the posterior bound: carried over the latency by the odometry, whose
-    // noise there (not recorded: the odometry is per frame) enters both sides as the model's variance.
-    if (setup.latency_s > 0) {
-      motion_model(poses[k], frames[k].truth, setup, F, Q);
-      const V6 ef = F * e;
-      const M6 Pf = F * P * F.transpose() + Q;
-      if (Pf(0, 0) + Pf(1, 1) <= 0.25) {
-        scored.pos_sq += ef.head<2>().squaredNorm() + Q(0, 0) + Q(1, 1);
-        scored.heading_sq += ef(2) * ef(2) + Q(2, 2);
-        scored.pos_var += Pf(0, 0) + Pf(1, 1);
-        scored.heading_var += Pf(2, 2);
-        ++scored.frames;
+    if (temporal) {
+      if (roots[k].proj.any()) correlated_update(x9, P9, correlated_rows<9>(roots[k], tc.rho), eta[k], tc.rho);
+      const M6 Pc = P9.topLeftCorner<6, 6>();
+      oracle_tally(V6(x9.head<6>()), Pc, 0.25, rc);
+      oracle_tally(e, Pc, 0.25, rwc);
+      if (setup.latency_s > 0) {
+        tally_scored(x9.head<6>(), Pc, k, scored_c);
+        tally_scored(e, Pc, k, scored_wc);
       }
     }
+    if (setup.latency_s > 0) tally_scored(e, P, k, scored);
   }
-  if (setup.latency_s <= 0) scored = r;
-  Json c{{"estimator", "the posterior bound's filter on this run: true association, the measured noise, the recorded odometry (its scale fitted from the truth)"},
-         {"frames", scored.frames}};
-  const double n = static_cast<double>(scored.frames);
-  c["position_rms_m"] = scored.frames ? Json(std::sqrt(scored.pos_sq / n)) : Json(nullptr);
-  c["heading_rms_rad"] = scored.frames ? Json(std::sqrt(scored.heading_sq / n)) : Json(nullptr);
-  c["position_ratio"] = scored.pos_var > 0 ? Json(std::sqrt(scored.pos_sq / scored.pos_var)) : Json(nullptr);
-  c["heading_ratio"] = scored.heading_var > 0 ? Json(std::sqrt(scored.heading_sq / scored.heading_var)) : Json(nullptr);
-  c["position_ratio_at_exposure"] = r.pos_var > 0 ? Json(std::sqrt(r.pos_sq / r.pos_var)) : Json(nullptr);
-  c["heading_ratio_at_exposure"] = r.heading_var > 0 ? Json(std::sqrt(r.heading_sq / r.heading_var)) : Json(nullptr);
-  return c;
+  if (setup.latency_s <= 0) {
+    scored = r;
+    scored_c = rc;
+    scored_wc = rwc;
+  }
+  const auto ratio = [](double sq, double var) { return var > 0 ? Json(std::sqrt(sq / var)) : Json(nullptr); };
+  const auto check = [&](const char* estimator, const OracleResult& at_frame, const OracleResult& at_exposure) {
+    Json c{{"estimator", estimator}, {"frames", at_frame.frames}};
+    const double n = static_cast<double>(at_frame.frames);
+    c["position_rms_m"] = at_frame.frames ? Json(std::sqrt(at_frame.pos_sq / n)) : Json(nullptr);
+    c["heading_rms_rad"] = at_frame.frames ? Json(std::sqrt(at_frame.heading_sq / n)) : Json(nullptr);
+    c["position_ratio"] = ratio(at_frame.pos_sq, at_frame.pos_var);
+    c["heading_ratio"] = ratio(at_frame.heading_sq, at_frame.heading_var);
+    c["position_ratio_at_exposure"] = ratio(at_exposure.pos_sq, at_exposure.pos_var);
+    c["heading_ratio_at_exposure"] = ratio(at_exposure.heading_sq, at_exposure.heading_var);
+    return c;
+  };
+  PosteriorCheck out;
+  out.white = check("the posterior bound's filter on this run: true association, the measured noise, the recorded odometry (its scale fitted from the truth)",
+                    scored, r);
+  if (temporal) {
+    out.carried = check("the filter of the bound with carried errors on this run: the same, with the carried image error among its states", scored_c, rc);
+    Json w = check("the filter that takes the frames as independent, its errors against the covariance of the bound with carried errors "
+                   "(below 1 beyond sampling error would be a filter beating that bound)",
+                   scored_wc, rwc);
+    out.carried["independent_filter"] = w;
+  } else {
+    out.carried = out.white;
+  }
+  return out;
 }
 
 // The odometry's error per frame against the truth's increments, beside the model's prediction
@@ -1079,7 +1350,29 @@ BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
   const SingleFrame sf = single_frame_bounds(frames, work, nm, compass, compass_sigma, out.frames);
   std::vector<double> resets = setup.resets;
   std::sort(resets.begin(), resets.end());
-  const Series post = posterior_bounds(frames, poses, sf.info, resets, setup, field, out.frames);
+  // The errors frames carry over to the next ones, measured from their whitened errors at the truth
+  // over lags up to one second (a recursion's memory is shorter: a few frames to a second).
+  std::vector<InfoRoots> roots(nf);
+  std::vector<Eigen::Vector3d> eta(nf, Eigen::Vector3d::Zero());
+  std::vector<bool> has_eta(nf, false);
+  std::vector<int> segment(nf, 0);
+  {
+    std::size_t reset_at = 0;
+    for (std::size_t k = 0; k < nf; ++k) {
+      roots[k] = info_roots(sf.info[k]);
+      eta[k] = -(roots[k].inv_root * sf.score[k]);
+      has_eta[k] = out.frames[k].pos.has_value();
+      bool reset = false;
+      while (reset_at < resets.size() && k > 0 && resets[reset_at] < frames[k].t - 1e-9) {
+        reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
+        ++reset_at;
+      }
+      segment[k] = k == 0 ? 0 : segment[k - 1] + (reset ? 1 : 0);
+    }
+  }
+  const int max_lag = static_cast<int>(std::clamp(std::lround(setup.camera_rate), 2L, 60L));
+  const TemporalCorrelation tc = fit_temporal_correlation(eta, has_eta, segment, max_lag);
+  const PosteriorSeries post = posterior_bounds(frames, poses, sf.info, roots, tc, resets, setup, field, out.frames);
   const OdometryError oe = odometry_error(frames, resets, setup);
 
   // Latency: the shift between the pose the image shows and the pose scored, a bias of any
@@ -1094,11 +1387,29 @@ BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
   Json& b = out.bound;
   b["single_frame"] = series_json(sf.series, scored);
   b["single_frame"]["check"] = check_json(sf);
-  b["posterior"] = series_json(post, scored);
-  b["posterior"]["prior"] = setup.start_pose_given ? "the true start pose (the localizer was given it)"
-                                                   : "uniform over the floor and heading (the localizer was not given its start)";
+  const PosteriorCheck pc = posterior_check(frames, poses, sf, roots, eta, tc, resets, setup, field);
+  const char* prior = setup.start_pose_given ? "the true start pose (the localizer was given it)"
+                                             : "uniform over the floor and heading (the localizer was not given its start)";
+  b["posterior"] = series_json(post.carried, scored);
+  b["posterior"]["prior"] = prior;
   if (!setup.resets.empty()) b["posterior"]["restarts_at_s"] = setup.resets;
-  b["posterior"]["check"] = posterior_check(frames, poses, sf, resets, setup, field);
+  b["posterior"]["check"] = pc.carried;
+  Json carried{{"share", tc.rho},
+               {"per_frame", tc.a},
+               {"memory_frames", tc.rho > 0 && tc.a > 0 && tc.a < 1 ? Json(-1.0 / std::log(tc.a)) : Json(nullptr)},
+               {"lags", tc.lags},
+               {"pairs", tc.pairs},
+               {"model", "a share of each frame's whitened error carried to the next frames with a per-frame coefficient, fitted to "
+                         "the autocorrelation of the frames' errors at the truth over lags 1..lags"}};
+  Json acf = Json::array();
+  for (double v : tc.autocorrelation) acf.push_back(num_or_null(v));
+  carried["autocorrelation"] = acf;
+  if (!tc.why.empty()) carried["why_independent"] = tc.why;
+  b["posterior"]["carried_errors"] = carried;
+  b["posterior_white"] = series_json(post.white, scored);
+  b["posterior_white"]["prior"] = prior;
+  b["posterior_white"]["check"] = pc.white;
+  b["posterior_white"]["model"] = "each frame's errors independent of the other frames' (beside, for comparison)";
   std::size_t no_bound = 0;
   Json why_j = Json::object();
   for (const auto& [k, v] : sf.why) {

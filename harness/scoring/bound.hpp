@@ -105,6 +105,53 @@ struct OracleResult {
 /// about the ratio.
 OracleResult posterior_oracle(const std::vector<OracleStep>& steps, const Eigen::VectorXd& e0, const Eigen::MatrixXd& P0, double settle_pos_var);
 
+/// Errors that carry over from frame to frame (the same lines at nearly the same pixels while the robot
+/// moves a little; a calibration error): the frames' measurements are not independent, and a
+/// recursion that takes them so is optimistic (posterior_oracle shows by how much). The model, in
+/// each frame's whitened error eta_k = J_k^{1/2} eps_k (eps_k the efficient single-frame estimator's
+/// error, so eta_k has unit covariance on the range of J_k):
+///   eta_k = sqrt(rho) Pi_k z_k + sqrt(1 - rho) n_k,  z_k = a z_{k-1} + sqrt(1 - a^2) w_k,
+/// n, w white with unit covariance and Pi_k the projector on J_k's range: a share rho of every
+/// frame's error variance is carried with coefficient a per frame, the rest is fresh. Each frame
+/// keeps its own marginal covariance J_k^-1; only its correlation with the other frames is added.
+struct TemporalCorrelation {
+  double rho = 0.0;  ///< share of a frame's error variance that carries over (0: independent frames)
+  double a = 0.0;    ///< per-frame coefficient of the carried part
+  int lags = 0;      ///< the autocorrelation was fitted over lags 1..lags (frames)
+  std::size_t pairs = 0;  ///< frame pairs one frame apart that entered the measurement
+  std::vector<double> autocorrelation;  ///< measured, lags 1..lags (null where no pair)
+  std::string why;   ///< why rho is 0 when it was not measured
+};
+/// The largest share taken: the fresh part's covariance (1 - rho) must stay invertible.
+inline constexpr double kMaxCarriedShare = 0.9;
+
+/// A frame's whitened error: -J^{-1/2} score (on J's range), i.e. J^{1/2} times the efficient
+/// single-frame estimator's error -J^-1 score.
+Eigen::Vector3d whitened_error(const Eigen::Matrix3d& info, const Eigen::Vector3d& score);
+
+/// rho a^l fitted by least squares to the measured autocorrelation of the whitened errors at lags
+/// 1..max_lag: r(l) = mean(eta_k . eta_{k+l}) / mean(|eta_k|^2) over the pairs of frames that both
+/// have an error (`has`) and lie in one `segment` (between two kidnaps). a is searched on a grid of
+/// 0.001, rho is its least-squares share, clamped to [0, kMaxCarriedShare]. Fewer than
+/// 3 max_lag pairs one frame apart: rho 0, with why.
+TemporalCorrelation fit_temporal_correlation(const std::vector<Eigen::Vector3d>& eta, const std::vector<bool>& has,
+                                             const std::vector<int>& segment, int max_lag);
+
+/// One frame's information on the state (pose, ..., z) of `states` entries whose first three are
+/// the pose and last three the carried error z: H^T H / (1 - rho), H = [J^{1/2}, 0, sqrt(rho) Pi].
+/// Its pose block marginalised over z (prior identity) is J again.
+Eigen::MatrixXd correlated_frame_information(const Eigen::Matrix3d& info, double rho, int states);
+
+/// posterior_oracle with the carried errors in the filter (the optimal filter of the temporal model):
+/// the state is the steps' (pose first) and z behind it, z predicted by a with (1 - a^2) noise, kept
+/// through a reset. `eta` per step is the frame's whitened error (whitened_error of its info and
+/// score). `white`, when given, gets the independent filter's (posterior_oracle's) errors tallied
+/// against this filter's covariance: a ratio below 1 beyond sampling error would be a filter
+/// beating the temporal bound.
+OracleResult posterior_oracle_correlated(const std::vector<OracleStep>& steps, const std::vector<Eigen::Vector3d>& eta,
+                                         const TemporalCorrelation& tc, const Eigen::VectorXd& e0, const Eigen::MatrixXd& P0,
+                                         double settle_pos_var, OracleResult* white = nullptr);
+
 /// A point mapped to the world and matched to its nearest marking: the signed distance along the
 /// marking's normal and that normal (world frame). `kind`: 0 none, 1 segment/arc, 2 spot.
 struct MarkingMatch {
