@@ -51,6 +51,24 @@ def test_reader_gives_typed_records_with_the_share():
     assert rb.limit_m == pytest.approx(RMSE / 1.3)
 
 
+def test_the_carried_errors_are_read_and_said_and_older_blocks_say_nothing():
+    r = bounded(1.3)
+    r["bound"]["posterior"]["carried_errors"] = {"share": 0.29, "per_frame": 0.97, "lags": 30, "pairs": 1799}
+    r["bound"]["posterior_white"] = {"position_rms_m": 0.0048, "heading_rms_rad": 0.0017, "frames": 97, "share": 0.97}
+    rb = bound.read_robot_bound(r)
+    assert rb is not None and rb.bound is not None and rb.bound.carried_share == 0.29
+    assert rb.bound.posterior_white is not None and rb.bound.posterior_white.position_rms_m == 0.0048
+    assert bound.carried_errors_text(rb.bound) == ("The posterior bound carries 0.29 of each frame's error variance to the next frames "
+                                                  "(measured at the truth: the same lines at nearly the same pixels); taking the frames "
+                                                  "as independent it would be 0.48 cm.")
+    old = bound.read_robot_bound(bounded(1.3))
+    assert old is not None and old.bound is not None and old.bound.carried_share is None and old.bound.posterior_white is None
+    assert bound.carried_errors_text(old.bound) == ""
+    r["bound"]["posterior"]["carried_errors"]["share"] = 0.0  # too short a run to measure: independent frames
+    rb0 = bound.read_robot_bound(r)
+    assert rb0 is not None and rb0.bound is not None and bound.carried_errors_text(rb0.bound) == ""
+
+
 def test_a_block_from_before_the_bound_has_none_and_a_null_bound_is_never_zero():
     assert bound.read_robot_bound(scored(robot(3.9))) is None
     rb = bound.read_robot_bound(dict(scored(robot(3.9)), **no_limit_blocks()))

@@ -97,19 +97,26 @@ class Noise:
 
 @dataclass(frozen=True)
 class Bound:
-    """summary.json's "bound" block of one robot."""
+    """summary.json's "bound" block of one robot. `carried_share`: the share of each frame's error the
+    posterior bound carries to the next frames (measured from the run; 0 where it took the frames
+    as independent; None for a run scored before the bound carried errors); `posterior_white`: the
+    posterior bound with the frames taken as independent, beside for comparison."""
     single_frame: Optional[BoundFigure]
     posterior: Optional[BoundFigure]
     no_bound: NoBound
     noise: Optional[Noise]
     assumptions: Optional[str]
+    carried_share: Optional[float] = None
+    posterior_white: Optional[BoundFigure] = None
 
     @staticmethod
     def from_json(raw: JSON) -> Bound:
         b = obj(raw)
+        carried = obj(obj(b.get("posterior")).get("carried_errors"))
         return Bound(single_frame=BoundFigure.from_json(b.get("single_frame")), posterior=BoundFigure.from_json(b.get("posterior")),
                      no_bound=NoBound.from_json(b.get("no_bound")), noise=Noise.from_json(b.get("noise")),
-                     assumptions=text(b.get("assumptions")))
+                     assumptions=text(b.get("assumptions")), carried_share=number(carried.get("share")),
+                     posterior_white=BoundFigure.from_json(b.get("posterior_white")))
 
 
 @dataclass(frozen=True)
@@ -298,6 +305,17 @@ def share_text(share: Optional[float]) -> str:
 
 def cm_text(v_m: Optional[float]) -> str:
     return "-" if v_m is None else f"{100.0 * v_m:.2g} cm" if v_m < 0.1 else f"{100.0 * v_m:.0f} cm"
+
+
+def carried_errors_text(b: Bound) -> str:
+    """What the posterior bound carries from frame to frame, with the bound the frames would give taken
+    as independent: '' for a run that carried nothing or was scored before the bound carried errors."""
+    if b.carried_share is None or b.carried_share <= 0:
+        return ""
+    white = b.posterior_white.position_rms_m if b.posterior_white is not None else None
+    return (f"The posterior bound carries {b.carried_share:.2f} of each frame's error variance to the next frames (measured at the "
+            "truth: the same lines at nearly the same pixels)"
+            + (f"; taking the frames as independent it would be {cm_text(white)}" if white is not None else "") + ".")
 
 
 def limit_text(rmse_m: Optional[float], eff: Optional[float], share: Optional[float], why: Optional[str] = None) -> str:

@@ -171,10 +171,12 @@ def run_table(rep: Writer, run: Run) -> None:
         bands = [f"{a:g}-{b:g} m: {bound.cm_text(s)}" for a, b, s in zip(noise.bands_m, noise.bands_m[1:], noise.measured_sigma_m)]
         noise_text = (f" Line points' noise measured at the truth ({noise.points} points, {noise.false_points} false detections left out): "
                       + ", ".join(bands) + ".")
+    carried_text = bound.carried_errors_text(rb.bound) if rb is not None and rb.bound is not None else ""
+    carried_text = f" {carried_text}" if carried_text else ""
     rep.table(LIMIT_HEADER, rows,
               "the accuracy limit: the position RMSE over the Cramer-Rao bound of the same frames (1x is the limit; posterior bound where "
               "the run tracks), each figure with the share of scored frames it covers; 'no bound' where there is none (no truth, or no "
-              "frame with a finite bound), never 0." + noise_text + (f" Assumes: {assumptions}" if assumptions else ""))
+              "frame with a finite bound), never 0." + noise_text + carried_text + (f" Assumes: {assumptions}" if assumptions else ""))
 
 
 def aggregate_limit_cell(g: AggregateGroup, phase: bool) -> str:
