@@ -304,7 +304,8 @@ struct InfoRoots {
 };
 InfoRoots info_roots(const Eigen::Matrix3d& J) {
   InfoRoots r;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (J + J.transpose()));
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(0.5 * (J + J.transpose()));
   const Eigen::Vector3d w = es.eigenvalues();
   const double top = w.maxCoeff();
   if (!(top > 0)) return r;
@@ -333,31 +334,33 @@ Eigen::Matrix<double, 3, N> correlated_rows(const InfoRoots& r, double rho, int 
   return H;
 }
 
-// One Kalman update of the temporal model's filter on state x (pose errors first, the estimate of
-// z last) with the frame's whitened error eta: innovation eta - H x, fresh noise (1 - rho) I
-// (invertible: rho <= kMaxCarriedShare). Joseph form, so P stays symmetric and positive.
+// One update of the temporal model with a frame: rows H (pose and z), fresh noise (1 - rho) I
+// (invertible: rho <= kMaxCarriedShare). In Kalman form, P - (H P)^T S^-1 (H P) with the 3 x 3
+// innovation covariance S: the information form's (I + P Jz)^-1 P with Jz = H^T H / (1 - rho), at a
+// fraction of the cost of a solve over the whole state. `x` is the check's filter state (pose and
+// scale errors first, the estimate of z last) and `eta` the frame's whitened error, so that the
+// innovation is eta - H x; the bound's recursion, which has no state, passes zeros.
 template <class M, class V, class H3>
-void correlated_update(V& x, M& P, const H3& H, const Eigen::Vector3d& eta, double rho) {
-  const Eigen::Matrix3d R = (1.0 - rho) * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d S = H * P * H.transpose() + R;
-  const auto K = (P * H.transpose() * S.inverse()).eval();
-  x += K * (eta - H * x);
-  const M IKH = M::Identity(P.rows(), P.cols()) - K * H;
-  const M out = IKH * P * IKH.transpose() + K * R * K.transpose();
+void correlated_update(M& P, V& x, const H3& H, double rho, const Eigen::Vector3d& eta) {
+  const auto HP = (H * P).eval();
+  const Eigen::Matrix3d S = HP * H.transpose() + (1.0 - rho) * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d Si = S.inverse();
+  x += HP.transpose() * (Si * (eta - H * x));
+  const M out = P - HP.transpose() * (Si * HP);
   P = 0.5 * (out + out.transpose());
 }
 
 // The motion of the augmented state: the steps' F, Q on the first n entries; z times a, with
-// (1 - a^2) noise so that its variance stays 1.
-template <class M>
-void augment_motion(M& Fa, M& Qa, const Eigen::Ref<const Eigen::MatrixXd>& F, const Eigen::Ref<const Eigen::MatrixXd>& Q, double a) {
-  const Eigen::Index n = F.rows(), N = Fa.rows();
-  Fa.setZero();
-  Qa.setZero();
-  Fa.topLeftCorner(n, n) = F;
-  Qa.topLeftCorner(n, n) = Q;
-  Fa.bottomRightCorner(3, 3) = a * Eigen::Matrix3d::Identity();
-  Qa.bottomRightCorner(3, 3) = (1.0 - a * a) * Eigen::Matrix3d::Identity();
+// (1 - a^2) noise so that its variance stays 1. P <- Fa P Fa^T + Qa by blocks (Fa is block diagonal).
+template <class M, class MF>
+void predict_augmented(M& P, const MF& F, const MF& Q, double a) {
+  const Eigen::Index n = F.rows(), N = P.rows();
+  const MF Pnn = P.topLeftCorner(n, n);
+  P.topLeftCorner(n, n) = F * Pnn * F.transpose() + Q;
+  const auto Pnz = (a * (F * P.topRightCorner(n, 3))).eval();
+  P.topRightCorner(n, 3) = Pnz;
+  P.bottomLeftCorner(3, n) = Pnz.transpose();
+  P.bottomRightCorner(3, 3) = a * a * P.bottomRightCorner(3, 3) + (1.0 - a * a) * Eigen::Matrix3d::Identity();
   (void)N;
 }
 }  // namespace
@@ -446,7 +449,6 @@ OracleResult posterior_oracle_correlated(const std::vector<OracleStep>& steps, c
   P.bottomRightCorner(3, 3).setIdentity();
   VX ew = e0;
   MX Pw = P0;
-  MX Fa(N, N), Qa(N, N);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const OracleStep& s = steps[k];
     if (s.reset) {
@@ -455,15 +457,14 @@ OracleResult posterior_oracle_correlated(const std::vector<OracleStep>& steps, c
       P.block(n, 0, 3, 3).setZero();
       Pw = s.reset_cov;
     } else if (k > 0) {
-      augment_motion(Fa, Qa, s.F, s.Q, tc.a);
-      x = Fa * x;
-      x.head(n) += s.process_error;
-      P = Fa * P * Fa.transpose() + Qa;
+      x.head(n) = s.F * x.head(n) + s.process_error;
+      x.tail<3>() *= tc.a;
+      predict_augmented(P, s.F, s.Q, tc.a);
       ew = s.F * ew + s.process_error;
       Pw = s.F * Pw * s.F.transpose() + s.Q;
     }
     const InfoRoots ir = info_roots(s.info.topLeftCorner<3, 3>());
-    if (ir.proj.any()) correlated_update(x, P, correlated_rows<Eigen::Dynamic>(ir, tc.rho, static_cast<int>(N)), eta[k], tc.rho);
+    if (ir.proj.any()) correlated_update(P, x, correlated_rows<Eigen::Dynamic>(ir, tc.rho, static_cast<int>(N)), tc.rho, eta[k]);
     oracle_tally(x, P, settle_pos_var, r);
     if (white) {
       oracle_update(ew, Pw, s.info, s.score);
@@ -1070,7 +1071,6 @@ PosteriorSeries posterior_bounds(const std::vector<FrameRecord>& frames, const s
   PosteriorSeries out;
   std::size_t reset_at = 0;
   M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
-  M9 F9, Q9;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     F.setIdentity();
     Q.setZero();
@@ -1079,21 +1079,20 @@ PosteriorSeries posterior_bounds(const std::vector<FrameRecord>& frames, const s
       reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
       ++reset_at;
     }
-    F9.setIdentity();
-    Q9.setZero();
     if (reset) {
       reset_pose(P, uniform);
       reset_pose(P9, uniform);
     } else if (k > 0) {
       motion_model(poses[k - 1], poses[k], setup, F, Q);
-      augment_motion(F9, Q9, F, Q, tc.a);
+      if (temporal) predict_augmented(P9, F, Q, tc.a);
     }
     Jz.setZero();
     Jz.topLeftCorner<3, 3>() = info[k];
     P = posterior_step_impl<M6>(P, F, Q, Jz);
-    if (temporal) {
-      const Eigen::Matrix<double, 3, 9> H = correlated_rows<9>(roots[k], tc.rho);
-      P9 = posterior_step_impl<M9>(P9, F9, Q9, M9(H.transpose() * H / (1.0 - tc.rho)));
+    if (temporal && roots[k].proj.any()) {
+      // The check's filter's arithmetic on a state of zeros: the covariance is all the bound needs.
+      V9 none = V9::Zero();
+      correlated_update(P9, none, correlated_rows<9>(roots[k], tc.rho), tc.rho, Eigen::Vector3d::Zero());
     }
     // The recursion runs on the poses the images were exposed at; the pose scored is the frame's,
     // the latency later: carried forward through the odometry over it (its noise included). The
@@ -1158,7 +1157,6 @@ PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std
   V9 x9 = V9::Zero();
   x9.head<6>() = e;
   M6 F, Q, J = M6::Zero();
-  M9 F9, Q9;
   V6 score = V6::Zero();
   // r: at the exposure pose; scored: at the frame's pose (the latency later); c: the temporal
   // model's filter; wc: the independent filter's errors against the temporal model's covariance.
@@ -1192,10 +1190,9 @@ PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std
       e = F * e + nu;
       P = F * P * F.transpose() + Q;
       if (temporal) {
-        augment_motion(F9, Q9, F, Q, tc.a);
-        x9 = F9 * x9;
-        x9.head<6>() += nu;
-        P9 = F9 * P9 * F9.transpose() + Q9;
+        x9.head<6>() = F * x9.head<6>() + nu;
+        x9.tail<3>() *= tc.a;
+        predict_augmented(P9, F, Q, tc.a);
       }
     }
     J.topLeftCorner<3, 3>() = sf.info[k];
@@ -1203,7 +1200,7 @@ PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std
     oracle_update(e, P, J, score);
     oracle_tally(e, P, 0.25, r);
     if (temporal) {
-      if (roots[k].proj.any()) correlated_update(x9, P9, correlated_rows<9>(roots[k], tc.rho), eta[k], tc.rho);
+      if (roots[k].proj.any()) correlated_update(P9, x9, correlated_rows<9>(roots[k], tc.rho), tc.rho, eta[k]);
       const M6 Pc = P9.topLeftCorner<6, 6>();
       oracle_tally(V6(x9.head<6>()), Pc, 0.25, rc);
       oracle_tally(e, Pc, 0.25, rwc);
