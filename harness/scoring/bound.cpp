@@ -354,14 +354,13 @@ void correlated_update(M& P, V& x, const H3& H, double rho, const Eigen::Vector3
 // (1 - a^2) noise so that its variance stays 1. P <- Fa P Fa^T + Qa by blocks (Fa is block diagonal).
 template <class M, class MF>
 void predict_augmented(M& P, const MF& F, const MF& Q, double a) {
-  const Eigen::Index n = F.rows(), N = P.rows();
+  const Eigen::Index n = F.rows();
   const MF Pnn = P.topLeftCorner(n, n);
   P.topLeftCorner(n, n) = F * Pnn * F.transpose() + Q;
   const auto Pnz = (a * (F * P.topRightCorner(n, 3))).eval();
   P.topRightCorner(n, 3) = Pnz;
   P.bottomLeftCorner(3, n) = Pnz.transpose();
   P.bottomRightCorner(3, 3) = a * a * P.bottomRightCorner(3, 3) + (1.0 - a * a) * Eigen::Matrix3d::Identity();
-  (void)N;
 }
 }  // namespace
 
