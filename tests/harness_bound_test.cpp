@@ -483,6 +483,9 @@ TEST(Bound, CarriedErrorsMonteCarloFilterReachesTheBoundNoneBeatsIt) {
       if (kind == 2) e -= e.dot(along) * along;  // nothing is measured along the line
       eta[static_cast<std::size_t>(k)] = e;
       s.score = -(roots[kind] * e);  // eta = -J^{-1/2} score on J's range
+      if (t == 0) {
+        EXPECT_LT((whitened_error(s.info, s.score) - e).norm(), 1e-9) << "frame " << k;  // and back, on one line too
+      }
     }
     const OracleResult r = posterior_oracle_correlated(steps, eta, tc, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero(), 1.0, &white);
     if (t == 0) {
