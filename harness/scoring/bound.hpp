@@ -18,7 +18,11 @@
 // - camera latency is a bias, not noise: the geometry is evaluated at the pose the image was
 //   exposed at (the truth interpolated latency seconds before the frame), and the shift between
 //   the two poses is reported beside the bound, never folded into a sigma;
-// - a compass adds 1 / sigma^2 to the heading information (its declared white noise).
+// - a compass adds 1 / sigma^2 to the heading information (its declared white noise);
+// - errors carried from frame to frame (the same lines at nearly the same pixels): a share of each
+//   frame's whitened error carried on with a per-frame coefficient, both fitted to the run's own
+//   autocorrelation at the truth (TemporalCorrelation below); the posterior bound holds them as
+//   three more states, and the recursion with independent frames is kept beside for comparison.
 // Assumptions: known association, the measured noise is Gaussian and is the truth, unbiased
 // estimators. A real localizer may legitimately differ: it does not know the association (the bound
 // is then optimistic), a biased estimator (a prior, a robust cost that shrinks) can go below it, and
