@@ -467,13 +467,7 @@ OracleResult posterior_oracle_correlated(const std::vector<OracleStep>& steps, c
     oracle_tally(x, P, settle_pos_var, r);
     if (white) {
       oracle_update(ew, Pw, s.info, s.score);
-      if (P(0, 0) + P(1, 1) <= settle_pos_var) {
-        white->pos_sq += ew(0) * ew(0) + ew(1) * ew(1);
-        white->heading_sq += ew(2) * ew(2);
-        white->pos_var += P(0, 0) + P(1, 1);
-        white->heading_var += P(2, 2);
-        ++white->frames;
-      }
+      oracle_tally(ew, P, settle_pos_var, *white);
     }
   }
   return r;
@@ -495,6 +489,15 @@ namespace {
 // and `tb`: the simulation applies an event at the first physics step at or after its time, so an
 // event at a frame's own time moves the robot after that frame.
 bool moved_between(double tm, double ta, double tb) { return tm >= ta - 1e-9 && tm < tb - 1e-9; }
+
+// Per frame: whether a move without odometry fell between it and the previous frame (the posterior
+// starts again there, and no odometry increment spans it).
+std::vector<bool> resets_before(const std::vector<FrameRecord>& frames, const std::vector<double>& resets) {
+  std::vector<bool> out(frames.size(), false);
+  for (std::size_t k = 1; k < frames.size(); ++k)
+    for (double tr : resets) out[k] = out[k] || moved_between(tr, frames[k - 1].t, frames[k].t);
+  return out;
+}
 
 // A frame's line point matched at the exposure pose.
 // Kept small (64 bytes): the noise passes stream through every point of the run several times.
@@ -1056,29 +1059,23 @@ M9 augmented(const M6& P6) {
 
 // The posterior recursion over the frames: `white` takes the frames as independent; `carried` (when
 // tc.rho > 0) adds the errors they carry over (TemporalCorrelation), and is the bound put in
-// `out_frames` (else `white` is). `resets` sorted.
+// `out_frames` (else `white` is).
 struct PosteriorSeries {
   Series white, carried;
 };
 PosteriorSeries posterior_bounds(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const std::vector<Eigen::Matrix3d>& info,
-                                 const std::vector<InfoRoots>& roots, const TemporalCorrelation& tc, const std::vector<double>& resets,
+                                 const std::vector<InfoRoots>& roots, const TemporalCorrelation& tc, const std::vector<bool>& reset_before,
                                  const BoundSetup& setup, const Field& field, std::vector<FrameBound>& out_frames) {
   const Eigen::Vector3d uniform = floor_prior(field);
   M6 P = start_covariance(setup, uniform);
   const bool temporal = tc.rho > 0;
   M9 P9 = augmented(P);
   PosteriorSeries out;
-  std::size_t reset_at = 0;
   M6 F = M6::Identity(), Q = M6::Zero(), Jz = M6::Zero();
   for (std::size_t k = 0; k < frames.size(); ++k) {
     F.setIdentity();
     Q.setZero();
-    bool reset = false;
-    while (reset_at < resets.size() && k > 0 && resets[reset_at] < frames[k].t - 1e-9) {
-      reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
-      ++reset_at;
-    }
-    if (reset) {
+    if (reset_before[k]) {
       reset_pose(P, uniform);
       reset_pose(P9, uniform);
     } else if (k > 0) {
@@ -1130,11 +1127,8 @@ struct PosteriorCheck {
 };
 PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std::vector<Pose2>& poses, const SingleFrame& sf,
                                const std::vector<InfoRoots>& roots, const std::vector<Eigen::Vector3d>& eta, const TemporalCorrelation& tc,
-                               const std::vector<double>& resets, const BoundSetup& setup, const Field& field) {
+                               const std::vector<bool>& reset_before, const BoundSetup& setup, const Field& field) {
   const std::size_t nf = frames.size();
-  std::vector<bool> reset_before(nf, false);
-  for (std::size_t k = 1; k < nf; ++k)
-    for (double tr : resets) reset_before[k] = reset_before[k] || moved_between(tr, frames[k - 1].t, frames[k].t);
   Eigen::Vector3d num = Eigen::Vector3d::Zero(), den = Eigen::Vector3d::Zero();
   for (std::size_t k = 1; k < nf; ++k) {
     if (reset_before[k]) continue;
@@ -1162,13 +1156,14 @@ PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std
   OracleResult r, scored, rc, scored_c, rwc, scored_wc;
   // At the pose scored, as the posterior bound: carried over the latency by the odometry, whose
   // noise there (not recorded: the odometry is per frame) enters both sides as the model's variance.
-  const auto tally_scored = [&](const V6& err, const M6& Pk, std::size_t k, OracleResult& out) {
-    motion_model(poses[k], frames[k].truth, setup, F, Q);
-    const V6 ef = F * err;
-    const M6 Pf = F * Pk * F.transpose() + Q;
+  // Fl, Ql: the motion over the latency, once per frame for the three filters.
+  M6 Fl, Ql;
+  const auto tally_scored = [&](const V6& err, const M6& Pk, OracleResult& out) {
+    const V6 ef = Fl * err;
+    const M6 Pf = Fl * Pk * Fl.transpose() + Ql;
     if (Pf(0, 0) + Pf(1, 1) > 0.25) return;
-    out.pos_sq += ef.head<2>().squaredNorm() + Q(0, 0) + Q(1, 1);
-    out.heading_sq += ef(2) * ef(2) + Q(2, 2);
+    out.pos_sq += ef.head<2>().squaredNorm() + Ql(0, 0) + Ql(1, 1);
+    out.heading_sq += ef(2) * ef(2) + Ql(2, 2);
     out.pos_var += Pf(0, 0) + Pf(1, 1);
     out.heading_var += Pf(2, 2);
     ++out.frames;
@@ -1198,17 +1193,18 @@ PosteriorCheck posterior_check(const std::vector<FrameRecord>& frames, const std
     score.head<3>() = sf.score[k];
     oracle_update(e, P, J, score);
     oracle_tally(e, P, 0.25, r);
+    if (setup.latency_s > 0) motion_model(poses[k], frames[k].truth, setup, Fl, Ql);
     if (temporal) {
       if (roots[k].proj.any()) correlated_update(P9, x9, correlated_rows<9>(roots[k], tc.rho), tc.rho, eta[k]);
       const M6 Pc = P9.topLeftCorner<6, 6>();
       oracle_tally(V6(x9.head<6>()), Pc, 0.25, rc);
       oracle_tally(e, Pc, 0.25, rwc);
       if (setup.latency_s > 0) {
-        tally_scored(x9.head<6>(), Pc, k, scored_c);
-        tally_scored(e, Pc, k, scored_wc);
+        tally_scored(x9.head<6>(), Pc, scored_c);
+        tally_scored(e, Pc, scored_wc);
       }
     }
-    if (setup.latency_s > 0) tally_scored(e, P, k, scored);
+    if (setup.latency_s > 0) tally_scored(e, P, scored);
   }
   if (setup.latency_s <= 0) {
     scored = r;
@@ -1248,13 +1244,11 @@ struct OdometryError {
   std::vector<double> ox, oy, ot;
   double px = 0, pt = 0;  // the declared model's variance, summed over the frames
 };
-OdometryError odometry_error(const std::vector<FrameRecord>& frames, const std::vector<double>& resets, const BoundSetup& setup) {
+OdometryError odometry_error(const std::vector<FrameRecord>& frames, const std::vector<bool>& reset_before, const BoundSetup& setup) {
   OdometryError o;
   for (std::size_t k = 1; k < frames.size(); ++k) {
     const FrameRecord& r = frames[k];
-    bool reset = false;
-    for (double tr : resets) reset = reset || moved_between(tr, frames[k - 1].t, r.t);
-    if (reset) continue;
+    if (reset_before[k]) continue;
     const Pose2 u = frames[k - 1].truth.between(r.truth);
     o.ox.push_back(r.odometry.x - u.x);
     o.oy.push_back(r.odometry.y - u.y);
@@ -1344,32 +1338,23 @@ BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
   const bool compass = setup.has_heading_sensor && !cr.offsets.empty();
   const double compass_sigma = std::max(kCompassFloor, setup.heading_sigma);
   const SingleFrame sf = single_frame_bounds(frames, work, nm, compass, compass_sigma, out.frames);
-  std::vector<double> resets = setup.resets;
-  std::sort(resets.begin(), resets.end());
+  const std::vector<bool> reset_before = resets_before(frames, setup.resets);
   // The errors frames carry over to the next ones, measured from their whitened errors at the truth
   // over lags up to one second (a recursion's memory is shorter: a few frames to a second).
   std::vector<InfoRoots> roots(nf);
   std::vector<Eigen::Vector3d> eta(nf, Eigen::Vector3d::Zero());
   std::vector<bool> has_eta(nf, false);
   std::vector<int> segment(nf, 0);
-  {
-    std::size_t reset_at = 0;
-    for (std::size_t k = 0; k < nf; ++k) {
-      roots[k] = info_roots(sf.info[k]);
-      eta[k] = -(roots[k].inv_root * sf.score[k]);
-      has_eta[k] = out.frames[k].pos.has_value();
-      bool reset = false;
-      while (reset_at < resets.size() && k > 0 && resets[reset_at] < frames[k].t - 1e-9) {
-        reset = reset || moved_between(resets[reset_at], frames[k - 1].t, frames[k].t);
-        ++reset_at;
-      }
-      segment[k] = k == 0 ? 0 : segment[k - 1] + (reset ? 1 : 0);
-    }
+  for (std::size_t k = 0; k < nf; ++k) {
+    roots[k] = info_roots(sf.info[k]);
+    eta[k] = -(roots[k].inv_root * sf.score[k]);
+    has_eta[k] = out.frames[k].pos.has_value();
+    segment[k] = k == 0 ? 0 : segment[k - 1] + (reset_before[k] ? 1 : 0);
   }
   const int max_lag = static_cast<int>(std::clamp(std::lround(setup.camera_rate), 2L, 60L));
   const TemporalCorrelation tc = fit_temporal_correlation(eta, has_eta, segment, max_lag);
-  const PosteriorSeries post = posterior_bounds(frames, poses, sf.info, roots, tc, resets, setup, field, out.frames);
-  const OdometryError oe = odometry_error(frames, resets, setup);
+  const PosteriorSeries post = posterior_bounds(frames, poses, sf.info, roots, tc, reset_before, setup, field, out.frames);
+  const OdometryError oe = odometry_error(frames, reset_before, setup);
 
   // Latency: the shift between the pose the image shows and the pose scored, a bias of any
   // localizer that does not carry its estimate forward by the odometry over the latency.
@@ -1383,7 +1368,7 @@ BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
   Json& b = out.bound;
   b["single_frame"] = series_json(sf.series, scored);
   b["single_frame"]["check"] = check_json(sf);
-  const PosteriorCheck pc = posterior_check(frames, poses, sf, roots, eta, tc, resets, setup, field);
+  const PosteriorCheck pc = posterior_check(frames, poses, sf, roots, eta, tc, reset_before, setup, field);
   const char* prior = setup.start_pose_given ? "the true start pose (the localizer was given it)"
                                              : "uniform over the floor and heading (the localizer was not given its start)";
   b["posterior"] = series_json(post.carried, scored);
