@@ -139,6 +139,34 @@ TEST_F(WorldCacheTest, RunsFromTheCacheWriteTheLiveRunsFiles) {
   EXPECT_FALSE(run_with_world_cache(scenario(j3), o3, c).summary["omniloc"].contains("world_cache"));
 }
 
+// A GPU's pixels depend on the machine: an "egl" run draws live whether the file asks for it or
+// OMNILOC_GL_BACKEND does (the variable overrides every scenario's camera.backend), and an "osmesa"
+// forced over a file's "egl" is cached.
+TEST(WorldCacheEligibility, TheBackEndTheRunDrawsWithDecides) {
+  const auto with_env = [](const char* value, const Json& j) {
+    const char* old = std::getenv("OMNILOC_GL_BACKEND");
+    const std::string kept = old ? old : "";
+    if (value) ::setenv("OMNILOC_GL_BACKEND", value, 1);
+    else ::unsetenv("OMNILOC_GL_BACKEND");
+    std::string why;
+    try {
+      why = world_cache_ineligible(scenario(j), RunOptions{});
+    } catch (...) {
+      why = "(egl cannot render here)";
+    }
+    if (old) ::setenv("OMNILOC_GL_BACKEND", kept.c_str(), 1);
+    else ::unsetenv("OMNILOC_GL_BACKEND");
+    return why;
+  };
+  const Json plain = tracking_json(1.0);
+  Json egl = plain;
+  egl["camera"]["backend"] = "egl";
+  EXPECT_EQ(with_env(nullptr, plain), "");
+  EXPECT_EQ(with_env("osmesa", egl), "");
+  EXPECT_NE(with_env(nullptr, egl), "");
+  EXPECT_NE(with_env("egl", plain), "");
+}
+
 TEST_F(WorldCacheTest, ADamagedEntryIsRedrawnNeverUsed) {
   const Scenario sc = scenario(tracking_json(1.0));
   WorldCache c = cache();

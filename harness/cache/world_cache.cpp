@@ -159,7 +159,10 @@ WorldCacheOptions world_cache_from_env() {
 std::string world_cache_ineligible(const Scenario& sc, const RunOptions& opt) {
   if (sc.localizer.type() != "external" && !localizer_info(sc.localizer).needs_vision) return "a localizer without vision runs live";
   if (!opt.frames_dir.empty()) return "--frames draws the images";
-  const std::string backend = sc.camera.is_object() ? sc.camera.value("backend", std::string("osmesa")) : std::string("osmesa");
+  // The back-end the run really draws with: OMNILOC_GL_BACKEND overrides the file's camera.backend,
+  // and only the effective camera block holds the result.
+  const Json* cam = sc.effective.contains("camera") ? &sc.effective["camera"] : nullptr;
+  const std::string backend = cam && cam->is_object() ? cam->value("backend", std::string("osmesa")) : std::string("osmesa");
   if (backend != "osmesa") return "the " + backend + " renderer's pixels depend on the machine";
   return "";
 }
