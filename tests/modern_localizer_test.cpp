@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include "core/field.hpp"
+#include "core/floor_tilt.hpp"
 #include "core/rng.hpp"
 #include "harness/external_session.hpp"
 #include "harness/localizer_registry.hpp"
@@ -176,6 +177,54 @@ TEST(AlternativePoses, SimplexFitsThePoseFromAnOffsetStart) {
   EXPECT_LT(std::hypot(c.pose.x() - truth.x, c.pose.y() - truth.y), 0.02);
   EXPECT_LT(std::fabs(angle_diff(c.pose.z(), truth.theta)), 0.01);
   EXPECT_LT(c.score, 0.05);
+}
+
+// The second gate. A robot at (3, 0.3) facing +x has the penalty area's line 3.75 m ahead, square
+// to its view: there a tilt of the camera moves a point along the line's normal by (r^2 + h^2) / h,
+// 19 m per radian (10 cm at the declared 0.3 deg), so the first gate (3 sigma of a point's whole
+// spread, the tilt's included) is 30 cm wide. After 30 frames of exact points (a standing robot)
+// one frame brings the same points and seven more 15 cm in front of that line: the first gate lets
+// them through and they pull the estimate; judged once the frame's own tilt, fitted to all its
+// points, is taken out, they are 5 or more white spreads off and are left out. A frame whose points
+// are all moved by a tilt of 0.3 deg in roll and pitch (far points by up to 25 cm) is not taken for
+// outliers: the estimate moves no more with the gate than without it.
+TEST(UkfMh, PointsOffTheirMarkingOnceTheFramesTiltIsOutAreLeftOut) {
+  const Field f = Field::preset("msl2012");
+  const Pose2 truth(3.0, 0.3, 0.0);
+  Rng rng(11);
+  const std::vector<Eigen::Vector2d> clean = scenes::line_points(f, truth, 80, rng);
+  std::vector<Eigen::Vector2d> off = clean;
+  for (double y = -0.9; y <= 0.91; y += 0.3) off.emplace_back(6.75 - 0.15 - truth.x, y - truth.y);  // 15 cm short of x = 6.75
+  std::vector<Eigen::Vector2d> tilted;
+  const Eigen::Vector2d tilt(0.005, -0.005);
+  for (const auto& q : clean) tilted.push_back(q + floor_tilt_jacobian(q, 0.75) * tilt);
+  const auto shift = [&](const std::vector<Eigen::Vector2d>& last, double gate) {
+    UkfMhParams p;
+    p.white_gate_sigmas = gate;
+    p.tilt_sd = 0.3 * kPi / 180.0;
+    p.mount_height = 0.75;
+    p.latency = 0.0;
+    p.alt_tracking_restarts = 0;
+    UkfMhLocalizer loc(f, p, 1, "");
+    loc.reset(truth);
+    Observations obs;
+    for (int k = 0; k < 30; ++k) {
+      obs.t = k / 30.0;
+      obs.line_points = clean;
+      loc.update(obs, Odometry{obs.t, Pose2()}, std::nullopt);
+    }
+    obs.t = 1.0;
+    obs.line_points = last;
+    return loc.update(obs, Odometry{obs.t, Pose2()}, std::nullopt).pose;
+  };
+  const Pose2 settled = shift(clean, 4.0);
+  const double pulled = shift(off, 0.0).x - settled.x, kept = shift(off, 4.0).x - settled.x;
+  EXPECT_GT(pulled, 0.001);
+  EXPECT_LT(std::fabs(kept), 0.1 * pulled);
+  const Pose2 gate = shift(tilted, 4.0), none = shift(tilted, 0.0), settled_none = shift(clean, 0.0);
+  EXPECT_EQ(settled_none.x, settled.x);  // exact points: the gate leaves none of them out
+  EXPECT_LT(std::hypot(gate.x - settled.x, gate.y - settled.y), std::hypot(none.x - settled.x, none.y - settled.y) + 1e-4);
+  EXPECT_LT(std::fabs(gate.theta - settled.theta), std::fabs(none.theta - settled.theta) + 1e-4);
 }
 
 namespace {
@@ -552,9 +601,10 @@ TEST(UkfMh, GrazingPointSpreadsOverTheLinesWidth) {
 }
 
 // Points whose rays graze the sideline 20 cm off it (robot frame (x, -1.3) for x = 5 ... 6.6 m,
-// |n . u| = 0.19-0.25) pull the pose towards them (1.75 cm to -y with the defaults, which have no
-// grazing class); given the grazing spread of a line width / sqrt(12) they weigh less and pull it
-// less, and told a spread of 10 line widths they hardly move it.
+// |n . u| = 0.19-0.25) pull the pose towards them (1.75 cm to -y without a grazing class); given the
+// grazing spread of a line width / sqrt(12) they weigh less and pull it less, and told a spread of
+// 10 line widths they hardly move it. The point noise is pinned at 5 cm at 1.5 m and the second gate
+// is off, so that the weights below are known numbers whatever the defaults.
 TEST(UkfMh, GrazingPointsWeighLessWithTheirSpread) {
   const Field f = Field::preset("msl2012");
   const Pose2 truth(0.5, -4.5, 0.0);
@@ -570,6 +620,8 @@ TEST(UkfMh, GrazingPointsWeighLessWithTheirSpread) {
   const auto estimate = [&](const Observations& obs, double spread) {
     UkfMhParams p;
     p.grazing_spread = spread;
+    p.point_sigma = 0.05;
+    p.white_gate_sigmas = 0.0;
     p.alt_tracking_restarts = 0;  // no proposals: the one hypothesis's update alone
     UkfMhLocalizer loc(f, p, 1, "");
     loc.reset(truth);

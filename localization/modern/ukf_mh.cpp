@@ -78,6 +78,9 @@ const ParamList<UkfMhParams>& UkfMhParams::params() {
       number_param("common_sd_theta", &P::common_sd_theta, 0.0, 1.0, "rad", "where the tilt is not modelled: a frame-common heading error of the points"),
       positive_param("corridor", &P::corridor, 10.0, "m", "points farther than this from their nearest marking are not associated"),
       positive_param("gate_sigmas", &P::gate_sigmas, 100.0, "", "innovation gate of a point in standard deviations"),
+      number_param("white_gate_sigmas", &P::white_gate_sigmas, 0.0, 100.0, "",
+                   "a second gate where the tilt is modelled: a point whose residual, once the frame's tilt fitted to its points is taken out, exceeds this many of its white spread (white_sigma, its marking's offset, the pose's spread) is not that marking's; 0: none"),
+      positive_param("white_sigma", &P::white_sigma, 1.0, "m", "a line point's own spread once the frame's tilt is taken out (the second gate's unit)"),
       positive_param("inlier_sigmas", &P::inlier_sigmas, 100.0, "", "a point fits (validity) when within this many standard deviations of its marking"),
       integer_param("iterations", &P::iterations, 1, 20, "iterated update: association and linearisation again at the new mean"),
       number_param("latency", &P::latency, 0.0, 1.0, "s", "the image is this much older than the odometry; 0: moved to no time (JSON default: the camera's declared latency, the robot profile's 0.033)"),
@@ -136,6 +139,15 @@ UkfMhLocalizer::UkfMhLocalizer(const Field& field, const UkfMhParams& p, std::ui
       assoc_(field),
       alt_(p.alt, field.half_floor_x(), field.half_floor_y(), seed),
       grazing_var_(std::pow(p.grazing_spread * field.line_width, 2)) {}
+
+namespace {
+// One point's part in the frame's tilt fit (the second gate): its tilt row (m per radian), its
+// signed distance to its marking (m), its noise variance and the variance of its white residual.
+struct TiltRow {
+  Eigen::Vector2d a;
+  double v, var, white_var;
+};
+}  // namespace
 
 double incidence_variance(double own_var, const Eigen::Vector2d& ray, const Eigen::Vector2d& normal, double grazing_below, double grazing_var) {
   return std::fabs(ray.dot(normal)) < grazing_below ? own_var + grazing_var : own_var;
@@ -234,9 +246,9 @@ bool UkfMhLocalizer::contradicted(const Eigen::Vector3d& q, std::optional<double
   return false;
 }
 
-double UkfMhLocalizer::point_variance(const Eigen::Vector2d& o) const {
+double UkfMhLocalizer::point_variance(const Eigen::Vector2d& o, double sigma) const {
   const double d2 = p_.weight_d * p_.weight_d;
-  return p_.point_sigma * p_.point_sigma * (d2 + o.squaredNorm()) / (d2 + p_.weight_ref * p_.weight_ref);
+  return sigma * sigma * (d2 + o.squaredNorm()) / (d2 + p_.weight_ref * p_.weight_ref);
 }
 
 double UkfMhLocalizer::noise_variance(std::size_t i, double own, const Eigen::Vector2d& g, double c, double s) const {
@@ -258,7 +270,7 @@ double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q) const {
     if (m.marking < 0) continue;
     const Eigen::Vector2d g = m.gradient(w);
     const double tilt_var = tilt_variance(i, g, c, s, nullptr);
-    const double own = noise_variance(i, point_variance(o), g, c, s);
+    const double own = noise_variance(i, point_variance(o, p_.point_sigma), g, c, s);
     if (m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (own + common_var + tilt_var)) ++fit;
   }
   return static_cast<double>(fit) / static_cast<double>(pts.size());
@@ -271,13 +283,53 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   const double common_var = p_.common_xy_var();
   thread_local std::vector<double> own_var;
   own_var.resize(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) own_var[i] = point_variance(pts[i]);
+  for (std::size_t i = 0; i < pts.size(); ++i) own_var[i] = point_variance(pts[i], p_.point_sigma);
   // Points on one marking share an offset of standard deviation marking_sd (in metres, the same for
   // each of them, as the accuracy bound measures it); what is left of a point's variance is its own
   // (never below half of it: a shared part larger than the whole is a contradiction of parameters).
   const double shared_var = p_.marking_sd * p_.marking_sd;
+  const bool white_gate = p_.white_gate_sigmas > 0 && !tilt_.empty();
   const auto linearise = [&](const Eigen::Vector3d& at, const SigmaPoints& sp, InformationSum& sum) {
     const double c = std::cos(at.z()), s = std::sin(at.z());
+    // The frame's tilt fitted to its points at this pose (the first gate's survivors, weighted by
+    // their noise, with the tilt's prior): what is left of a point's residual after it is that
+    // point's own error, whose spread is small (the far points' large spread is the tilt's).
+    Eigen::Vector2d tilt_hat = Eigen::Vector2d::Zero();
+    if (white_gate) {
+      // Each first-gate survivor's tilt row, residual and variances, then the fit twice: the second
+      // time without the points the first fit leaves beyond the gate (a far outlier's large
+      // lever on the tilt would otherwise hide part of it).
+      thread_local std::vector<TiltRow> rows;
+      rows.clear();
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const Eigen::Vector2d& o = pts[i];
+        const Eigen::Vector2d w(at.x() + c * o.x() - s * o.y(), at.y() + s * o.x() + c * o.y());
+        const LocalMarking m = assoc_.associate(w);
+        if (m.marking < 0 || m.distance > p_.corridor) continue;
+        TiltRow r;
+        const Eigen::Vector2d g = m.gradient(w);
+        const double tilt_var = tilt_variance(i, g, c, s, &r.a);
+        r.var = noise_variance(i, own_var[i], g, c, s);
+        r.v = m.value(w.x(), w.y());
+        if (r.v * r.v > p_.gate_sigmas * p_.gate_sigmas * (r.var + tilt_var + common_var)) continue;
+        r.white_var = p_.white_sigma * p_.white_sigma + (r.var - own_var[i]) + shared_var;
+        rows.push_back(r);
+      }
+      const Eigen::Matrix2d prior = Eigen::Matrix2d::Identity() / (p_.tilt_sd * p_.tilt_sd);
+      for (int pass = 0; pass < 2; ++pass) {
+        Eigen::Matrix2d ai = prior;
+        Eigen::Vector2d ar = Eigen::Vector2d::Zero();
+        for (const TiltRow& r : rows) {
+          if (pass > 0) {
+            const double white = r.v + r.a.dot(tilt_hat);
+            if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * r.white_var) continue;
+          }
+          ai.noalias() += r.a * r.a.transpose() / r.var;
+          ar.noalias() -= r.a * (r.v / r.var);
+        }
+        tilt_hat = ai.ldlt().solve(ar);
+      }
+    }
     std::array<double, 6> cs{}, sn{};
     for (int k = 0; k < 6; ++k) cs[static_cast<std::size_t>(k)] = std::cos(sp[k].z()), sn[static_cast<std::size_t>(k)] = std::sin(sp[k].z());
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -298,6 +350,11 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
       // The gate: the innovation against its whole spread (pose, point, tilt, frame-common error).
       const double spread = pr.var + var + tilt_var + common_var;
       if (pr.mean * pr.mean > p_.gate_sigmas * p_.gate_sigmas * spread) continue;
+      if (white_gate) {
+        const double white = m.value(w.x(), w.y()) + a.dot(tilt_hat);
+        const double white_var = p_.white_sigma * p_.white_sigma + (var - own_var[i]) + shared_var + pr.var;
+        if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * white_var) continue;
+      }
       if (shared_var > 0)
         sp.add(hv, pr, 0.0, std::max(var - shared_var, 0.5 * var), sum, tilt_.empty() ? nullptr : &a, m.marking, p_.marking_sd);
       else

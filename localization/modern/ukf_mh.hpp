@@ -53,7 +53,7 @@ struct UkfMhParams {
   // Measurements.
   int max_points = 100;          ///< line points evenly subsampled beyond this (cost; the common error dominates beyond)
   int min_points = 10;           ///< fewer: no sensor update (matching's default; NuBot > 15, CAMBADA > 5)
-  double point_sigma = 0.05;     ///< m: a line point's own noise at range weight_ref (matching's point_sigma)
+  double point_sigma = 0.015;    ///< m: a line point's own noise at range weight_ref (the accuracy bound's white noise, measured)
   double weight_d = 2.5;         ///< m: point noise grows as (weight_d^2 + r^2) (NuBot's range weights)
   double weight_ref = 1.5;       ///< m: the range at which the noise is point_sigma (NuBot)
   double grazing_below = 0.3;    ///< |n.u| (marking normal, scan ray) below which the ray meets the marking at a grazing angle
@@ -65,6 +65,8 @@ struct UkfMhParams {
   double common_sd_theta = 0.01; ///< rad
   double corridor = 0.5;         ///< m: points farther from their marking are not associated
   double gate_sigmas = 3.0;      ///< innovation gate in standard deviations
+  double white_gate_sigmas = 4.0;  ///< second gate: a point's residual with the frame's own tilt taken out, in white spreads; 0: none
+  double white_sigma = 0.015;    ///< m: a point's own spread once the frame's tilt is taken out (the accuracy bound's white noise)
   double inlier_sigmas = 3.0;    ///< a point fits when within this many standard deviations of its marking
   int iterations = 2;            ///< iterated update: association and linearisation again at the new mean
   double latency = 0.0;          ///< s: the image is this much older than the odometry (JSON default: the camera's declared latency)
@@ -123,7 +125,9 @@ class UkfMhLocalizer : public Localizer {
   /// of cosine c and sine s; `a` (optional): the distance's change per radian of tilt.
   double tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const;
   void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
-  double point_variance(const Eigen::Vector2d& o) const;
+  /// A point's own noise variance (m^2) at o (robot frame, m): `sigma` at range weight_ref, grown
+  /// with the range as NuBot's weights say.
+  double point_variance(const Eigen::Vector2d& o, double sigma) const;
   /// Point i's variance (its own, `own`, plus the grazing term) against a marking of normal g (world)
   /// at a heading of cosine c and sine s.
   double noise_variance(std::size_t i, double own, const Eigen::Vector2d& g, double c, double s) const;
