@@ -141,11 +141,14 @@ UkfMhLocalizer::UkfMhLocalizer(const Field& field, const UkfMhParams& p, std::ui
       grazing_var_(std::pow(p.grazing_spread * field.line_width, 2)) {}
 
 namespace {
-// One point's part in the frame's tilt fit (the second gate): its tilt row (m per radian), its
-// signed distance to its marking (m), its noise variance and the variance of its white residual.
-struct TiltRow {
-  Eigen::Vector2d a;
-  double v, var, white_var;
+// One point of a frame placed at a linearisation pose: its marking's local model there and what the
+// update and the second gate read of it.
+struct PointAt {
+  LocalMarking m;
+  Eigen::Vector2d w{0.0, 0.0}, a{0.0, 0.0};  ///< world position (m); d(distance)/d(tilt) (m/rad)
+  double var = 0.0, tilt_var = 0.0;          ///< its noise variance, and the tilt's (m^2)
+  double v = 0.0, white_var = 0.0;           ///< second gate: signed distance (m), white variance (m^2)
+  bool ok = false, in_fit = false;           ///< associated within the corridor; in the tilt's fit
 };
 }  // namespace
 
@@ -289,76 +292,81 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   // (never below half of it: a shared part larger than the whole is a contradiction of parameters).
   const double shared_var = p_.marking_sd * p_.marking_sd;
   const bool white_gate = p_.white_gate_sigmas > 0 && !tilt_.empty();
+  // Point i placed at the linearisation pose (heading cosine c, sine s) and associated; its model
+  // there when within the corridor (q.ok).
+  const auto place = [&](std::size_t i, const Eigen::Vector3d& at, double c, double s, PointAt& q) {
+    const Eigen::Vector2d& o = pts[i];
+    q.w = Eigen::Vector2d(at.x() + c * o.x() - s * o.y(), at.y() + s * o.x() + c * o.y());
+    q.m = assoc_.associate(q.w);
+    q.ok = q.m.marking >= 0 && q.m.distance <= p_.corridor;
+    if (!q.ok) return;
+    const Eigen::Vector2d g = q.m.gradient(q.w);
+    q.tilt_var = tilt_variance(i, g, c, s, &q.a);
+    q.var = noise_variance(i, own_var[i], g, c, s);
+  };
   const auto linearise = [&](const Eigen::Vector3d& at, const SigmaPoints& sp, InformationSum& sum) {
     const double c = std::cos(at.z()), s = std::sin(at.z());
     // The frame's tilt fitted to its points at this pose (the first gate's survivors, weighted by
     // their noise, with the tilt's prior): what is left of a point's residual after it is that
-    // point's own error, whose spread is small (the far points' large spread is the tilt's).
+    // point's own error, whose spread is small (the far points' large spread is the tilt's). Fitted
+    // twice: the second time without the points the first fit leaves beyond the gate (a far
+    // outlier's long lever on the tilt would otherwise hide part of its residual). The points'
+    // placement is kept for the update below.
     Eigen::Vector2d tilt_hat = Eigen::Vector2d::Zero();
+    thread_local std::vector<PointAt> placed;
     if (white_gate) {
-      // Each first-gate survivor's tilt row, residual and variances, then the fit twice: the second
-      // time without the points the first fit leaves beyond the gate (a far outlier's large
-      // lever on the tilt would otherwise hide part of it).
-      thread_local std::vector<TiltRow> rows;
-      rows.clear();
+      placed.resize(pts.size());
       for (std::size_t i = 0; i < pts.size(); ++i) {
-        const Eigen::Vector2d& o = pts[i];
-        const Eigen::Vector2d w(at.x() + c * o.x() - s * o.y(), at.y() + s * o.x() + c * o.y());
-        const LocalMarking m = assoc_.associate(w);
-        if (m.marking < 0 || m.distance > p_.corridor) continue;
-        TiltRow r;
-        const Eigen::Vector2d g = m.gradient(w);
-        const double tilt_var = tilt_variance(i, g, c, s, &r.a);
-        r.var = noise_variance(i, own_var[i], g, c, s);
-        r.v = m.value(w.x(), w.y());
-        if (r.v * r.v > p_.gate_sigmas * p_.gate_sigmas * (r.var + tilt_var + common_var)) continue;
-        r.white_var = p_.white_sigma * p_.white_sigma + (r.var - own_var[i]) + shared_var;
-        rows.push_back(r);
+        PointAt& q = placed[i];
+        place(i, at, c, s, q);
+        if (!q.ok) continue;
+        q.v = q.m.value(q.w.x(), q.w.y());
+        q.in_fit = q.v * q.v <= p_.gate_sigmas * p_.gate_sigmas * (q.var + q.tilt_var + common_var);
+        q.white_var = p_.white_sigma * p_.white_sigma + (q.var - own_var[i]) + shared_var;
       }
       const Eigen::Matrix2d prior = Eigen::Matrix2d::Identity() / (p_.tilt_sd * p_.tilt_sd);
       for (int pass = 0; pass < 2; ++pass) {
         Eigen::Matrix2d ai = prior;
         Eigen::Vector2d ar = Eigen::Vector2d::Zero();
-        for (const TiltRow& r : rows) {
+        for (const PointAt& q : placed) {
+          if (!q.ok || !q.in_fit) continue;
           if (pass > 0) {
-            const double white = r.v + r.a.dot(tilt_hat);
-            if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * r.white_var) continue;
+            const double white = q.v + q.a.dot(tilt_hat);
+            if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * q.white_var) continue;
           }
-          ai.noalias() += r.a * r.a.transpose() / r.var;
-          ar.noalias() -= r.a * (r.v / r.var);
+          ai.noalias() += q.a * q.a.transpose() / q.var;
+          ar.noalias() -= q.a * (q.v / q.var);
         }
         tilt_hat = ai.ldlt().solve(ar);
       }
     }
     std::array<double, 6> cs{}, sn{};
     for (int k = 0; k < 6; ++k) cs[static_cast<std::size_t>(k)] = std::cos(sp[k].z()), sn[static_cast<std::size_t>(k)] = std::sin(sp[k].z());
+    PointAt here;
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const Eigen::Vector2d& o = pts[i];
-      const Eigen::Vector2d w(at.x() + c * o.x() - s * o.y(), at.y() + s * o.x() + c * o.y());
-      const LocalMarking m = assoc_.associate(w);
-      if (m.marking < 0 || m.distance > p_.corridor) continue;
+      if (!white_gate) place(i, at, c, s, here);
+      const PointAt& q = white_gate ? placed[i] : here;
+      if (!q.ok) continue;
+      const LocalMarking& m = q.m;
       std::array<double, 6> hv{};
       for (int k = 0; k < 6; ++k) {
         const auto ku = static_cast<std::size_t>(k);
         hv[ku] = m.value(sp[k].x() + cs[ku] * o.x() - sn[ku] * o.y(), sp[k].y() + sn[ku] * o.x() + cs[ku] * o.y());
       }
       const SigmaPoints::Predicted pr = sp.predict(hv);
-      Eigen::Vector2d a;
-      const Eigen::Vector2d g = m.gradient(w);
-      const double tilt_var = tilt_variance(i, g, c, s, &a);
-      const double var = noise_variance(i, own_var[i], g, c, s);
       // The gate: the innovation against its whole spread (pose, point, tilt, frame-common error).
-      const double spread = pr.var + var + tilt_var + common_var;
+      const double spread = pr.var + q.var + q.tilt_var + common_var;
       if (pr.mean * pr.mean > p_.gate_sigmas * p_.gate_sigmas * spread) continue;
       if (white_gate) {
-        const double white = m.value(w.x(), w.y()) + a.dot(tilt_hat);
-        const double white_var = p_.white_sigma * p_.white_sigma + (var - own_var[i]) + shared_var + pr.var;
-        if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * white_var) continue;
+        const double white = q.v + q.a.dot(tilt_hat);
+        if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * (q.white_var + pr.var)) continue;
       }
+      Eigen::Vector2d a = q.a;
       if (shared_var > 0)
-        sp.add(hv, pr, 0.0, std::max(var - shared_var, 0.5 * var), sum, tilt_.empty() ? nullptr : &a, m.marking, p_.marking_sd);
+        sp.add(hv, pr, 0.0, std::max(q.var - shared_var, 0.5 * q.var), sum, tilt_.empty() ? nullptr : &a, m.marking, p_.marking_sd);
       else
-        sp.add(hv, pr, 0.0, var, sum, tilt_.empty() ? nullptr : &a);
+        sp.add(hv, pr, 0.0, q.var, sum, tilt_.empty() ? nullptr : &a);
     }
   };
   Eigen::Matrix3d common = Eigen::Matrix3d::Zero();
