@@ -341,3 +341,26 @@ def test_gate_a_recording_without_truth_has_no_bound(tmp_path):
     p = run_gate(tmp_path, tmp_path / "r", [{"metric": "efficiency/position", "max": 1.5}])
     assert p.returncode == 1, p.stdout + p.stderr
     assert "FAIL  nubot_robot1 / matching  r0/efficiency/position  no bound (n=0 of 1)" in p.stdout and "[no bound in 1 of 1 runs]" in p.stdout, p.stdout
+
+
+def test_the_modern_references_target_is_said_with_the_bounds_own_filter_beside(tmp_path):
+    def side(folder, effs, check, scenario):
+        for seed, eff in enumerate(effs, 1):
+            r = bounded(eff)
+            if check is not None:
+                r["bound"]["posterior"]["check"] = {"position_ratio": check, "heading_ratio": 1.0}
+            write_run(pathlib.Path(folder) / f"s{seed}", scenario, "ukf_mh", seed, {}, r, start_pose_given=True, scoring=SCORING)
+    side(tmp_path / "t", [1.0, 1.2], 1.05, "tracking")
+    side(tmp_path / "o", [1.4, 1.6], 1.25, "occlusion_002")
+    runs = [r for g in discover([tmp_path]) for r in g]
+    assert limit.reference_sentence(runs) == (
+        "The modern reference ukf_mh is, against its target of 1.3x the limit, within it on tracking (1.10x); above it on "
+        "occlusion (1.50x), where the bound's own filter on the same frames (true association, the measured noise) is at 1.25x: "
+        "ukf_mh is 1.20x what that filter has.")
+    # Results without the modern reference, or made before the bound's check, say so or nothing.
+    assert limit.reference_sentence([r for r in runs if r.scenario == "tracking"]).endswith("within it on tracking (1.10x).")
+    side(tmp_path / "n", [1.5], None, "occlusion_002")
+    only = [r for g in discover([tmp_path / "n"]) for r in g]
+    assert limit.reference_sentence(only).endswith("above it on occlusion (1.50x; no check of the bound's own filter in these results).")
+    write_side(tmp_path / "m", [1.4], localizer="matching")
+    assert limit.reference_sentence([r for g in discover([tmp_path / "m"]) for r in g]) == ""

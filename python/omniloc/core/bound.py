@@ -100,7 +100,9 @@ class Bound:
     """summary.json's "bound" block of one robot. `carried_share`: the share of each frame's error the
     posterior bound carries to the next frames (measured from the run; 0 where it took the frames
     as independent; None for a run scored before the bound carried errors); `posterior_white`: the
-    posterior bound with the frames taken as independent, beside for comparison."""
+    posterior bound with the frames taken as independent, beside for comparison; `check_position`:
+    the bound's own filter on the run's data (true association, the measured noise) against the
+    posterior bound, position RMSE / bound (None where the run has no such check)."""
     single_frame: Optional[BoundFigure]
     posterior: Optional[BoundFigure]
     no_bound: NoBound
@@ -108,15 +110,18 @@ class Bound:
     assumptions: Optional[str]
     carried_share: Optional[float] = None
     posterior_white: Optional[BoundFigure] = None
+    check_position: Optional[float] = None
 
     @staticmethod
     def from_json(raw: JSON) -> Bound:
         b = obj(raw)
-        carried = obj(obj(b.get("posterior")).get("carried_errors"))
+        post = obj(b.get("posterior"))
+        carried = obj(post.get("carried_errors"))
         return Bound(single_frame=BoundFigure.from_json(b.get("single_frame")), posterior=BoundFigure.from_json(b.get("posterior")),
                      no_bound=NoBound.from_json(b.get("no_bound")), noise=Noise.from_json(b.get("noise")),
                      assumptions=text(b.get("assumptions")), carried_share=number(carried.get("share")),
-                     posterior_white=BoundFigure.from_json(b.get("posterior_white")))
+                     posterior_white=BoundFigure.from_json(b.get("posterior_white")),
+                     check_position=number(obj(post.get("check")).get("position_ratio")))
 
 
 @dataclass(frozen=True)

@@ -127,4 +127,7 @@ def headline(rep: Writer, ctx: Context, claims: Sequence[Claim], field_claims: O
     near = limit.headline_sentence(ctx.runs)  # results made before the bound: nothing
     if near:
         parts.append(near)
+    reference = limit.reference_sentence(ctx.runs)
+    if reference:
+        parts.append(reference)
     rep.para("**In short.** " + " ".join(parts), "headline", "headline")
