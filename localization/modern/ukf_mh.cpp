@@ -249,9 +249,9 @@ bool UkfMhLocalizer::contradicted(const Eigen::Vector3d& q, std::optional<double
   return false;
 }
 
-double UkfMhLocalizer::point_variance(const Eigen::Vector2d& o, double sigma) const {
+double UkfMhLocalizer::point_variance(const Eigen::Vector2d& o) const {
   const double d2 = p_.weight_d * p_.weight_d;
-  return sigma * sigma * (d2 + o.squaredNorm()) / (d2 + p_.weight_ref * p_.weight_ref);
+  return p_.point_sigma * p_.point_sigma * (d2 + o.squaredNorm()) / (d2 + p_.weight_ref * p_.weight_ref);
 }
 
 double UkfMhLocalizer::noise_variance(std::size_t i, double own, const Eigen::Vector2d& g, double c, double s) const {
@@ -273,7 +273,7 @@ double UkfMhLocalizer::inlier_share(const Eigen::Vector3d& q) const {
     if (m.marking < 0) continue;
     const Eigen::Vector2d g = m.gradient(w);
     const double tilt_var = tilt_variance(i, g, c, s, nullptr);
-    const double own = noise_variance(i, point_variance(o, p_.point_sigma), g, c, s);
+    const double own = noise_variance(i, point_variance(o), g, c, s);
     if (m.distance * m.distance <= p_.inlier_sigmas * p_.inlier_sigmas * (own + common_var + tilt_var)) ++fit;
   }
   return static_cast<double>(fit) / static_cast<double>(pts.size());
@@ -286,7 +286,7 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
   const double common_var = p_.common_xy_var();
   thread_local std::vector<double> own_var;
   own_var.resize(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) own_var[i] = point_variance(pts[i], p_.point_sigma);
+  for (std::size_t i = 0; i < pts.size(); ++i) own_var[i] = point_variance(pts[i]);
   // Points on one marking share an offset of standard deviation marking_sd (in metres, the same for
   // each of them, as the accuracy bound measures it); what is left of a point's variance is its own
   // (never below half of it: a shared part larger than the whole is a contradiction of parameters).
@@ -362,11 +362,10 @@ void UkfMhLocalizer::sensor_update(Hypothesis& h, const std::vector<Eigen::Vecto
         const double white = q.v + q.a.dot(tilt_hat);
         if (white * white > p_.white_gate_sigmas * p_.white_gate_sigmas * (q.white_var + pr.var)) continue;
       }
-      Eigen::Vector2d a = q.a;
       if (shared_var > 0)
-        sp.add(hv, pr, 0.0, std::max(q.var - shared_var, 0.5 * q.var), sum, tilt_.empty() ? nullptr : &a, m.marking, p_.marking_sd);
+        sp.add(hv, pr, 0.0, std::max(q.var - shared_var, 0.5 * q.var), sum, tilt_.empty() ? nullptr : &q.a, m.marking, p_.marking_sd);
       else
-        sp.add(hv, pr, 0.0, q.var, sum, tilt_.empty() ? nullptr : &a);
+        sp.add(hv, pr, 0.0, q.var, sum, tilt_.empty() ? nullptr : &q.a);
     }
   };
   Eigen::Matrix3d common = Eigen::Matrix3d::Zero();

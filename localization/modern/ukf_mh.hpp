@@ -125,9 +125,9 @@ class UkfMhLocalizer : public Localizer {
   /// of cosine c and sine s; `a` (optional): the distance's change per radian of tilt.
   double tilt_variance(std::size_t i, const Eigen::Vector2d& g, double c, double s, Eigen::Vector2d* a) const;
   void sensor_update(Hypothesis& h, const std::vector<Eigen::Vector2d>& pts, std::optional<double> heading, const Observations& obs, double dt);
-  /// A point's own noise variance (m^2) at o (robot frame, m): `sigma` at range weight_ref, grown
-  /// with the range as NuBot's weights say.
-  double point_variance(const Eigen::Vector2d& o, double sigma) const;
+  /// A point's own noise variance (m^2) at o (robot frame, m): point_sigma at range weight_ref,
+  /// grown with the range as NuBot's weights say.
+  double point_variance(const Eigen::Vector2d& o) const;
   /// Point i's variance (its own, `own`, plus the grazing term) against a marking of normal g (world)
   /// at a heading of cosine c and sine s.
   double noise_variance(std::size_t i, double own, const Eigen::Vector2d& g, double c, double s) const;
