@@ -324,6 +324,10 @@ InfoRoots info_roots(const Eigen::Matrix3d& J) {
   return r;
 }
 
+// The frame's whitened error J^{1/2} e from its score, e = -J^+ score (whitened_error's formula, for
+// roots already made).
+Eigen::Vector3d whitened(const InfoRoots& r, const Eigen::Vector3d& score) { return -(r.inv_root * score); }
+
 // The frame's rows H = [J^{1/2}, 0, sqrt(rho) Pi] on a state of N entries (pose first, z last); the
 // fresh part's covariance is (1 - rho) I.
 template <int N>
@@ -364,7 +368,7 @@ void predict_augmented(M& P, const MF& F, const MF& Q, double a) {
 }
 }  // namespace
 
-Eigen::Vector3d whitened_error(const Eigen::Matrix3d& info, const Eigen::Vector3d& score) { return -(info_roots(info).inv_root * score); }
+Eigen::Vector3d whitened_error(const Eigen::Matrix3d& info, const Eigen::Vector3d& score) { return whitened(info_roots(info), score); }
 
 TemporalCorrelation fit_temporal_correlation(const std::vector<Eigen::Vector3d>& eta, const std::vector<bool>& has,
                                              const std::vector<int>& segment, int max_lag) {
@@ -1077,7 +1081,7 @@ PosteriorSeries posterior_bounds(const std::vector<FrameRecord>& frames, const s
     Q.setZero();
     if (reset_before[k]) {
       reset_pose(P, uniform);
-      reset_pose(P9, uniform);
+      if (temporal) reset_pose(P9, uniform);
     } else if (k > 0) {
       motion_model(poses[k - 1], poses[k], setup, F, Q);
       if (temporal) predict_augmented(P9, F, Q, tc.a);
@@ -1097,7 +1101,7 @@ PosteriorSeries posterior_bounds(const std::vector<FrameRecord>& frames, const s
     if (setup.latency_s > 0) {
       motion_model(poses[k], frames[k].truth, setup, F, Q);
       Pf = F * P * F.transpose() + Q;
-      Pf9 = F * Pf9 * F.transpose() + Q;
+      if (temporal) Pf9 = F * Pf9 * F.transpose() + Q;
     }
     const auto add = [](Series& sr, const M6& C) {
       sr.pos.push_back(std::sqrt(std::max(0.0, C(0, 0) + C(1, 1))));
@@ -1347,7 +1351,7 @@ BoundPart bound_part(const RobotRecord& robot, const BoundSetup& setup) {
   std::vector<int> segment(nf, 0);
   for (std::size_t k = 0; k < nf; ++k) {
     roots[k] = info_roots(sf.info[k]);
-    eta[k] = -(roots[k].inv_root * sf.score[k]);
+    eta[k] = whitened(roots[k], sf.score[k]);
     has_eta[k] = out.frames[k].pos.has_value();
     segment[k] = k == 0 ? 0 : segment[k - 1] + (reset_before[k] ? 1 : 0);
   }
