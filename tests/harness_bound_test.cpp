@@ -203,6 +203,39 @@ TEST(Bound, NoiseOfALargeSampleIsTheExactMedianAbsoluteDeviation) {
   }
 }
 
+// After a kidnap the posterior bound of the blind frames is an average over where the robot may be
+// put, which one run's error can lie below: the efficiency over all frames says so where it stands,
+// and only when the run had a kidnap.
+TEST(Bound, AKidnapRunsAllFramesEfficiencySaysToReadTheTrackingPhase) {
+  const Field f = cross_field();
+  const Pose2 pose(0.5, 0.7, 0.2);
+  RobotRecord rec;
+  for (int k = 0; k < 10; ++k) {
+    FrameRecord r;
+    r.t = 0.1 * k;
+    r.truth = pose;
+    r.est = pose;
+    r.valid = true;
+    r.camera_ok = true;
+    for (const auto& w : kCross) {
+      const Eigen::Vector2d p = pose.inverse_transform(w);
+      r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
+    }
+    rec.frames.push_back(r);
+  }
+  BoundSetup setup;
+  setup.field = &f;
+  setup.start_pose_given = true;
+  EXPECT_FALSE(bound_robot(rec, setup).efficiency.contains("all_frames_note"));
+  setup.resets = {0.45};
+  setup.excluded = {{0.45, 0.65}};
+  const RobotBound b = bound_robot(rec, setup);
+  EXPECT_TRUE(b.efficiency.contains("all_frames_note"));
+  EXPECT_TRUE(b.efficiency.contains("tracking_phase"));
+  setup.has_odometry = false;  // against the single-frame bound, which a kidnap does not reset
+  EXPECT_FALSE(bound_robot(rec, setup).efficiency.contains("all_frames_note"));
+}
+
 // A compass adds exactly 1 / sigma^2 to the heading information: with the diagonal geometry above
 // the heading variance goes from sigma_p^2 / 43 to 1 / (43 / sigma_p^2 + 1 / sigma_c^2).
 TEST(Bound, CompassAddsItsInformation) {
