@@ -40,8 +40,9 @@ constexpr std::size_t kClasses = 2 * kBands;
 // A class measured from fewer points takes its band's pooled figure.
 constexpr std::size_t kMinClassPoints = 30;
 
-// The k-th smallest of v's values (0-based) and, with `lower`, the (k-1)-th (k >= 1): exactly the
-// values nth_element finds, the same bytes. On a large sample nth_element over the whole of it is
+// The k-th smallest of v's values (0-based) and, with `lower`, the (k-1)-th (k >= 1): the values
+// nth_element finds, the same bytes (of a -0 and a +0 at the rank, either may come back, as from
+// nth_element itself). On a large sample nth_element over the whole of it is
 // mostly cache misses and mispredicted branches (the noise passes take medians of up to 150 000
 // residuals), so a sample of kSelectSample values brackets the rank (4 sigma of the sample quantile
 // either side), one branch-free pass keeps what lies in the bracket and counts what lies below, and
