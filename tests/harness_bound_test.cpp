@@ -39,6 +39,20 @@ std::vector<BoundRow> rows_at(const Field& f, const Pose2& pose, const std::vect
   return rows;
 }
 
+// A frame at time t whose line points are the world points `world` seen from `pose` (as floats, as
+// the camera's are).
+FrameRecord frame_seeing(const Pose2& pose, const std::vector<Eigen::Vector2d>& world, double t, bool camera_ok) {
+  FrameRecord r;
+  r.t = t;
+  r.truth = pose;
+  r.camera_ok = camera_ok;
+  for (const auto& w : world) {
+    const Eigen::Vector2d p = pose.inverse_transform(w);
+    r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
+  }
+  return r;
+}
+
 // Points at x = +-2, +-3 on the x axis and y = +-1.5, +-2.5 on the y axis.
 const std::vector<Eigen::Vector2d> kCross = {{2, 0}, {-2, 0}, {3, 0}, {-3, 0}, {0, 1.5}, {0, -1.5}, {0, 2.5}, {0, -2.5}};
 
@@ -74,15 +88,7 @@ TEST(Bound, OneLineIsUnboundedAndSaysWhy) {
 
   RobotRecord rec;
   const auto frame = [&](const std::vector<Eigen::Vector2d>& world, bool ok) {
-    FrameRecord r;
-    r.t = 0.1 * static_cast<double>(rec.frames.size());
-    r.truth = pose;
-    r.camera_ok = ok;
-    for (const auto& w : world) {
-      const Eigen::Vector2d p = pose.inverse_transform(w);
-      r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
-    }
-    rec.frames.push_back(r);
+    rec.frames.push_back(frame_seeing(pose, world, 0.1 * static_cast<double>(rec.frames.size()), ok));
   };
   // Float points are not exactly on the lines: the run's measured noise is that rounding.
   frame({{2, 0}, {-2, 0}, {3, 0}, {0, 1.5}, {0, -1.5}, {0, 2.5}}, true);
@@ -211,16 +217,9 @@ TEST(Bound, AKidnapRunsAllFramesEfficiencySaysToReadTheTrackingPhase) {
   const Pose2 pose(0.5, 0.7, 0.2);
   RobotRecord rec;
   for (int k = 0; k < 10; ++k) {
-    FrameRecord r;
-    r.t = 0.1 * k;
-    r.truth = pose;
+    FrameRecord r = frame_seeing(pose, kCross, 0.1 * k, true);
     r.est = pose;
     r.valid = true;
-    r.camera_ok = true;
-    for (const auto& w : kCross) {
-      const Eigen::Vector2d p = pose.inverse_transform(w);
-      r.line_points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y())});
-    }
     rec.frames.push_back(r);
   }
   BoundSetup setup;
