@@ -133,7 +133,10 @@ static void BM_RecordTracking10s(benchmark::State& state) {
 BENCHMARK(BM_RecordTracking10s)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 // The accuracy bound (harness/scoring/bound.hpp) alone on the same 1801 frames, as scoring computes
-// it after a replay: its cost beside BM_ReplayTrackingMatching's (it must stay under 5 % of it).
+// it after a replay whose frames' bound is not kept: what the first replay of frames made elsewhere
+// pays once. Every other replay reads it from the bound cache (BM_BoundCacheWarmOnTrackingFrames
+// below): that is what must stay under 5 % of BM_ReplayTrackingMatchingBoundCached
+// (docs/results.md "Cost.").
 struct BoundInput {
   harness::Scenario sc;
   harness::RobotRecord rec;
