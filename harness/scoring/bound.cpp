@@ -772,7 +772,7 @@ Json efficiency_json(const RobotRecord& robot, const std::vector<std::optional<d
 namespace {
 
 // The markings that can be the nearest to some point of each 0.5 m cell of the floor, so that a
-// point is compared with those instead of all of them (the match is a third of the bound's cost).
+// point is compared with those instead of all of them (the match is a quarter of the bound's cost).
 class MarkingIndex {
  public:
   explicit MarkingIndex(const Field& f) : f_(f) {
