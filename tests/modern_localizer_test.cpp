@@ -186,8 +186,8 @@ TEST(AlternativePoses, SimplexFitsThePoseFromAnOffsetStart) {
 // one frame brings the same points and seven more 15 cm in front of that line: the first gate lets
 // them through and they pull the estimate; judged once the frame's own tilt, fitted to all its
 // points, is taken out, they are 5 or more white spreads off and are left out. A tilted frame is not
-// taken for outliers: with points moved by a tilt of 0.1 deg in roll and pitch (far points by up to 8 cm), the
-// gate leaves none of them out and the estimate is the one without the gate.
+// taken for outliers: with points moved by a tilt of 0.1 deg in roll and pitch (far points by up to
+// 8 cm), the gate leaves none of them out and the estimate is the one without the gate.
 TEST(UkfMh, PointsOffTheirMarkingOnceTheFramesTiltIsOutAreLeftOut) {
   const Field f = Field::preset("msl2012");
   const Pose2 truth(3.0, 0.3, 0.0);
